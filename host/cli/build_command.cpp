@@ -1,0 +1,13 @@
+// Placeholder until the command is implemented; replaced by its owner.
+#include <cstdio>
+
+#include "commands.hpp"
+
+namespace mmvk::cli {
+
+int run_build(Args) {
+  std::fputs("mmvk build: not implemented yet\n", stderr);
+  return 1;
+}
+
+}  // namespace mmvk::cli

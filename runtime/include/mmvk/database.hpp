@@ -1,0 +1,108 @@
+// The motion database: the normalized feature matrix, the normalization that
+// produced it, clips and per-frame metadata. Immutable once created; every
+// search backend (CPU and Vulkan) reads it, none modifies it.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mmvk/feature_schema.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+using TagMask = std::uint64_t;  // bit t set = the frame carries tag_names()[t]
+inline constexpr std::size_t kMaxTags = 64;
+
+// Per-frame flags.
+enum FrameFlag : std::uint32_t {
+  kFrameDoNotUse = 1u << 0,         // never a result
+  kFrameBlockTransition = 1u << 1,  // may be continued into, never jumped into
+  kFrameEdgeExcluded = 1u << 2,     // future trajectory runs past a non-looping clip's end
+};
+
+struct Clip {
+  std::string name;
+  std::string source;               // the BVH file it came from
+  TagMask tags = 0;
+  bool loop = false;
+  bool mirrored = false;
+  float cost_multiplier = 1.0f;     // > 0
+  float cost_bias = 0.0f;           // added to every frame's cost
+  std::uint32_t first_frame = 0;    // database frame index of the clip's first frame
+  std::uint32_t frame_count = 0;
+};
+
+// Normalization of one feature dimension: normalized = (raw - offset) / scale.
+// The channel weight is folded into the scale (scale = spread / weight).
+struct DimNormalization {
+  float offset = 0.0f;
+  float scale = 1.0f;   // > 0
+};
+
+// Everything a Database is made of; Database::create validates it.
+struct DatabaseParts {
+  FeatureSchema schema;
+  float fps = 0.0f;
+  std::vector<DimNormalization> normalization;  // [dims]
+  std::vector<std::string> tag_names;           // <= kMaxTags, unique
+  std::vector<Clip> clips;                      // contiguous, in frame order, covering all frames
+  std::vector<std::uint32_t> frame_flags;       // [frames], FrameFlag bits
+  std::vector<float> features;                  // [frames x dims], normalized, row-major
+};
+
+class Database {
+ public:
+  // Validates: schema, dims, finite features, positive scales, clip ranges,
+  // tag masks within tag_names, multipliers > 0, finite biases.
+  static Result<Database> create(DatabaseParts parts);
+
+  const FeatureSchema& schema() const { return parts_.schema; }
+  float fps() const { return parts_.fps; }
+  std::uint32_t frame_count() const { return frame_count_; }
+  std::uint32_t dims() const { return dims_; }
+
+  // Row-major [frame_count x dims], normalized.
+  std::span<const float> features() const { return parts_.features; }
+  std::span<const float> row(std::uint32_t frame) const { return {parts_.features.data() + std::size_t{frame} * dims_, dims_}; }
+  std::span<const DimNormalization> normalization() const { return parts_.normalization; }
+  std::span<const std::string> tag_names() const { return parts_.tag_names; }
+  std::span<const Clip> clips() const { return parts_.clips; }
+
+  // Per-frame metadata, [frame_count] each (the clip's values repeated, so
+  // backends index them by frame without a lookup).
+  std::span<const std::uint32_t> frame_flags() const { return parts_.frame_flags; }
+  std::span<const std::uint32_t> frame_clip() const { return frame_clip_; }
+  std::span<const TagMask> frame_tags() const { return frame_tags_; }
+  std::span<const float> frame_multiplier() const { return frame_multiplier_; }
+  std::span<const float> frame_bias() const { return frame_bias_; }
+
+  // Mask of the named tags; an unknown name is an error that names it.
+  Result<TagMask> tag_mask(std::span<const std::string> names) const;
+  // Normalizes a raw feature vector of dims() values (same offsets and scales
+  // as the database rows). Precondition: raw.size() == out.size() == dims().
+  void normalize(std::span<const float> raw, std::span<float> out) const;
+
+  // A 64-bit digest of the whole content; cluster tables and backends record
+  // it to detect being used with another database.
+  std::uint64_t content_hash() const { return content_hash_; }
+
+  const DatabaseParts& parts() const { return parts_; }
+
+ private:
+  explicit Database(DatabaseParts parts);
+
+  DatabaseParts parts_;
+  std::uint32_t frame_count_ = 0;
+  std::uint32_t dims_ = 0;
+  std::vector<std::uint32_t> frame_clip_;
+  std::vector<TagMask> frame_tags_;
+  std::vector<float> frame_multiplier_;
+  std::vector<float> frame_bias_;
+  std::uint64_t content_hash_ = 0;
+};
+
+}  // namespace mmvk

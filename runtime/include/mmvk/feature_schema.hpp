@@ -1,0 +1,74 @@
+// The feature schema: one table of channels that drives both the database
+// build and the query build, so no layout offset is ever written by hand.
+// Each channel is one normalization and weighting group.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+inline constexpr std::size_t kMaxChannels = 32;
+
+enum class ChannelKind : std::uint8_t {
+  TrajectoryPosition,   // future root positions (x, z) in character space, metres; 2 dims per offset
+  TrajectoryDirection,  // future facing directions (x, z) in character space; 2 dims per offset
+  BonePosition,         // bone position (x, y, z) in character space, metres; 3 dims
+  BoneVelocity,         // bone velocity (x, y, z) in character space, m/s; 3 dims
+  RootVelocity,         // hip (source bone) velocity (x, y, z) in character space, m/s; 3 dims
+  Custom,               // per-frame values from a sidecar file; `custom_dims` dims
+};
+
+enum class Normalization : std::uint8_t {
+  GroupStd,     // z-score; one spread for the channel = mean of its per-dim std
+  PerDimStd,    // z-score per dimension
+  MeanAbsDev,   // mean absolute deviation per dimension (UE PoseSearch's choice)
+  MinMax,       // (x - min) / (max - min) per dimension
+};
+
+struct FeatureChannel {
+  std::string name;                     // unique within the schema
+  ChannelKind kind = ChannelKind::BonePosition;
+  std::string bone;                     // Bone*: joint name or role, see find_bone()
+  std::vector<float> offsets_seconds;   // Trajectory*: future times, seconds, > 0
+  std::uint32_t custom_dims = 0;        // Custom: dims per frame
+  float weight = 1.0f;                  // > 0; folded into the scale (scale = spread / weight)
+  Normalization normalization = Normalization::GroupStd;
+
+  std::uint32_t dims() const;
+};
+
+struct FeatureSchema {
+  std::vector<FeatureChannel> channels;  // order = feature layout order
+
+  std::uint32_t dims() const;
+  // First feature dimension of channel `c`.
+  std::uint32_t offset(std::size_t channel) const;
+  // Index of the channel named `name`, or -1.
+  int find(std::string_view name) const;
+  // Name of dimension d, e.g. "trajectory_position[1].z".
+  std::string dim_name(std::uint32_t d) const;
+  // Checks names, dims, weights, offsets and the channel count (<= kMaxChannels).
+  Status validate() const;
+};
+
+// The widely used 27-d set: left/right foot positions and velocities, hip
+// velocity, trajectory positions (x, z) and directions (x, z) at 0.33, 0.67
+// and 1.0 s.
+FeatureSchema default_schema();
+
+// JSON form: {"channels": [{"name": ..., "kind": "trajectory_position" |
+// "trajectory_direction" | "bone_position" | "bone_velocity" |
+// "root_velocity" | "custom", "bone": ..., "offsets_seconds": [...],
+// "dims": n, "weight": w, "normalization": "group_std" | "per_dim_std" |
+// "mean_abs_dev" | "min_max"}]}. Errors name the field at fault.
+Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source);
+Result<FeatureSchema> load_schema(const std::filesystem::path& path);
+std::string schema_to_json(const FeatureSchema& schema);
+
+}  // namespace mmvk

@@ -1,0 +1,74 @@
+// A clip of motion as local joint transforms in metres, Y-up, right-handed,
+// plus the operations that produce one: import from BVH (units, axes),
+// resampling and left/right mirroring; and forward kinematics.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "mmvk/bvh.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+struct Skeleton {
+  std::vector<std::string> names;
+  std::vector<int> parents;           // -1 for the root; parents[i] < i
+  std::vector<glm::vec3> rest_offsets;  // metres, in the parent's frame
+
+  std::size_t size() const { return names.size(); }
+  // Index of the joint named `name` (exact match), or -1.
+  int find(std::string_view name) const;
+};
+
+// Local transforms per frame, in metres, Y-up. Position channels of the BVH
+// replace the OFFSET (they do not add to it), so local_positions holds the
+// effective translation of each joint relative to its parent.
+struct Motion {
+  Skeleton skeleton;
+  float fps = 0.0f;
+  std::uint32_t frame_count = 0;
+  std::vector<glm::vec3> local_positions;  // [frame_count x joints], metres
+  std::vector<glm::quat> local_rotations;  // [frame_count x joints]
+
+  std::size_t joint_count() const { return skeleton.size(); }
+  std::size_t index(std::uint32_t frame, std::size_t joint) const { return frame * joint_count() + joint; }
+};
+
+enum class UpAxis : std::uint8_t { Y, Z };
+
+struct ImportOptions {
+  // Metres per file unit. 0 = guess from the skeleton's height (cm, ASF units
+  // of 0.05644 m, inches or metres); CMU ASF-derived BVH is 0.05644, Bandai and
+  // LAFAN1 are 0.01.
+  float metres_per_unit = 0.0f;
+  // The file's up axis; Z-up files are rotated into mmvk's Y-up frame.
+  UpAxis up_axis = UpAxis::Y;
+};
+
+Result<Motion> motion_from_bvh(const BvhFile& file, const ImportOptions& options);
+
+// Global (model-space) joint positions and rotations of one frame.
+// Preconditions: frame < motion.frame_count, spans sized joint_count().
+void forward_kinematics(const Motion& motion, std::uint32_t frame, std::span<glm::vec3> global_positions,
+                        std::span<glm::quat> global_rotations);
+
+// Resamples to `fps` (> 0): positions are interpolated linearly and rotations
+// with slerp; the clip's duration is kept.
+Result<Motion> resample(const Motion& motion, float fps);
+
+// Swaps left and right: joints are paired by name (_L/_R, Left/Right, l/r
+// prefixes) and the motion is reflected across the YZ plane (x -> -x).
+// mirror(mirror(m)) == m.
+Result<Motion> mirror(const Motion& motion);
+
+// Index of each joint's mirror partner (itself when it has none).
+std::vector<int> mirror_pairs(const Skeleton& skeleton);
+
+}  // namespace mmvk

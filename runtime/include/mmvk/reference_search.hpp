@@ -1,0 +1,25 @@
+// The CPU reference: plain scalar brute force in the documented order. It is
+// the oracle every other backend is tested against; it is meant to be
+// obviously right, not fast.
+#pragma once
+
+#include "mmvk/search.hpp"
+
+namespace mmvk {
+
+class ReferenceSearch final : public SearchBackend {
+ public:
+  explicit ReferenceSearch(const Database& database) : database_(&database) {}
+
+  std::string_view name() const override { return "reference"; }
+  const Database& database() const override { return *database_; }
+  Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
+  SearchStats stats() const override { return stats_; }
+  void reset_stats() override { stats_ = {}; }
+
+ private:
+  const Database* database_;
+  SearchStats stats_;
+};
+
+}  // namespace mmvk

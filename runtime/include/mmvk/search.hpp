@@ -1,0 +1,103 @@
+// The search semantics every backend implements (docs/search.md explains
+// them in prose). One batched call answers a whole crowd's queries.
+//
+// Cost of a candidate frame i for a query q:
+//   total_i = sum over channels c in schema order of  w_c * s_ic,
+//             s_ic = sum over dims d of c in order of (x_id - q_d)^2,
+//             accumulated in float from 0.0f, without FP contraction;
+//   cost_i  = multiplier_i * total_i + bias_i
+//             (+ continuing_bias, added last, when i is the continuing frame).
+// Results are the best k frames sorted by (cost, frame id): equal costs go to
+// the lower frame id.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string_view>
+
+#include "mmvk/database.hpp"
+#include "mmvk/feature_schema.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+inline constexpr std::uint32_t kNoFrame = 0xFFFFFFFFu;
+inline constexpr std::uint32_t kMaxK = 16;
+
+// Per-query options. The defaults give a plain nearest-neighbour query.
+struct QueryParams {
+  // The frame the character plays next if it does not jump, or kNoFrame.
+  std::uint32_t continuing_frame = kNoFrame;
+  // Added to the continuing frame's cost (negative favours staying).
+  float continuing_bias = 0.0f;
+  // Frames within +-exclusion_window of the continuing frame in the same clip
+  // (wrapping for looping clips) are not candidates; the continuing frame
+  // itself stays one.
+  std::uint32_t exclusion_window = 0;
+  TagMask require_all = 0;   // candidate tags must include all of these
+  TagMask exclude_any = 0;   // candidate tags must include none of these
+  // Weight of each schema channel (finite, >= 0; 0 turns the channel off).
+  std::array<float, kMaxChannels> channel_weights = filled_weights();
+
+  static constexpr std::array<float, kMaxChannels> filled_weights() {
+    std::array<float, kMaxChannels> w{};
+    w.fill(1.0f);
+    return w;
+  }
+};
+
+struct Match {
+  std::uint32_t frame = kNoFrame;  // kNoFrame: no valid candidate ("none")
+  float cost = std::numeric_limits<float>::infinity();
+
+  friend bool operator==(const Match&, const Match&) = default;
+};
+
+// A batch of B queries.
+struct QueryBatch {
+  std::span<const float> features;     // [B x dims], normalized (Database::normalize)
+  std::span<const QueryParams> params;  // [B], or empty: default params for every query
+  std::size_t size = 0;                 // B
+};
+
+// Counters a backend accumulates over its calls (benchmarks report them).
+struct SearchStats {
+  std::uint64_t queries = 0;
+  std::uint64_t rows_evaluated = 0;  // full cost evaluations
+  double rows_fraction(std::uint32_t frame_count) const {
+    return queries == 0 ? 0.0 : double(rows_evaluated) / (double(queries) * frame_count);
+  }
+};
+
+class SearchBackend {
+ public:
+  virtual ~SearchBackend() = default;
+  virtual std::string_view name() const = 0;
+  virtual const Database& database() const = 0;
+  // Writes B*k matches, query b's best k at out[b*k .. b*k+k), sorted by
+  // (cost, frame); slots beyond the number of candidates are Match{} (none).
+  virtual Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) = 0;
+  virtual SearchStats stats() const = 0;
+  virtual void reset_stats() = 0;
+};
+
+// The checks every backend runs before searching: k in [1, kMaxK], sizes,
+// finite query features, params (continuing frame in range, weights finite
+// and >= 0), an empty database. Errors name the query index and field.
+Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out);
+
+// True when frame `frame` may be a result for `params` (flags, tags and the
+// exclusion window); the same rule every backend applies.
+bool is_candidate(const Database& database, std::uint32_t frame, const QueryParams& params);
+
+// The cost of frame `frame` for a query, in the documented order.
+float frame_cost(const Database& database, std::uint32_t frame, std::span<const float> query, const QueryParams& params);
+
+// Orders matches by (cost, frame).
+inline bool match_less(const Match& a, const Match& b) {
+  return a.cost < b.cost || (a.cost == b.cost && a.frame < b.frame);
+}
+
+}  // namespace mmvk

@@ -1,0 +1,131 @@
+#include "mmvk/feature_schema.hpp"
+
+#include <cmath>
+#include <set>
+
+namespace mmvk {
+
+std::uint32_t FeatureChannel::dims() const {
+  switch (kind) {
+    case ChannelKind::TrajectoryPosition:
+    case ChannelKind::TrajectoryDirection:
+      return 2 * static_cast<std::uint32_t>(offsets_seconds.size());
+    case ChannelKind::BonePosition:
+    case ChannelKind::BoneVelocity:
+    case ChannelKind::RootVelocity:
+      return 3;
+    case ChannelKind::Custom:
+      return custom_dims;
+  }
+  return 0;
+}
+
+std::uint32_t FeatureSchema::dims() const {
+  std::uint32_t total = 0;
+  for (const FeatureChannel& channel : channels) total += channel.dims();
+  return total;
+}
+
+std::uint32_t FeatureSchema::offset(std::size_t channel) const {
+  std::uint32_t total = 0;
+  for (std::size_t c = 0; c < channel; ++c) total += channels[c].dims();
+  return total;
+}
+
+int FeatureSchema::find(std::string_view name) const {
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    if (channels[c].name == name) return static_cast<int>(c);
+  }
+  return -1;
+}
+
+std::string FeatureSchema::dim_name(std::uint32_t d) const {
+  static constexpr const char* kXyz[] = {"x", "y", "z"};
+  static constexpr const char* kXz[] = {"x", "z"};
+  for (const FeatureChannel& channel : channels) {
+    const std::uint32_t n = channel.dims();
+    if (d < n) {
+      switch (channel.kind) {
+        case ChannelKind::TrajectoryPosition:
+        case ChannelKind::TrajectoryDirection:
+          return channel.name + "[" + std::to_string(d / 2) + "]." + kXz[d % 2];
+        case ChannelKind::BonePosition:
+        case ChannelKind::BoneVelocity:
+        case ChannelKind::RootVelocity:
+          return channel.name + "." + kXyz[d];
+        case ChannelKind::Custom:
+          return channel.name + "[" + std::to_string(d) + "]";
+      }
+    }
+    d -= n;
+  }
+  return "dim " + std::to_string(d) + " (beyond the schema)";
+}
+
+Status FeatureSchema::validate() const {
+  if (channels.empty()) return make_error("schema: no channels");
+  if (channels.size() > kMaxChannels) {
+    return make_error("schema: " + std::to_string(channels.size()) + " channels, at most " +
+                      std::to_string(kMaxChannels) + " are supported");
+  }
+  std::set<std::string> names;
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    const FeatureChannel& channel = channels[c];
+    const std::string where = "schema: channel " + std::to_string(c) + " ('" + channel.name + "')";
+    if (channel.name.empty()) return make_error("schema: channel " + std::to_string(c) + " has no name");
+    if (!names.insert(channel.name).second) return make_error(where + ": duplicate name");
+    if (!(channel.weight > 0.0f) || !std::isfinite(channel.weight)) {
+      return make_error(where + ": weight must be finite and > 0");
+    }
+    switch (channel.kind) {
+      case ChannelKind::TrajectoryPosition:
+      case ChannelKind::TrajectoryDirection:
+        if (channel.offsets_seconds.empty()) return make_error(where + ": offsets_seconds is empty");
+        for (float t : channel.offsets_seconds) {
+          if (!(t > 0.0f) || !std::isfinite(t)) return make_error(where + ": offsets_seconds must be finite and > 0");
+        }
+        break;
+      case ChannelKind::BonePosition:
+      case ChannelKind::BoneVelocity:
+        if (channel.bone.empty()) return make_error(where + ": bone is missing");
+        break;
+      case ChannelKind::RootVelocity:
+        break;
+      case ChannelKind::Custom:
+        if (channel.custom_dims == 0) return make_error(where + ": dims must be > 0");
+        break;
+    }
+  }
+  return {};
+}
+
+FeatureSchema default_schema() {
+  const std::vector<float> offsets = {1.0f / 3.0f, 2.0f / 3.0f, 1.0f};
+  auto bone_channel = [](std::string name, ChannelKind kind, std::string bone) {
+    FeatureChannel channel;
+    channel.name = std::move(name);
+    channel.kind = kind;
+    channel.bone = std::move(bone);
+    return channel;
+  };
+  auto trajectory_channel = [&](std::string name, ChannelKind kind) {
+    FeatureChannel channel;
+    channel.name = std::move(name);
+    channel.kind = kind;
+    channel.offsets_seconds = offsets;
+    return channel;
+  };
+  FeatureSchema schema;
+  schema.channels = {
+      bone_channel("left_foot_position", ChannelKind::BonePosition, "@left_foot"),
+      bone_channel("right_foot_position", ChannelKind::BonePosition, "@right_foot"),
+      bone_channel("left_foot_velocity", ChannelKind::BoneVelocity, "@left_foot"),
+      bone_channel("right_foot_velocity", ChannelKind::BoneVelocity, "@right_foot"),
+      bone_channel("hip_velocity", ChannelKind::RootVelocity, "@hips"),
+      trajectory_channel("trajectory_position", ChannelKind::TrajectoryPosition),
+      trajectory_channel("trajectory_direction", ChannelKind::TrajectoryDirection),
+  };
+  return schema;
+}
+
+}  // namespace mmvk

@@ -1,0 +1,91 @@
+#include "mmvk/search.hpp"
+
+#include <cmath>
+
+namespace mmvk {
+
+Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out) {
+  if (database.frame_count() == 0) return make_error("search: the database is empty");
+  if (k < 1 || k > kMaxK) {
+    return make_error("search: k = " + std::to_string(k) + " is out of range [1, " + std::to_string(kMaxK) + "]");
+  }
+  const std::size_t dims = database.dims();
+  if (batch.features.size() != batch.size * dims) {
+    return make_error("search: query features have " + std::to_string(batch.features.size()) + " values, expected " +
+                      std::to_string(batch.size) + " queries x " + std::to_string(dims) + " dims");
+  }
+  if (!batch.params.empty() && batch.params.size() != batch.size) {
+    return make_error("search: " + std::to_string(batch.params.size()) + " query params for " +
+                      std::to_string(batch.size) + " queries");
+  }
+  if (out.size() != batch.size * k) {
+    return make_error("search: result span has " + std::to_string(out.size()) + " slots, expected " +
+                      std::to_string(batch.size) + " x k=" + std::to_string(k));
+  }
+  for (std::size_t i = 0; i < batch.features.size(); ++i) {
+    if (!std::isfinite(batch.features[i])) {
+      return make_error("search: query " + std::to_string(i / dims) + " feature " +
+                        database.schema().dim_name(static_cast<std::uint32_t>(i % dims)) + " is not finite");
+    }
+  }
+  const std::size_t channels = database.schema().channels.size();
+  for (std::size_t q = 0; q < batch.params.size(); ++q) {
+    const QueryParams& p = batch.params[q];
+    const std::string where = "search: query " + std::to_string(q) + ": ";
+    if (p.continuing_frame != kNoFrame && p.continuing_frame >= database.frame_count()) {
+      return make_error(where + "continuing_frame " + std::to_string(p.continuing_frame) + " is out of range (" +
+                        std::to_string(database.frame_count()) + " frames)");
+    }
+    if (!std::isfinite(p.continuing_bias)) return make_error(where + "continuing_bias is not finite");
+    for (std::size_t c = 0; c < channels; ++c) {
+      if (!std::isfinite(p.channel_weights[c]) || p.channel_weights[c] < 0.0f) {
+        return make_error(where + "weight of channel '" + database.schema().channels[c].name +
+                          "' must be finite and >= 0");
+      }
+    }
+  }
+  return {};
+}
+
+bool is_candidate(const Database& database, std::uint32_t frame, const QueryParams& params) {
+  const std::uint32_t flags = database.frame_flags()[frame];
+  if ((flags & (kFrameDoNotUse | kFrameEdgeExcluded)) != 0) return false;
+  const bool continuing = frame == params.continuing_frame;
+  if ((flags & kFrameBlockTransition) != 0 && !continuing) return false;
+  const TagMask tags = database.frame_tags()[frame];
+  if ((tags & params.require_all) != params.require_all) return false;
+  if ((tags & params.exclude_any) != 0) return false;
+  if (params.continuing_frame != kNoFrame && !continuing && params.exclusion_window > 0) {
+    const std::uint32_t clip_index = database.frame_clip()[params.continuing_frame];
+    if (database.frame_clip()[frame] == clip_index) {
+      const Clip& clip = database.clips()[clip_index];
+      const std::uint32_t a = frame - clip.first_frame;
+      const std::uint32_t b = params.continuing_frame - clip.first_frame;
+      std::uint32_t distance = a > b ? a - b : b - a;
+      if (clip.loop) distance = std::min(distance, clip.frame_count - distance);
+      if (distance <= params.exclusion_window) return false;
+    }
+  }
+  return true;
+}
+
+float frame_cost(const Database& database, std::uint32_t frame, std::span<const float> query, const QueryParams& params) {
+  const std::span<const float> row = database.row(frame);
+  const FeatureSchema& schema = database.schema();
+  float total = 0.0f;
+  std::uint32_t d = 0;
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const std::uint32_t end = d + schema.channels[c].dims();
+    float channel_sum = 0.0f;
+    for (; d < end; ++d) {
+      const float diff = row[d] - query[d];
+      channel_sum += diff * diff;
+    }
+    total += params.channel_weights[c] * channel_sum;
+  }
+  float cost = database.frame_multiplier()[frame] * total + database.frame_bias()[frame];
+  if (frame == params.continuing_frame) cost += params.continuing_bias;
+  return cost;
+}
+
+}  // namespace mmvk

@@ -1,0 +1,75 @@
+// Manifest -> Database: load every clip (parse, import, resample, mirror),
+// extract raw features with the schema, normalize them over the whole
+// database, and assemble clips, tags and per-frame flags.
+//
+// Rules:
+//   - Frame rate: the manifest's fps (or the CLI's --fps) resamples every clip;
+//     without it the database keeps the source rate, and clips with different
+//     source rates are an error naming two files that disagree.
+//   - Mirroring: a clip with mirror = true is followed by its mirrored copy,
+//     a separate clip named "<name>_mirrored" with Clip::mirrored set and the
+//     same tags, flags and costs. Custom channel values are copied unchanged.
+//   - Edge rule (non-looping clips): a frame whose furthest trajectory offset
+//     (round(max offset_seconds x fps) frames ahead) lies past the clip's last
+//     frame is flagged kFrameEdgeExcluded with EdgeRule::Exclude, and kept as
+//     an ordinary frame with clamped trajectory features with
+//     EdgeRule::Clamp. Looping clips wrap and never get the flag.
+//   - Time ranges: frame f of a clip is in [begin, end) seconds when
+//     begin <= f / fps < end; do_not_use sets kFrameDoNotUse,
+//     block_transition sets kFrameBlockTransition.
+//   - Normalization statistics are taken over every frame of the database
+//     (normalization.hpp); tags are numbered in order of first appearance.
+//   - Skeletons may differ between clips as long as the schema's bones
+//     resolve on each (find_bone).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mmvk/database.hpp"
+#include "mmvk/manifest.hpp"
+#include "mmvk/motion.hpp"
+#include "mmvk/status.hpp"
+#include "mmvk/thread_pool.hpp"
+
+namespace mmvk {
+
+struct BuildProgress {
+  std::size_t clips_done = 0;     // manifest clips loaded so far
+  std::size_t clip_count = 0;     // manifest clips in all
+  std::uint64_t frames_done = 0;  // database frames produced so far (mirrored copies included)
+};
+
+struct BuildOptions {
+  // Called after each manifest clip is processed. Calls are serialized but
+  // may come from the pool's worker threads.
+  std::function<void(const BuildProgress&)> progress;
+  // Clips are loaded and featurized in parallel on this pool when given.
+  ThreadPool* pool = nullptr;
+};
+
+Result<Database> build_database(const Manifest& manifest, const BuildOptions& options = {});
+
+// The lower-level entry: clips already in memory (tests, hosts with their own
+// importer). `meta.file` only names the clip in messages and Clip::source;
+// `meta.mirror` is ignored (pass mirrored motions yourself, with mirrored =
+// true). Every motion must have the same fps, which the database keeps.
+struct MotionClip {
+  ManifestClip meta;
+  Motion motion;
+  std::vector<std::vector<float>> custom;  // one [frames x dims] array per Custom channel, schema order
+  bool mirrored = false;
+};
+
+struct MotionBuildSettings {
+  FeatureSchema schema = default_schema();
+  CharacterRootOptions character_root;
+  EdgeRule edge_rule = EdgeRule::Exclude;
+};
+
+Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings);
+
+}  // namespace mmvk

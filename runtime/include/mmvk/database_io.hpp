@@ -1,0 +1,49 @@
+// The .mmdb file: a versioned, checksummed binary form of a Database.
+//
+// Layout (all integers and floats little-endian):
+//   offset 0   8 bytes  magic "MMVKDB\n\0"
+//          8   u32      format version (kDatabaseFormatVersion)
+//         12   u32      reserved, 0
+//         16   u64      payload size P in bytes
+//         24   P bytes  payload:
+//                         str  schema as JSON (schema_to_json)
+//                         f32  fps
+//                         u32  dims, then dims x (f32 offset, f32 scale)
+//                         u32  tag count, then that many str
+//                         u32  clip count, then per clip: str name, str source,
+//                              u64 tags, u8 loop, u8 mirrored, f32 cost multiplier,
+//                              f32 cost bias, u32 first frame, u32 frame count
+//                         u32  frames, then frames x u32 frame flags
+//                         f32  features [frames x dims], row-major, normalized
+//                       (str = u32 byte length + UTF-8 bytes)
+//   24 + P     u64      FNV-1a 64 of bytes [0, 24 + P)
+// Loading checks, in order: the length covers the header, the magic, the
+// version, that the payload size matches the file length exactly, the
+// checksum, then every size inside the payload against what is left, and
+// finally everything Database::create validates. Each failure names the file.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "mmvk/database.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+inline constexpr std::uint32_t kDatabaseFormatVersion = 1;
+inline constexpr std::size_t kDatabaseHeaderBytes = 24;
+
+// The file's bytes.
+std::string serialize_database(const Database& database);
+// Parses and validates file bytes; `source` names the file in messages.
+Result<Database> deserialize_database(std::string_view bytes, std::string_view source);
+
+// Atomic write (temp file beside the target, fsync, rename): a failed save
+// leaves any previous file intact.
+Status save_database(const Database& database, const std::filesystem::path& path);
+Result<Database> load_database(const std::filesystem::path& path);
+
+}  // namespace mmvk

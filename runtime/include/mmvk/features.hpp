@@ -1,0 +1,88 @@
+// Raw feature extraction: one clip of motion + its character root + the
+// feature schema -> a [frames x schema.dims()] matrix of raw (unnormalized)
+// features in character space.
+//
+// Character space of frame f: origin at the character root position (on the
+// ground), +Z along the root's facing, +Y up, +X to the character's left
+// (right-handed). Every channel kind is expressed in it:
+//   - BonePosition: global bone position minus the root position, rotated
+//     into character space, metres.
+//   - BoneVelocity / RootVelocity: the global bone velocity rotated into
+//     character space, m/s. Velocities are finite differences of global
+//     positions: central inside the clip, one-sided on its first and last
+//     frame (0 for a one-frame clip). RootVelocity uses the channel's `bone`,
+//     or "@hips" when it is empty.
+//   - TrajectoryPosition: the root position `k` frames ahead, (x, z) in the
+//     current character space, metres; k = round(offset_seconds * fps), at
+//     least 1.
+//   - TrajectoryDirection: the root facing `k` frames ahead, (x, z) in the
+//     current character space (a unit vector).
+//   - Custom: values copied from the caller's per-channel arrays.
+//
+// Future frames past the end of a clip: a looping clip wraps (its last frame
+// is followed by its first, displaced by one "cycle": the rigid ground motion
+// from frame 0 to the frame after the last, extrapolated from the last step);
+// a non-looping clip clamps to its last frame and reports the frame as
+// running past the end (the database build turns that into
+// kFrameEdgeExcluded or ignores it, depending on its edge rule).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mmvk/character.hpp"
+#include "mmvk/feature_schema.hpp"
+#include "mmvk/motion.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+struct FeatureExtractionOptions {
+  bool loop = false;
+  // Names the clip in error messages (usually the BVH path).
+  std::string source;
+  // One array per Custom channel, in schema order, each [frame_count x
+  // custom_dims]. Must hold exactly as many arrays as the schema has Custom
+  // channels.
+  std::span<const std::vector<float>> custom;
+};
+
+struct RawFeatures {
+  std::uint32_t frame_count = 0;
+  std::uint32_t dims = 0;
+  std::vector<float> values;            // [frame_count x dims], row-major, raw units
+  std::vector<std::uint8_t> past_end;   // [frame_count]: 1 when a trajectory offset ran past a non-looping clip's end
+};
+
+// Frames ahead for a trajectory offset at `fps`: round(seconds * fps), >= 1.
+std::uint32_t offset_frames(float offset_seconds, float fps);
+
+// Largest trajectory offset of the schema in frames at `fps` (0 when the
+// schema has no trajectory channel).
+std::uint32_t max_offset_frames(const FeatureSchema& schema, float fps);
+
+// Extracts raw features. Bones are resolved with find_bone() on the motion's
+// skeleton; an unresolved bone is an error naming the channel and the source.
+// Preconditions: root arrays sized motion.frame_count.
+Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& root, const FeatureSchema& schema,
+                                     const FeatureExtractionOptions& options);
+
+// Custom channel sidecars: the values of Custom channel `name` for clip
+// `dir/walk.bvh` are read from `dir/walk.name.f32`, raw little-endian float32
+// [source frames x custom_dims] at the BVH's own frame rate (before any
+// resampling). Returns the path for a clip file.
+std::filesystem::path custom_sidecar_path(const std::filesystem::path& bvh_path, const FeatureChannel& channel);
+
+// Loads a sidecar and checks its size against `frame_count` x channel dims.
+Result<std::vector<float>> load_custom_sidecar(const std::filesystem::path& bvh_path, const FeatureChannel& channel,
+                                               std::uint32_t frame_count);
+
+// Linear resampling of per-frame values [src_frames x dims] at src_fps to
+// dst_frames at dst_fps (times clamped to the source's last frame).
+std::vector<float> resample_values(std::span<const float> values, std::uint32_t dims, std::uint32_t src_frames,
+                                   float src_fps, std::uint32_t dst_frames, float dst_fps);
+
+}  // namespace mmvk

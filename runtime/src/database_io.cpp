@@ -1,0 +1,252 @@
+#include "mmvk/database_io.hpp"
+
+#include <bit>
+#include <cstring>
+
+#include "file_io.hpp"
+#include "hash.hpp"
+
+namespace mmvk {
+
+namespace {
+
+constexpr char kMagic[8] = {'M', 'M', 'V', 'K', 'D', 'B', '\n', '\0'};
+
+// Little-endian encoding independent of the host's byte order.
+class Writer {
+ public:
+  void u8(std::uint8_t v) { bytes_.push_back(static_cast<char>(v)); }
+  void u32(std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  }
+  void u64(std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  }
+  void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
+  void str(std::string_view s) {
+    u32(static_cast<std::uint32_t>(s.size()));
+    bytes_.append(s);
+  }
+  void raw(std::string_view s) { bytes_.append(s); }
+  std::string& bytes() { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+// Bounds-checked reads: every size read from the file is compared with what
+// is left before it is used.
+class Reader {
+ public:
+  Reader(std::string_view bytes, std::size_t start, std::size_t end) : bytes_(bytes), pos_(start), end_(end) {}
+
+  std::size_t left() const { return end_ - pos_; }
+  std::size_t position() const { return pos_; }
+
+  bool u8(std::uint8_t& v) {
+    if (left() < 1) return false;
+    v = static_cast<std::uint8_t>(bytes_[pos_++]);
+    return true;
+  }
+  bool u32(std::uint32_t& v) {
+    if (left() < 4) return false;
+    v = 0;
+    for (int i = 0; i < 4; ++i) v |= std::uint32_t{static_cast<std::uint8_t>(bytes_[pos_ + i])} << (8 * i);
+    pos_ += 4;
+    return true;
+  }
+  bool u64(std::uint64_t& v) {
+    if (left() < 8) return false;
+    v = 0;
+    for (int i = 0; i < 8; ++i) v |= std::uint64_t{static_cast<std::uint8_t>(bytes_[pos_ + i])} << (8 * i);
+    pos_ += 8;
+    return true;
+  }
+  bool f32(float& v) {
+    std::uint32_t bits = 0;
+    if (!u32(bits)) return false;
+    v = std::bit_cast<float>(bits);
+    return true;
+  }
+  bool str(std::string& s) {
+    std::uint32_t size = 0;
+    if (!u32(size) || size > left()) return false;
+    s.assign(bytes_.data() + pos_, size);
+    pos_ += size;
+    return true;
+  }
+
+ private:
+  std::string_view bytes_;
+  std::size_t pos_;
+  std::size_t end_;
+};
+
+std::uint64_t read_u64_at(std::string_view bytes, std::size_t at) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= std::uint64_t{static_cast<std::uint8_t>(bytes[at + i])} << (8 * i);
+  return v;
+}
+
+std::uint32_t read_u32_at(std::string_view bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v |= std::uint32_t{static_cast<std::uint8_t>(bytes[at + i])} << (8 * i);
+  return v;
+}
+
+}  // namespace
+
+std::string serialize_database(const Database& database) {
+  const DatabaseParts& parts = database.parts();
+  Writer payload;
+  payload.str(schema_to_json(parts.schema));
+  payload.f32(parts.fps);
+  payload.u32(static_cast<std::uint32_t>(parts.normalization.size()));
+  for (const DimNormalization& n : parts.normalization) {
+    payload.f32(n.offset);
+    payload.f32(n.scale);
+  }
+  payload.u32(static_cast<std::uint32_t>(parts.tag_names.size()));
+  for (const std::string& tag : parts.tag_names) payload.str(tag);
+  payload.u32(static_cast<std::uint32_t>(parts.clips.size()));
+  for (const Clip& clip : parts.clips) {
+    payload.str(clip.name);
+    payload.str(clip.source);
+    payload.u64(clip.tags);
+    payload.u8(clip.loop ? 1 : 0);
+    payload.u8(clip.mirrored ? 1 : 0);
+    payload.f32(clip.cost_multiplier);
+    payload.f32(clip.cost_bias);
+    payload.u32(clip.first_frame);
+    payload.u32(clip.frame_count);
+  }
+  payload.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
+  for (std::uint32_t flags : parts.frame_flags) payload.u32(flags);
+  payload.bytes().reserve(payload.bytes().size() + parts.features.size() * 4 + 64);
+  for (float v : parts.features) payload.f32(v);
+
+  Writer file;
+  file.raw(std::string_view(kMagic, sizeof(kMagic)));
+  file.u32(kDatabaseFormatVersion);
+  file.u32(0);
+  file.u64(payload.bytes().size());
+  file.bytes().reserve(kDatabaseHeaderBytes + payload.bytes().size() + 8);
+  file.raw(payload.bytes());
+  detail::Hasher hasher;
+  hasher.add_bytes(file.bytes().data(), file.bytes().size());
+  file.u64(hasher.digest());
+  return std::move(file.bytes());
+}
+
+Result<Database> deserialize_database(std::string_view bytes, std::string_view source_name) {
+  const std::string source(source_name.empty() ? std::string_view("database") : source_name);
+  if (bytes.empty()) return make_error(source + ": truncated mmvk database (the file is empty)");
+  if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+    if (bytes.size() < sizeof(kMagic) && std::memcmp(bytes.data(), kMagic, bytes.size()) == 0) {
+      return make_error(source + ": truncated mmvk database (" + std::to_string(bytes.size()) + " bytes)");
+    }
+    return make_error(source + ": not an mmvk database (wrong magic)");
+  }
+  if (bytes.size() < kDatabaseHeaderBytes + 8) {
+    return make_error(source + ": truncated mmvk database (" + std::to_string(bytes.size()) + " bytes, the header and checksum need " +
+                      std::to_string(kDatabaseHeaderBytes + 8) + ")");
+  }
+  const std::uint32_t version = read_u32_at(bytes, 8);
+  if (version != kDatabaseFormatVersion) {
+    return make_error(source + ": unsupported mmvk database version " + std::to_string(version) + " (this build reads version " +
+                      std::to_string(kDatabaseFormatVersion) + ")");
+  }
+  if (read_u32_at(bytes, 12) != 0) return make_error(source + ": corrupt mmvk database header (reserved field is not 0)");
+  const std::uint64_t payload_size = read_u64_at(bytes, 16);
+  const std::uint64_t available = bytes.size() - kDatabaseHeaderBytes - 8;
+  if (payload_size > available) {
+    return make_error(source + ": truncated mmvk database (" + std::to_string(bytes.size()) + " bytes, the header announces " +
+                      std::to_string(payload_size) + " payload bytes but only " + std::to_string(available) + " are there)");
+  }
+  if (payload_size < available) {
+    return make_error(source + ": corrupt mmvk database (" + std::to_string(available - payload_size) +
+                      " unexpected bytes after the payload)");
+  }
+  detail::Hasher hasher;
+  hasher.add_bytes(bytes.data(), kDatabaseHeaderBytes + payload_size);
+  if (hasher.digest() != read_u64_at(bytes, kDatabaseHeaderBytes + payload_size)) {
+    return make_error(source + ": checksum mismatch: the mmvk database is corrupt");
+  }
+
+  Reader in(bytes, kDatabaseHeaderBytes, kDatabaseHeaderBytes + payload_size);
+  auto corrupt = [&](const std::string& what) {
+    return make_error(source + ": corrupt mmvk database payload: " + what + " at byte " + std::to_string(in.position()));
+  };
+  DatabaseParts parts;
+  std::string schema_json;
+  if (!in.str(schema_json)) return corrupt("schema");
+  Result<FeatureSchema> schema = parse_schema_json(schema_json, source + " (schema)");
+  if (!schema.ok()) return make_error(schema.message());
+  parts.schema = std::move(*schema);
+  if (!in.f32(parts.fps)) return corrupt("fps");
+  std::uint32_t dims = 0;
+  if (!in.u32(dims)) return corrupt("dims");
+  if (dims != parts.schema.dims()) {
+    return corrupt("normalization has " + std::to_string(dims) + " dims, the schema " + std::to_string(parts.schema.dims()));
+  }
+  if (std::uint64_t{dims} * 8 > in.left()) return corrupt("normalization");
+  parts.normalization.resize(dims);
+  for (DimNormalization& n : parts.normalization) {
+    if (!in.f32(n.offset) || !in.f32(n.scale)) return corrupt("normalization");
+  }
+  std::uint32_t tags = 0;
+  if (!in.u32(tags)) return corrupt("tag count");
+  if (tags > kMaxTags) return corrupt(std::to_string(tags) + " tags");
+  parts.tag_names.resize(tags);
+  for (std::string& tag : parts.tag_names) {
+    if (!in.str(tag)) return corrupt("tag name");
+  }
+  std::uint32_t clips = 0;
+  if (!in.u32(clips)) return corrupt("clip count");
+  constexpr std::size_t kMinClipBytes = 4 + 4 + 8 + 1 + 1 + 4 + 4 + 4 + 4;
+  if (std::uint64_t{clips} * kMinClipBytes > in.left()) return corrupt(std::to_string(clips) + " clips");
+  parts.clips.resize(clips);
+  for (Clip& clip : parts.clips) {
+    std::uint8_t loop = 0;
+    std::uint8_t mirrored = 0;
+    if (!in.str(clip.name) || !in.str(clip.source) || !in.u64(clip.tags) || !in.u8(loop) || !in.u8(mirrored) ||
+        !in.f32(clip.cost_multiplier) || !in.f32(clip.cost_bias) || !in.u32(clip.first_frame) ||
+        !in.u32(clip.frame_count)) {
+      return corrupt("clip");
+    }
+    if (loop > 1 || mirrored > 1) return corrupt("clip flags");
+    clip.loop = loop != 0;
+    clip.mirrored = mirrored != 0;
+  }
+  std::uint32_t frames = 0;
+  if (!in.u32(frames)) return corrupt("frame count");
+  if (std::uint64_t{frames} * 4 > in.left()) return corrupt(std::to_string(frames) + " frame flags");
+  parts.frame_flags.resize(frames);
+  for (std::uint32_t& flags : parts.frame_flags) {
+    if (!in.u32(flags)) return corrupt("frame flags");
+  }
+  const std::uint64_t values = std::uint64_t{frames} * dims;
+  if (values * 4 != in.left()) {
+    return corrupt("feature matrix of " + std::to_string(frames) + " x " + std::to_string(dims) + " floats needs " +
+                   std::to_string(values * 4) + " bytes, " + std::to_string(in.left()) + " are left");
+  }
+  parts.features.resize(values);
+  for (float& v : parts.features) {
+    if (!in.f32(v)) return corrupt("features");
+  }
+  Result<Database> database = Database::create(std::move(parts));
+  if (!database.ok()) return make_error(source + ": invalid mmvk database: " + database.message());
+  return database;
+}
+
+Status save_database(const Database& database, const std::filesystem::path& path) {
+  return detail::write_file_atomically(path, serialize_database(database));
+}
+
+Result<Database> load_database(const std::filesystem::path& path) {
+  Result<std::string> bytes = detail::read_file(path);
+  if (!bytes.ok()) return bytes.error();
+  return deserialize_database(*bytes, path.string());
+}
+
+}  // namespace mmvk

@@ -1,0 +1,256 @@
+#include "mmvk/manifest.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <set>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
+
+#include "file_io.hpp"
+
+namespace mmvk {
+
+namespace {
+
+using Json = nlohmann::json;
+
+Status check_fields(const Json& object, const std::string& where, const std::set<std::string>& known) {
+  for (const auto& item : object.items()) {
+    // `where` is either "file: " (top level) or "file: clips[2]" (nested).
+    const bool top = !where.empty() && where.back() == ' ';
+    if (!known.count(item.key())) return make_error(where + (top ? "" : ".") + item.key() + ": unknown field");
+  }
+  return {};
+}
+
+Result<float> read_number(const Json& value, const std::string& where) {
+  if (!value.is_number()) return make_error(where + ": expected a number");
+  const double number = value.get<double>();
+  if (!std::isfinite(number) || std::abs(number) > 3.0e38) return make_error(where + ": not a finite number");
+  return static_cast<float>(number);
+}
+
+Result<bool> read_bool(const Json& value, const std::string& where) {
+  if (!value.is_boolean()) return make_error(where + ": expected true or false");
+  return value.get<bool>();
+}
+
+Result<std::string> read_string(const Json& value, const std::string& where) {
+  if (!value.is_string()) return make_error(where + ": expected a string");
+  return value.get<std::string>();
+}
+
+Result<std::vector<TimeRange>> read_ranges(const Json& value, const std::string& where) {
+  if (!value.is_array()) return make_error(where + ": expected an array of [begin, end] pairs in seconds");
+  std::vector<TimeRange> ranges;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string at = where + "[" + std::to_string(i) + "]";
+    const Json& pair = value[i];
+    if (!pair.is_array() || pair.size() != 2) return make_error(at + ": expected [begin, end] in seconds");
+    Result<float> begin = read_number(pair[0], at + "[0]");
+    if (!begin.ok()) return begin.error();
+    Result<float> end = read_number(pair[1], at + "[1]");
+    if (!end.ok()) return end.error();
+    if (*begin < 0.0f || !(*end > *begin)) {
+      return make_error(at + ": expected 0 <= begin < end, got [" + std::to_string(*begin) + ", " +
+                        std::to_string(*end) + "]");
+    }
+    ranges.push_back({*begin, *end});
+  }
+  return ranges;
+}
+
+// Macro-free helper: assigns a parsed value or returns its error.
+#define MMVK_READ(target, expr)          \
+  do {                                   \
+    auto mmvk_read_ = (expr);            \
+    if (!mmvk_read_.ok()) return mmvk_read_.error(); \
+    target = std::move(*mmvk_read_);     \
+  } while (false)
+
+Result<ManifestClip> parse_clip(const Json& object, const std::string& where, const std::filesystem::path& base_dir) {
+  if (object.is_string()) {
+    ManifestClip clip;
+    clip.file = base_dir / object.get<std::string>();
+    clip.name = clip.file.stem().string();
+    return clip;
+  }
+  if (!object.is_object()) return make_error(where + ": expected an object (or a file name)");
+  MMVK_TRY(check_fields(object, where,
+                        {"file", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias", "do_not_use",
+                         "block_transition"}));
+  ManifestClip clip;
+  if (!object.contains("file")) return make_error(where + ".file: missing");
+  std::string file;
+  MMVK_READ(file, read_string(object["file"], where + ".file"));
+  if (file.empty()) return make_error(where + ".file: empty");
+  clip.file = base_dir / file;
+  clip.name = clip.file.stem().string();
+  if (object.contains("name")) MMVK_READ(clip.name, read_string(object["name"], where + ".name"));
+  if (object.contains("tags")) {
+    const Json& tags = object["tags"];
+    if (!tags.is_array()) return make_error(where + ".tags: expected an array of strings");
+    for (std::size_t i = 0; i < tags.size(); ++i) {
+      std::string tag;
+      MMVK_READ(tag, read_string(tags[i], where + ".tags[" + std::to_string(i) + "]"));
+      if (tag.empty()) return make_error(where + ".tags[" + std::to_string(i) + "]: empty tag");
+      if (std::find(clip.tags.begin(), clip.tags.end(), tag) == clip.tags.end()) clip.tags.push_back(tag);
+    }
+  }
+  if (object.contains("loop")) MMVK_READ(clip.loop, read_bool(object["loop"], where + ".loop"));
+  if (object.contains("mirror")) MMVK_READ(clip.mirror, read_bool(object["mirror"], where + ".mirror"));
+  if (object.contains("cost_multiplier")) {
+    MMVK_READ(clip.cost_multiplier, read_number(object["cost_multiplier"], where + ".cost_multiplier"));
+    if (!(clip.cost_multiplier > 0.0f)) return make_error(where + ".cost_multiplier: must be > 0");
+  }
+  if (object.contains("cost_bias")) MMVK_READ(clip.cost_bias, read_number(object["cost_bias"], where + ".cost_bias"));
+  if (object.contains("do_not_use")) {
+    MMVK_READ(clip.do_not_use, read_ranges(object["do_not_use"], where + ".do_not_use"));
+  }
+  if (object.contains("block_transition")) {
+    MMVK_READ(clip.block_transition, read_ranges(object["block_transition"], where + ".block_transition"));
+  }
+  return clip;
+}
+
+bool is_bvh(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".bvh";
+}
+
+}  // namespace
+
+Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_view source,
+                                     const std::filesystem::path& base_dir) {
+  const std::string name(source.empty() ? std::string_view("manifest") : source);
+  const Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded()) return make_error(name + ": not valid JSON");
+  if (!root.is_object()) return make_error(name + ": expected a JSON object with \"clips\"");
+  MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "clips"}));
+
+  Manifest manifest;
+  manifest.source = name;
+  const std::string at = name + ": ";
+  if (root.contains("schema")) {
+    const Json& schema = root["schema"];
+    if (schema.is_string()) {
+      std::filesystem::path path = base_dir / schema.get<std::string>();
+      Result<FeatureSchema> loaded = load_schema(path);
+      if (!loaded.ok()) return make_error(at + "schema: " + loaded.message());
+      manifest.schema = std::move(*loaded);
+    } else if (schema.is_object()) {
+      Result<FeatureSchema> parsed = parse_schema_json(schema.dump(), name + ": schema");
+      if (!parsed.ok()) return parsed.error();
+      manifest.schema = std::move(*parsed);
+    } else {
+      return make_error(at + "schema: expected a file name or a schema object");
+    }
+  }
+  if (root.contains("fps")) {
+    MMVK_READ(manifest.fps, read_number(root["fps"], at + "fps"));
+    if (!(manifest.fps > 0.0f) || manifest.fps > 10000.0f) return make_error(at + "fps: must be in (0, 10000]");
+  }
+  if (root.contains("import")) {
+    const Json& import = root["import"];
+    if (!import.is_object()) return make_error(at + "import: expected an object");
+    MMVK_TRY(check_fields(import, at + "import", {"metres_per_unit", "up_axis"}));
+    if (import.contains("metres_per_unit")) {
+      MMVK_READ(manifest.import.metres_per_unit, read_number(import["metres_per_unit"], at + "import.metres_per_unit"));
+      if (manifest.import.metres_per_unit < 0.0f) {
+        return make_error(at + "import.metres_per_unit: must be > 0 (or 0 to guess)");
+      }
+    }
+    if (import.contains("up_axis")) {
+      std::string axis;
+      MMVK_READ(axis, read_string(import["up_axis"], at + "import.up_axis"));
+      if (axis == "y" || axis == "Y") {
+        manifest.import.up_axis = UpAxis::Y;
+      } else if (axis == "z" || axis == "Z") {
+        manifest.import.up_axis = UpAxis::Z;
+      } else {
+        return make_error(at + "import.up_axis: expected \"y\" or \"z\", got \"" + axis + "\"");
+      }
+    }
+  }
+  if (root.contains("character_root")) {
+    const Json& options = root["character_root"];
+    if (!options.is_object()) return make_error(at + "character_root: expected an object");
+    MMVK_TRY(check_fields(options, at + "character_root", {"source_bone", "facing_smoothing_seconds"}));
+    if (options.contains("source_bone")) {
+      MMVK_READ(manifest.character_root.source_bone,
+                read_string(options["source_bone"], at + "character_root.source_bone"));
+    }
+    if (options.contains("facing_smoothing_seconds")) {
+      MMVK_READ(manifest.character_root.facing_smoothing_seconds,
+                read_number(options["facing_smoothing_seconds"], at + "character_root.facing_smoothing_seconds"));
+      if (manifest.character_root.facing_smoothing_seconds < 0.0f) {
+        return make_error(at + "character_root.facing_smoothing_seconds: must be >= 0");
+      }
+    }
+  }
+  if (root.contains("edge_rule")) {
+    std::string rule;
+    MMVK_READ(rule, read_string(root["edge_rule"], at + "edge_rule"));
+    if (rule == "exclude") {
+      manifest.edge_rule = EdgeRule::Exclude;
+    } else if (rule == "clamp") {
+      manifest.edge_rule = EdgeRule::Clamp;
+    } else {
+      return make_error(at + "edge_rule: expected \"exclude\" or \"clamp\", got \"" + rule + "\"");
+    }
+  }
+  bool mirror_all = false;
+  if (root.contains("mirror")) MMVK_READ(mirror_all, read_bool(root["mirror"], at + "mirror"));
+  if (!root.contains("clips") || !root["clips"].is_array()) {
+    return make_error(at + "clips: expected an array of clips");
+  }
+  const Json& clips = root["clips"];
+  if (clips.empty()) return make_error(at + "clips: empty");
+  for (std::size_t i = 0; i < clips.size(); ++i) {
+    Result<ManifestClip> clip = parse_clip(clips[i], at + "clips[" + std::to_string(i) + "]", base_dir);
+    if (!clip.ok()) return clip.error();
+    clip->mirror = clip->mirror || mirror_all;
+    manifest.clips.push_back(std::move(*clip));
+  }
+  return manifest;
+}
+
+#undef MMVK_READ
+
+Result<Manifest> load_manifest(const std::filesystem::path& path) {
+  Result<std::string> text = detail::read_file(path);
+  if (!text.ok()) return text.error();
+  return parse_manifest_json(*text, path.string(), path.parent_path());
+}
+
+Result<Manifest> manifest_from_directory(const std::filesystem::path& dir) {
+  std::error_code error;
+  std::vector<std::filesystem::path> files;
+  for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+    if (it->is_regular_file(error) && is_bvh(it->path())) files.push_back(it->path());
+  }
+  if (error) return make_error(dir.string() + ": cannot list the folder: " + error.message());
+  if (files.empty()) return make_error(dir.string() + ": no .bvh files in the folder");
+  std::sort(files.begin(), files.end());
+  Manifest manifest;
+  manifest.source = dir.string();
+  for (const std::filesystem::path& file : files) {
+    ManifestClip clip;
+    clip.file = file;
+    clip.name = file.stem().string();
+    manifest.clips.push_back(std::move(clip));
+  }
+  return manifest;
+}
+
+Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) return manifest_from_directory(path);
+  if (!std::filesystem::exists(path, error)) return make_error(path.string() + ": no such file or folder");
+  return load_manifest(path);
+}
+
+}  // namespace mmvk

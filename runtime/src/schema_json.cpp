@@ -1,0 +1,187 @@
+// The JSON form of a FeatureSchema (see feature_schema.hpp). Unknown fields
+// are errors, so a typo ("weigth") is reported instead of silently ignored.
+#include <cmath>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "file_io.hpp"
+#include "mmvk/feature_schema.hpp"
+
+namespace mmvk {
+
+namespace {
+
+using Json = nlohmann::json;
+
+struct KindName {
+  ChannelKind kind;
+  const char* name;
+};
+constexpr KindName kKinds[] = {
+    {ChannelKind::TrajectoryPosition, "trajectory_position"},
+    {ChannelKind::TrajectoryDirection, "trajectory_direction"},
+    {ChannelKind::BonePosition, "bone_position"},
+    {ChannelKind::BoneVelocity, "bone_velocity"},
+    {ChannelKind::RootVelocity, "root_velocity"},
+    {ChannelKind::Custom, "custom"},
+};
+
+struct NormalizationName {
+  Normalization mode;
+  const char* name;
+};
+constexpr NormalizationName kModes[] = {
+    {Normalization::GroupStd, "group_std"},
+    {Normalization::PerDimStd, "per_dim_std"},
+    {Normalization::MeanAbsDev, "mean_abs_dev"},
+    {Normalization::MinMax, "min_max"},
+};
+
+std::string kind_list() {
+  std::string list;
+  for (const KindName& k : kKinds) list += std::string(list.empty() ? "" : ", ") + '"' + k.name + '"';
+  return list;
+}
+
+std::string mode_list() {
+  std::string list;
+  for (const NormalizationName& m : kModes) list += std::string(list.empty() ? "" : ", ") + '"' + m.name + '"';
+  return list;
+}
+
+Result<float> finite_number(const Json& value, const std::string& where) {
+  if (!value.is_number()) return make_error(where + ": expected a number");
+  const double number = value.get<double>();
+  if (!std::isfinite(number) || std::abs(number) > 3.0e38) return make_error(where + ": not a finite float");
+  return static_cast<float>(number);
+}
+
+Result<FeatureChannel> parse_channel(const Json& object, const std::string& where) {
+  if (!object.is_object()) return make_error(where + ": expected an object");
+  static const std::set<std::string> kKnown = {"name", "kind", "bone", "offsets_seconds", "dims", "weight", "normalization"};
+  for (const auto& item : object.items()) {
+    if (!kKnown.count(item.key())) return make_error(where + "." + item.key() + ": unknown field");
+  }
+  FeatureChannel channel;
+  if (!object.contains("name") || !object["name"].is_string()) return make_error(where + ".name: expected a string");
+  channel.name = object["name"].get<std::string>();
+  if (!object.contains("kind") || !object["kind"].is_string()) {
+    return make_error(where + ".kind: expected one of " + kind_list());
+  }
+  const std::string kind = object["kind"].get<std::string>();
+  bool found = false;
+  for (const KindName& k : kKinds) {
+    if (kind == k.name) {
+      channel.kind = k.kind;
+      found = true;
+    }
+  }
+  if (!found) return make_error(where + ".kind: unknown kind \"" + kind + "\", expected one of " + kind_list());
+  if (object.contains("bone")) {
+    if (!object["bone"].is_string()) return make_error(where + ".bone: expected a string");
+    channel.bone = object["bone"].get<std::string>();
+  }
+  if (object.contains("offsets_seconds")) {
+    const Json& offsets = object["offsets_seconds"];
+    if (!offsets.is_array()) return make_error(where + ".offsets_seconds: expected an array of numbers");
+    for (std::size_t i = 0; i < offsets.size(); ++i) {
+      Result<float> t = finite_number(offsets[i], where + ".offsets_seconds[" + std::to_string(i) + "]");
+      if (!t.ok()) return t.error();
+      channel.offsets_seconds.push_back(*t);
+    }
+  }
+  if (object.contains("dims")) {
+    const Json& dims = object["dims"];
+    if (!dims.is_number_integer() || dims.get<std::int64_t>() <= 0 || dims.get<std::int64_t>() > 4096) {
+      return make_error(where + ".dims: expected an integer in [1, 4096]");
+    }
+    if (kind != "custom") {
+      const std::int64_t expected = FeatureChannel{.name = {}, .kind = channel.kind, .bone = {},
+                                                   .offsets_seconds = channel.offsets_seconds}
+                                        .dims();
+      if (dims.get<std::int64_t>() != expected) {
+        return make_error(where + ".dims: a " + kind + " channel has " + std::to_string(expected) + " dims, not " +
+                          std::to_string(dims.get<std::int64_t>()));
+      }
+    } else {
+      channel.custom_dims = static_cast<std::uint32_t>(dims.get<std::int64_t>());
+    }
+  }
+  if (object.contains("weight")) {
+    Result<float> weight = finite_number(object["weight"], where + ".weight");
+    if (!weight.ok()) return weight.error();
+    channel.weight = *weight;
+  }
+  if (object.contains("normalization")) {
+    const Json& mode = object["normalization"];
+    bool known = false;
+    if (mode.is_string()) {
+      for (const NormalizationName& m : kModes) {
+        if (mode.get<std::string>() == m.name) {
+          channel.normalization = m.mode;
+          known = true;
+        }
+      }
+    }
+    if (!known) return make_error(where + ".normalization: expected one of " + mode_list());
+  }
+  return channel;
+}
+
+}  // namespace
+
+Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source) {
+  const std::string name(source.empty() ? std::string_view("schema") : source);
+  Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded()) return make_error(name + ": not valid JSON");
+  if (!root.is_object()) return make_error(name + ": expected a JSON object with \"channels\"");
+  for (const auto& item : root.items()) {
+    if (item.key() != "channels") return make_error(name + ": " + item.key() + ": unknown field");
+  }
+  if (!root.contains("channels") || !root["channels"].is_array()) {
+    return make_error(name + ": channels: expected an array of channel objects");
+  }
+  FeatureSchema schema;
+  const Json& channels = root["channels"];
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    Result<FeatureChannel> channel = parse_channel(channels[i], name + ": channels[" + std::to_string(i) + "]");
+    if (!channel.ok()) return channel.error();
+    schema.channels.push_back(std::move(*channel));
+  }
+  Status valid = schema.validate();
+  if (!valid.ok()) return make_error(name + ": " + valid.message());
+  return schema;
+}
+
+Result<FeatureSchema> load_schema(const std::filesystem::path& path) {
+  Result<std::string> text = detail::read_file(path);
+  if (!text.ok()) return text.error();
+  return parse_schema_json(*text, path.string());
+}
+
+std::string schema_to_json(const FeatureSchema& schema) {
+  Json channels = Json::array();
+  for (const FeatureChannel& channel : schema.channels) {
+    Json object;
+    object["name"] = channel.name;
+    for (const KindName& k : kKinds) {
+      if (k.kind == channel.kind) object["kind"] = k.name;
+    }
+    if (!channel.bone.empty()) object["bone"] = channel.bone;
+    if (channel.kind == ChannelKind::TrajectoryPosition || channel.kind == ChannelKind::TrajectoryDirection) {
+      object["offsets_seconds"] = channel.offsets_seconds;
+    }
+    if (channel.kind == ChannelKind::Custom) object["dims"] = channel.custom_dims;
+    object["weight"] = channel.weight;
+    for (const NormalizationName& m : kModes) {
+      if (m.mode == channel.normalization) object["normalization"] = m.name;
+    }
+    channels.push_back(std::move(object));
+  }
+  Json root;
+  root["channels"] = std::move(channels);
+  return root.dump(2);
+}
+
+}  // namespace mmvk

@@ -1,0 +1,233 @@
+#include "mmvk/fast_search.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "fast_search_layout.hpp"
+
+namespace mmvk {
+
+namespace {
+
+static_assert(kFastTileRows == detail::kLanes && kFastGroupTiles == detail::kLanes,
+              "a group's tile boxes fill one 16-lane pack");
+
+constexpr std::uint32_t kGroupRows = kFastTileRows * kFastGroupTiles;
+// Queries that share one pass over a tile in brute force (loads are shared,
+// and the independent sums hide the add latency).
+constexpr std::uint32_t kBruteQueries = 2;
+
+// Inserts `candidate` into the sorted best-k list when it beats the k-th.
+void insert(std::span<Match> best, const Match& candidate) {
+  std::size_t slot = best.size() - 1;
+  if (!match_less(candidate, best[slot])) return;
+  while (slot > 0 && match_less(candidate, best[slot - 1])) {
+    best[slot] = best[slot - 1];
+    --slot;
+  }
+  best[slot] = candidate;
+}
+
+}  // namespace
+
+struct FastSearch::Workspace {
+  struct Thread {
+    std::vector<std::pair<float, std::uint32_t>> group_order;  // (bound, group)
+    std::array<std::uint32_t, kFastGroupTiles> tile_ids{};
+    std::array<detail::LaneHit, kFastGroupTiles * detail::kLanes * 4> hits{};
+  };
+  std::vector<Thread> threads;
+  std::vector<Match> partial;  // [parts x B x k] when one query is split over threads
+};
+
+FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOptions options)
+    : database_(&database),
+      pool_(&pool),
+      options_(options),
+      layout_(Layout::build(database)),
+      workspace_(std::make_unique<Workspace>()),
+      thread_rows_(pool.thread_count(), 0) {
+  workspace_->threads.resize(pool.thread_count());
+  for (Workspace::Thread& thread : workspace_->threads) thread.group_order.reserve(layout_->groups);
+}
+
+FastSearch::~FastSearch() = default;
+
+SearchStats FastSearch::stats() const { return stats_; }
+void FastSearch::reset_stats() { stats_ = {}; }
+
+void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
+                              std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best,
+                              unsigned thread) {
+  const Database& db = *database_;
+  const Layout& l = *layout_;
+  Workspace::Thread& scratch = workspace_->threads[thread];
+  const QueryParams default_params;
+  const std::uint32_t dims = l.dims;
+  const std::uint32_t first_row = first_group * kGroupRows;
+  const std::uint32_t end_row = std::min<std::uint64_t>(std::uint64_t{end_group} * kGroupRows, l.frames);
+  auto params_of = [&](std::size_t q) -> const QueryParams& {
+    return batch.params.empty() ? default_params : batch.params[q];
+  };
+  auto best_of = [&](std::size_t q) { return best.subspan((q - first_query) * k, k); };
+  auto query_of = [&](std::size_t q) { return batch.features.subspan(q * dims, dims); };
+  auto offer = [&](const detail::LaneHit& hit, std::size_t q) {
+    const std::span<Match> list = best_of(q);
+    const Match candidate{hit.frame, hit.cost};
+    if (!match_less(candidate, list[k - 1])) return;
+    const QueryParams& params = params_of(q);
+    // Tiles never mark block-transition rows valid; the continuing frame
+    // was evaluated with its bias before them.
+    if (hit.frame == params.continuing_frame || !is_candidate(db, hit.frame, params)) return;
+    insert(list, candidate);
+  };
+  std::uint64_t rows = 0;
+
+  // The continuing frame first: its cost carries continuing_bias (possibly
+  // negative), so the tile pass, which knows no such bias, skips it.
+  for (std::size_t q = first_query; q < end_query; ++q) {
+    const std::span<Match> list = best_of(q);
+    std::fill(list.begin(), list.end(), Match{});
+    const QueryParams& params = params_of(q);
+    const std::uint32_t cont = params.continuing_frame;
+    if (cont != kNoFrame && cont >= first_row && cont < end_row && is_candidate(db, cont, params)) {
+      insert(list, Match{cont, frame_cost(db, cont, query_of(q), params)});
+      ++rows;
+    }
+  }
+
+  const detail::TileArrays tiles = l.tile_arrays();
+  auto tile_rows = [&](std::uint32_t tile) { return std::min(kFastTileRows, l.frames - tile * kFastTileRows); };
+
+  if (!options_.prune) {
+    const std::uint32_t block_groups = std::max<std::uint32_t>(1, (options_.rows_per_block + kGroupRows - 1) / kGroupRows);
+    for (std::uint32_t block = first_group; block < end_group; block += block_groups) {
+      const std::uint32_t block_end = std::min(end_group, block + block_groups);
+      for (std::size_t q = first_query; q < end_query;) {
+        std::uint32_t count = 1;
+        while (count * 2 <= kBruteQueries && q + count * 2 <= end_query) count *= 2;
+        std::array<detail::KernelQuery, kBruteQueries> queries{};
+        for (std::uint32_t i = 0; i < count; ++i) {
+          queries[i].features = query_of(q + i).data();
+          queries[i].weights = params_of(q + i).channel_weights.data();
+        }
+        auto any_query_may_match = [&](const detail::BlockSummary& summary) {
+          for (std::uint32_t i = 0; i < count; ++i) {
+            if (detail::block_may_match(summary, params_of(q + i))) return true;
+          }
+          return false;
+        };
+        for (std::uint32_t group = block; group < block_end; ++group) {
+          if (!any_query_may_match(l.group_summary[group])) continue;
+          std::size_t tile_count = 0;
+          std::uint32_t group_rows = 0;
+          const std::uint32_t end_tile = std::min(l.tiles, (group + 1) * kFastGroupTiles);
+          for (std::uint32_t tile = group * kFastGroupTiles; tile < end_tile; ++tile) {
+            if (!any_query_may_match(l.tile_summary[tile])) continue;
+            scratch.tile_ids[tile_count++] = tile;
+            group_rows += tile_rows(tile);
+          }
+          for (std::uint32_t i = 0; i < count; ++i) queries[i].threshold = best_of(q + i)[k - 1].cost;
+          const std::size_t hits =
+              detail::evaluate_tiles(tiles, queries.data(), count, scratch.tile_ids.data(), tile_count, scratch.hits.data());
+          rows += std::uint64_t{group_rows} * count;
+          for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q + scratch.hits[h].query);
+        }
+        q += count;
+      }
+    }
+    thread_rows_[thread] += rows;
+    return;
+  }
+
+  // Pruned: visit groups by ascending lower bound, stop at the first bound
+  // above the k-th best (strictly: an equal cost may still win on frame id).
+  const detail::BoxArrays group_boxes = l.group_boxes();
+  const detail::BoxArrays tile_boxes = l.tile_boxes();
+  std::array<float, detail::kLanes> bounds{};
+  for (std::size_t q = first_query; q < end_query; ++q) {
+    const QueryParams& params = params_of(q);
+    const float* query = query_of(q).data();
+    const float* weights = params.channel_weights.data();
+    const std::span<Match> list = best_of(q);
+    scratch.group_order.clear();
+    for (std::uint32_t pack = first_group / detail::kLanes; pack * detail::kLanes < end_group; ++pack) {
+      detail::box_bounds(group_boxes, pack, query, weights, bounds.data());
+      for (std::uint32_t lane = 0; lane < detail::kLanes; ++lane) {
+        const std::uint32_t group = pack * detail::kLanes + lane;
+        if (group < first_group || group >= end_group || !detail::block_may_match(l.group_summary[group], params)) continue;
+        // A NaN bound (0 x inf on overflow) proves nothing: visit first.
+        const float bound = std::isnan(bounds[lane]) ? -std::numeric_limits<float>::infinity() : bounds[lane];
+        scratch.group_order.emplace_back(bound, group);
+      }
+    }
+    std::sort(scratch.group_order.begin(), scratch.group_order.end());
+    detail::KernelQuery kernel_query{query, weights, 0.0f};
+    for (const auto& [group_bound, group] : scratch.group_order) {
+      if (group_bound > list[k - 1].cost) break;
+      detail::box_bounds(tile_boxes, group, query, weights, bounds.data());
+      std::size_t tile_count = 0;
+      std::uint32_t group_rows = 0;
+      const std::uint32_t first_tile = group * kFastGroupTiles;
+      const std::uint32_t end_tile = std::min(l.tiles, first_tile + kFastGroupTiles);
+      for (std::uint32_t tile = first_tile; tile < end_tile; ++tile) {
+        if (bounds[tile - first_tile] > list[k - 1].cost || !detail::block_may_match(l.tile_summary[tile], params)) continue;
+        scratch.tile_ids[tile_count++] = tile;
+        group_rows += tile_rows(tile);
+      }
+      if (tile_count == 0) continue;
+      kernel_query.threshold = list[k - 1].cost;
+      const std::size_t hits =
+          detail::evaluate_tiles(tiles, &kernel_query, 1, scratch.tile_ids.data(), tile_count, scratch.hits.data());
+      rows += group_rows;
+      for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q);
+    }
+  }
+  thread_rows_[thread] += rows;
+}
+
+Status FastSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) {
+  MMVK_TRY(validate_search(*database_, batch, k, out));
+  const std::size_t count = batch.size;
+  if (count == 0) return {};
+  std::fill(thread_rows_.begin(), thread_rows_.end(), 0);
+  const unsigned threads = pool_->thread_count();
+  const std::uint32_t groups = layout_->groups;
+  if (count >= threads || threads == 1 || groups < 2) {
+    // Enough queries for every thread: split the queries.
+    pool_->parallel_for(count, [&](std::size_t begin, std::size_t end, unsigned thread) {
+      search_range(batch, k, begin, end, 0, groups, out.subspan(begin * k, (end - begin) * k), thread);
+    });
+  } else {
+    // Fewer queries than threads: split the rows, then merge the lists.
+    const unsigned parts = std::min<unsigned>(threads, groups);
+    std::vector<Match>& partial = workspace_->partial;
+    partial.assign(std::size_t{parts} * count * k, Match{});
+    pool_->parallel_for(parts, [&](std::size_t begin, std::size_t end, unsigned thread) {
+      for (std::size_t part = begin; part < end; ++part) {
+        const std::uint32_t first_group = static_cast<std::uint32_t>(std::uint64_t{groups} * part / parts);
+        const std::uint32_t end_group = static_cast<std::uint32_t>(std::uint64_t{groups} * (part + 1) / parts);
+        search_range(batch, k, 0, count, first_group, end_group,
+                     std::span<Match>(partial).subspan(part * count * k, count * k), thread);
+      }
+    });
+    std::vector<Match> merged;
+    merged.reserve(std::size_t{parts} * k);
+    for (std::size_t q = 0; q < count; ++q) {
+      merged.clear();
+      for (unsigned part = 0; part < parts; ++part) {
+        const Match* list = partial.data() + (part * count + q) * k;
+        merged.insert(merged.end(), list, list + k);
+      }
+      std::sort(merged.begin(), merged.end(), match_less);
+      std::copy(merged.begin(), merged.begin() + k, out.begin() + static_cast<std::ptrdiff_t>(q * k));
+    }
+  }
+  stats_.queries += count;
+  for (std::uint64_t rows : thread_rows_) stats_.rows_evaluated += rows;
+  return {};
+}
+
+}  // namespace mmvk

@@ -1,0 +1,83 @@
+// The cluster-pruned CPU backend over a k-means ClusterTable.
+//
+// Exact mode (nprobe = 0): per query, a lower bound of every cluster's best
+// possible cost is computed, clusters are visited in order of that bound,
+// and the walk stops when the next bound is strictly above the current k-th
+// best cost (equal costs may still win on the lower frame id). Returns the
+// reference's frames with bit-identical costs: rows are evaluated in the
+// reference's accumulation order (see search.hpp).
+//
+// The lower bound of cluster c is the max of two bounds, each a true lower
+// bound of multiplier_i * total_i for every member i, to which min_bias is
+// added (float addition is monotone, so the bias step keeps it a bound):
+//  - box: min_multiplier * sum_ch w_ch * sum_d gap_d^2, gap_d = distance of
+//    q_d to [box_min_d, box_max_d], accumulated in the reference's order in
+//    float; every rounding step is monotone, so it never exceeds the cost of
+//    a member computed the same way;
+//  - radius: min_multiplier * sum_ch w_ch * max(0, |q_ch - centroid_ch| -
+//    radius_ch)^2 (the triangle inequality per channel), computed in double
+//    and shrunk by a relative margin that covers the float rounding of the
+//    real cost evaluation (proof in cluster_search.cpp).
+// The continuing frame (whose cost may carry a negative continuing_bias) is
+// evaluated first as a seed and skipped during the cluster walk, so the
+// cluster bounds never need to account for continuing_bias.
+// Clusters are skipped without evaluation when their tag union misses the
+// query's require_all mask, their tag intersection hits exclude_any, or all
+// their members are do-not-use, edge-excluded or block-transition.
+//
+// Approximate mode (nprobe > 0): only the nprobe eligible clusters whose
+// centroids are nearest to the query (channel-weighted squared distance) are
+// searched (plus the continuing frame); nprobe >= cluster_count gives the
+// exact results.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/search.hpp"
+#include "mmvk/thread_pool.hpp"
+
+namespace mmvk {
+
+struct ClusterSearchOptions {
+  std::uint32_t nprobe = 0;  // 0 = exact; else clusters searched per query
+  bool box_bound = true;     // use the per-dimension box bound
+  bool radius_bound = true;  // use the per-channel radius (triangle) bound
+};
+
+class ClusterSearch final : public SearchBackend {
+ public:
+  // Validates `table` against `database` (validate_cluster_table) and copies
+  // the rows into cluster order. `database` and `pool` must outlive the
+  // backend; the pool serves one search() at a time.
+  static Result<std::unique_ptr<ClusterSearch>> create(const Database& database, const ClusterTable& table,
+                                                       ThreadPool& pool, ClusterSearchOptions options = {});
+  ~ClusterSearch() override;
+
+  std::string_view name() const override { return options_.nprobe == 0 ? "clusters" : "clusters-nprobe"; }
+  const Database& database() const override { return *database_; }
+  Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
+  SearchStats stats() const override { return stats_; }
+  void reset_stats() override { stats_ = {}; }
+
+  const ClusterSearchOptions& options() const { return options_; }
+  void set_nprobe(std::uint32_t nprobe) { options_.nprobe = nprobe; }
+  std::uint32_t cluster_count() const;
+
+  struct Layout;  // the cluster-ordered tiles (cluster_search.cpp)
+
+ private:
+  ClusterSearch(const Database& database, ThreadPool& pool, ClusterSearchOptions options, std::unique_ptr<Layout> layout);
+
+  const Database* database_;
+  ThreadPool* pool_;
+  ClusterSearchOptions options_;
+  std::unique_ptr<Layout> layout_;
+  SearchStats stats_;
+};
+
+}  // namespace mmvk

@@ -1,0 +1,280 @@
+// ClusterSearch against the CPU reference: same frames, bit-identical costs,
+// under every constraint and bias, ties and k > 1; nprobe = all equals exact.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "mmvk/cluster_search.hpp"
+#include "mmvk/reference_search.hpp"
+#include "support/clustered_data.hpp"
+
+namespace mmvk {
+namespace {
+
+Database make_database(test::ClusteredDataSpec spec = {}) {
+  Result<Database> db = Database::create(test::clustered_parts(spec));
+  EXPECT_TRUE(db.ok()) << db.message();
+  return std::move(db).value();
+}
+
+ClusterTable make_table(const Database& db, std::uint32_t clusters) {
+  KMeansParams params;
+  params.clusters = clusters;
+  Result<ClusterTable> table = train_cluster_table(db, params);
+  EXPECT_TRUE(table.ok()) << table.message();
+  return std::move(table).value();
+}
+
+// Queries near rows (noise), between blobs, and far away.
+std::vector<float> make_queries(const Database& db, std::size_t count, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<float> q(count * db.dims());
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto row = db.row(static_cast<std::uint32_t>(rng() % db.frame_count()));
+    const int kind = static_cast<int>(i % 3);
+    for (std::uint32_t d = 0; d < db.dims(); ++d) {
+      const double n = test::normal(rng);
+      q[i * db.dims() + d] = kind == 0   ? row[d] + static_cast<float>(0.05 * n)
+                             : kind == 1 ? static_cast<float>(3.0 * n)
+                                         : static_cast<float>(10.0 * n);
+    }
+  }
+  return q;
+}
+
+// Every constraint and bias, varied per query.
+std::vector<QueryParams> make_params(const Database& db, std::size_t count, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<QueryParams> params(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    QueryParams& p = params[i];
+    switch (i % 6) {
+      case 0: break;  // defaults
+      case 1:
+        p.continuing_frame = static_cast<std::uint32_t>(rng() % db.frame_count());
+        p.continuing_bias = -static_cast<float>(test::unit_uniform(rng) * 5.0);
+        p.exclusion_window = static_cast<std::uint32_t>(rng() % 40);
+        break;
+      case 2:
+        p.continuing_frame = static_cast<std::uint32_t>(rng() % db.frame_count());
+        p.continuing_bias = static_cast<float>(test::unit_uniform(rng));
+        p.exclusion_window = 200;  // wider than clips: loops wrap
+        break;
+      case 3:
+        p.require_all = rng() % 4;
+        p.exclude_any = (rng() % 4) << 2;
+        break;
+      case 4:
+        for (std::size_t c = 0; c < db.schema().channels.size(); ++c) {
+          p.channel_weights[c] = (rng() % 3 == 0) ? 0.0f : static_cast<float>(0.25 + 2.0 * test::unit_uniform(rng));
+        }
+        break;
+      case 5:
+        p.continuing_frame = static_cast<std::uint32_t>(rng() % db.frame_count());
+        p.continuing_bias = -0.5f;
+        p.exclusion_window = 10;
+        p.require_all = 1;
+        p.channel_weights[0] = 0.0f;  // e.g. a pose-only query
+        break;
+    }
+  }
+  return params;
+}
+
+void expect_identical(std::span<const Match> expected, std::span<const Match> actual, std::uint32_t k,
+                      const std::string& what) {
+  ASSERT_EQ(expected.size(), actual.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    ASSERT_EQ(expected[i].frame, actual[i].frame) << what << ": query " << i / k << " rank " << i % k;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(expected[i].cost), std::bit_cast<std::uint32_t>(actual[i].cost))
+        << what << ": query " << i / k << " rank " << i % k << " costs " << expected[i].cost << " vs " << actual[i].cost;
+  }
+}
+
+struct Variant {
+  const char* name;
+  ClusterSearchOptions options;
+};
+
+const Variant kExactVariants[] = {
+    {"exact", {}},
+    {"nprobe=all", {.nprobe = 1000000}},
+    {"box only", {.nprobe = 0, .box_bound = true, .radius_bound = false}},
+    {"radius only", {.nprobe = 0, .box_bound = false, .radius_bound = true}},
+};
+
+TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 30);
+  ThreadPool pool(2);
+  ReferenceSearch reference(db);
+  const std::size_t count = 240;
+  const std::vector<float> features = make_queries(db, count, 11);
+  const std::vector<QueryParams> params = make_params(db, count, 12);
+  const QueryBatch batch{features, params, count};
+  for (std::uint32_t k : {1u, 3u, 16u}) {
+    std::vector<Match> expected(count * k);
+    ASSERT_TRUE(reference.search(batch, k, expected).ok());
+    for (const Variant& variant : kExactVariants) {
+      auto backend = ClusterSearch::create(db, table, pool, variant.options);
+      ASSERT_TRUE(backend.ok()) << backend.message();
+      std::vector<Match> actual(count * k);
+      ASSERT_TRUE((*backend)->search(batch, k, actual).ok());
+      expect_identical(expected, actual, k, std::string(variant.name) + " k=" + std::to_string(k));
+    }
+  }
+}
+
+TEST(ClusterSearch, UniqueMinimaAreFoundWithDefaultParams) {
+  // Queries equal to a row: that row is the unique best at cost bias*... the
+  // reference decides; plain clips keep multiplier 1 and bias 0.
+  test::ClusteredDataSpec spec;
+  spec.varied_clips = false;
+  const Database db = make_database(spec);
+  const ClusterTable table = make_table(db, 40);
+  ThreadPool pool(2);
+  auto backend = ClusterSearch::create(db, table, pool);
+  ASSERT_TRUE(backend.ok());
+  std::vector<float> features;
+  std::vector<std::uint32_t> frames;
+  for (std::uint32_t f = 5; f < db.frame_count(); f += 97) {
+    frames.push_back(f);
+    features.insert(features.end(), db.row(f).begin(), db.row(f).end());
+  }
+  std::vector<Match> out(frames.size());
+  ASSERT_TRUE((*backend)->search({features, {}, frames.size()}, 1, out).ok());
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(out[i].frame, frames[i]);
+    EXPECT_EQ(out[i].cost, 0.0f);
+  }
+  // Exact hits prune almost everything.
+  EXPECT_LT((*backend)->stats().rows_fraction(db.frame_count()), 0.25);
+}
+
+TEST(ClusterSearch, TiesGoToTheLowerFrameId) {
+  // Blobs of zero spread: every blob's rows are identical, so costs tie in
+  // large groups spread over clusters and tiles.
+  test::ClusteredDataSpec spec;
+  spec.frames = 600;
+  spec.blobs = 4;
+  spec.blob_spread = 0.0f;
+  spec.varied_clips = false;
+  const Database db = make_database(spec);
+  ThreadPool pool(2);
+  ReferenceSearch reference(db);
+  const ClusterTable table = make_table(db, 9);
+  const std::size_t count = 30;
+  const std::vector<float> features = make_queries(db, count, 5);
+  for (std::uint32_t k : {1u, 7u, 16u}) {
+    std::vector<Match> expected(count * k);
+    ASSERT_TRUE(reference.search({features, {}, count}, k, expected).ok());
+    for (const Variant& variant : kExactVariants) {
+      auto backend = ClusterSearch::create(db, table, pool, variant.options);
+      ASSERT_TRUE(backend.ok());
+      std::vector<Match> actual(count * k);
+      ASSERT_TRUE((*backend)->search({features, {}, count}, k, actual).ok());
+      expect_identical(expected, actual, k, std::string("ties ") + variant.name);
+    }
+  }
+}
+
+TEST(ClusterSearch, AllCandidatesExcludedGivesNone) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 20);
+  ThreadPool pool(1);
+  auto backend = ClusterSearch::create(db, table, pool);
+  ASSERT_TRUE(backend.ok());
+  QueryParams params;
+  params.require_all = 0xF;
+  params.exclude_any = 0xF;  // contradictory: nothing passes
+  const std::vector<float> features = make_queries(db, 1, 3);
+  std::vector<Match> out(4);
+  ASSERT_TRUE((*backend)->search({features, {&params, 1}, 1}, 4, out).ok());
+  for (const Match& m : out) EXPECT_EQ(m, Match{});
+  EXPECT_EQ((*backend)->stats().rows_evaluated, 0u);
+}
+
+TEST(ClusterSearch, NprobeResultsAreRealCandidatesWithTrueCosts) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 30);
+  ThreadPool pool(2);
+  const std::size_t count = 120;
+  const std::vector<float> features = make_queries(db, count, 21);
+  const std::vector<QueryParams> params = make_params(db, count, 22);
+  ReferenceSearch reference(db);
+  std::vector<Match> exact(count);
+  ASSERT_TRUE(reference.search({features, params, count}, 1, exact).ok());
+  std::size_t previous_hits = 0;
+  for (std::uint32_t nprobe : {1u, 4u, 16u}) {
+    auto backend = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
+    ASSERT_TRUE(backend.ok());
+    std::vector<Match> out(count);
+    ASSERT_TRUE((*backend)->search({features, params, count}, 1, out).ok());
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+      hits += out[i].frame == exact[i].frame;
+      if (out[i].frame == kNoFrame) continue;
+      EXPECT_TRUE(is_candidate(db, out[i].frame, params[i]));
+      EXPECT_EQ(out[i].cost, frame_cost(db, out[i].frame, {features.data() + i * db.dims(), db.dims()}, params[i]));
+      EXPECT_FALSE(match_less(out[i], exact[i])) << "nprobe cannot beat exact";
+    }
+    EXPECT_GE(hits, previous_hits) << "more probes, no fewer exact hits (nprobe " << nprobe << ")";
+    previous_hits = hits;
+  }
+}
+
+TEST(ClusterSearch, CountsRowsAndPrunes) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 45);
+  ThreadPool pool(2);
+  auto backend = ClusterSearch::create(db, table, pool);
+  ASSERT_TRUE(backend.ok());
+  const std::size_t count = 90;
+  std::vector<float> features = make_queries(db, count, 31);
+  std::vector<Match> out(count);
+  ASSERT_TRUE((*backend)->search({features, {}, count}, 1, out).ok());
+  const SearchStats stats = (*backend)->stats();
+  EXPECT_EQ(stats.queries, count);
+  EXPECT_GT(stats.rows_evaluated, 0u);
+  EXPECT_LT(stats.rows_fraction(db.frame_count()), 0.5);
+  (*backend)->reset_stats();
+  EXPECT_EQ((*backend)->stats().rows_evaluated, 0u);
+}
+
+TEST(ClusterSearch, BadInputIsAnError) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 10);
+  ThreadPool pool(1);
+  auto backend = ClusterSearch::create(db, table, pool);
+  ASSERT_TRUE(backend.ok());
+  std::vector<float> features = make_queries(db, 2, 1);
+  std::vector<Match> out(2);
+  // Wrong query dimension.
+  std::vector<float> short_features(features.begin(), features.end() - 1);
+  EXPECT_FALSE((*backend)->search({short_features, {}, 2}, 1, out).ok());
+  // NaN in a query.
+  features[3] = std::nanf("");
+  const Status nan = (*backend)->search({features, {}, 2}, 1, out);
+  ASSERT_FALSE(nan.ok());
+  EXPECT_NE(nan.message().find("not finite"), std::string::npos) << nan.message();
+  features[3] = 0.0f;
+  // k out of range.
+  std::vector<Match> many(2 * 17);
+  EXPECT_FALSE((*backend)->search({features, {}, 2}, 17, many).ok());
+  std::vector<Match> none;
+  EXPECT_FALSE((*backend)->search({features, {}, 2}, 0, none).ok());
+
+  // A table from another database.
+  test::ClusteredDataSpec spec;
+  spec.seed = 99;
+  const Database other = make_database(spec);
+  auto mismatched = ClusterSearch::create(other, table, pool);
+  ASSERT_FALSE(mismatched.ok());
+  EXPECT_NE(mismatched.message().find("another database"), std::string::npos) << mismatched.message();
+}
+
+}  // namespace
+}  // namespace mmvk

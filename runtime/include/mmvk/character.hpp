@@ -15,9 +15,16 @@ namespace mmvk {
 
 // Resolves a bone reference: either an exact joint name ("Foot_L") or a role
 // written with a leading '@': "@hips", "@left_upper_leg", "@right_upper_leg",
-// "@left_foot", "@right_foot", "@left_toe", "@right_toe". Roles are matched
-// against the naming conventions seen in CMU (ASF, cgspeed max/mb/daz),
-// Bandai Namco and LAFAN1 skeletons. The error names the bone and lists the
+// "@left_lower_leg", "@right_lower_leg", "@left_foot", "@right_foot" (ankle),
+// "@left_toe", "@right_toe" (ball of the foot), "@left_hand", "@right_hand"
+// (wrist), "@head". Roles are matched against the naming conventions seen in
+// CMU (ASF lfemur/ltibia/lfoot/ltoes, cgspeed max LeftHip/LeftKnee/LeftAnkle,
+// mb LeftUpLeg/LeftLeg/LeftFoot/LeftToeBase, DAZ lThigh/lShin/lFoot), Bandai
+// Namco (UpperLeg_L/LowerLeg_L/Foot_L/Toes_L) and LAFAN1 skeletons, compared
+// lower-case without punctuation. "@hips" is the deepest common ancestor of
+// the two upper legs (so Bandai's static joint_Root above Hips is never
+// taken), or else a joint named hips/hip/pelvis/root. DAZ skeletons have no
+// toe joint: "@left_toe" fails there. The error names the bone and lists the
 // skeleton's joints.
 Result<int> find_bone(const Skeleton& skeleton, std::string_view bone);
 
@@ -33,6 +40,15 @@ struct CharacterRootOptions {
 
 // Per frame: the root position on the ground (y = 0, metres) and its facing
 // direction (unit vector in the XZ plane).
+//
+// The rule: position = the source bone's model-space position with y set to
+// 0 (not smoothed). Raw facing = (left upper leg - right upper leg) x up,
+// i.e. the horizontal direction perpendicular to the hip-to-hip axis (+Z for
+// a character whose left is +X), normalized. The facing is the normalized
+// mean of the raw facings over a centred window of facing_smoothing_seconds
+// (half a window each side, cut at the clip's ends); a window whose mean
+// vanishes keeps the previous facing (+Z on the first frame). Errors: an
+// unknown source bone, no upper legs, a negative smoothing window.
 struct CharacterRoot {
   std::vector<glm::vec3> positions;  // [frame_count]
   std::vector<glm::vec3> facings;    // [frame_count]

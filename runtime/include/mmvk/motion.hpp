@@ -44,20 +44,40 @@ struct Motion {
 enum class UpAxis : std::uint8_t { Y, Z };
 
 struct ImportOptions {
-  // Metres per file unit. 0 = guess from the skeleton's height (cm, ASF units
-  // of 0.05644 m, inches or metres); CMU ASF-derived BVH is 0.05644, Bandai and
-  // LAFAN1 are 0.01.
+  // Metres per file unit. 0 = guess with guess_metres_per_unit(); CMU
+  // ASF-derived BVH (amc2bvh, cgspeed max/mb) is 0.05644, Bandai, LAFAN1 and
+  // cgspeed DAZ are 0.01.
   float metres_per_unit = 0.0f;
   // The file's up axis; Z-up files are rotated into mmvk's Y-up frame.
   UpAxis up_axis = UpAxis::Y;
 };
 
+// Rotation channels compose in the file's channel order as intrinsic
+// rotations ("Zrotation Xrotation Yrotation" -> Rz * Rx * Ry); position
+// channels replace the OFFSET's components. fps = 1 / frame_time, snapped to
+// the nearest integer when within 0.01% (".0083333" -> 120). Rest offsets and
+// the root's translation and rotation are converted to Y-up when the file is
+// Z-up. Errors name the file (an inconsistent BvhFile, a bad option).
 Result<Motion> motion_from_bvh(const BvhFile& file, const ImportOptions& options);
+
+// The unit guess used when metres_per_unit is 0. Rule: take the skeleton's
+// tree diameter in file units (the longest leaf-to-leaf path through the
+// hierarchy, End Sites included, each bone counting the length of its OFFSET,
+// the root's own OFFSET excluded): for a human about toe tip to finger tip,
+// ~2.2 m. Return the candidate among cm (0.01), inches (0.0254), CMU ASF units
+// (0.05644) and metres (1.0) whose diameter in metres is closest to 2.2 m on a
+// log scale. Skeletons without bones give 1.0.
+float guess_metres_per_unit(const BvhFile& file);
 
 // Global (model-space) joint positions and rotations of one frame.
 // Preconditions: frame < motion.frame_count, spans sized joint_count().
 void forward_kinematics(const Motion& motion, std::uint32_t frame, std::span<glm::vec3> global_positions,
                         std::span<glm::quat> global_rotations);
+
+// Forward kinematics of every frame. Preconditions: spans sized
+// frame_count x joint_count(), row-major by frame ([frame][joint]).
+void forward_kinematics_clip(const Motion& motion, std::span<glm::vec3> global_positions,
+                             std::span<glm::quat> global_rotations);
 
 // Resamples to `fps` (> 0): positions are interpolated linearly and rotations
 // with slerp; the clip's duration is kept.

@@ -1,0 +1,158 @@
+// Bone roles ("@left_foot") -> joint indices, by the naming conventions of
+// the skeletons in ../shared/data/SOURCES.md plus common DCC exports.
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <string>
+#include <vector>
+
+#include "mmvk/character.hpp"
+
+namespace mmvk {
+
+namespace {
+
+// Lower case, letters and digits only: "Foot_L" -> "footl", "LeftUpLeg" ->
+// "leftupleg", so one table entry covers "Foot_L", "Foot.L" and "foot_l".
+std::string normalize(std::string_view name) {
+  std::string out;
+  out.reserve(name.size());
+  for (const char c : name) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (std::isalnum(u)) out += static_cast<char>(std::tolower(u));
+  }
+  return out;
+}
+
+struct RoleNames {
+  std::string_view role;
+  std::string_view description;
+  // Normalized joint names, most specific first. Sources: CMU ASF (lfemur),
+  // cgspeed max (LeftHip), cgspeed mb and LAFAN1/Mixamo (LeftUpLeg), Bandai
+  // (UpperLeg_L), DAZ (lThigh), and a few common exports.
+  std::array<std::string_view, 10> names;
+};
+
+constexpr std::array<RoleNames, 12> kRoles{{
+    {"left_upper_leg", "left upper leg (hip joint)",
+     {"lfemur", "leftupleg", "upperlegl", "lthigh", "lefthip", "leftthigh", "leftupperleg", "thighl", "lupleg", "lhip"}},
+    {"right_upper_leg", "right upper leg (hip joint)",
+     {"rfemur", "rightupleg", "upperlegr", "rthigh", "righthip", "rightthigh", "rightupperleg", "thighr", "rupleg",
+      "rhip"}},
+    {"left_lower_leg", "left lower leg (knee)",
+     {"ltibia", "leftleg", "lowerlegl", "lshin", "leftknee", "leftshin", "leftlowerleg", "shinl", "leftcalf", "lknee"}},
+    {"right_lower_leg", "right lower leg (knee)",
+     {"rtibia", "rightleg", "lowerlegr", "rshin", "rightknee", "rightshin", "rightlowerleg", "shinr", "rightcalf",
+      "rknee"}},
+    {"left_foot", "left foot (ankle)",
+     {"lfoot", "leftfoot", "footl", "leftankle", "anklel", "lankle", "leftfootankle", "", "", ""}},
+    {"right_foot", "right foot (ankle)",
+     {"rfoot", "rightfoot", "footr", "rightankle", "ankler", "rankle", "rightfootankle", "", "", ""}},
+    {"left_toe", "left toe (ball of the foot)",
+     {"ltoes", "lefttoebase", "toesl", "lefttoe", "toel", "lefttoes", "ltoe", "ltoebase", "", ""}},
+    {"right_toe", "right toe (ball of the foot)",
+     {"rtoes", "righttoebase", "toesr", "righttoe", "toer", "righttoes", "rtoe", "rtoebase", "", ""}},
+    {"head", "head", {"head", "", "", "", "", "", "", "", "", ""}},
+    {"left_hand", "left hand (wrist)",
+     {"lwrist", "leftwrist", "wristl", "lefthand", "handl", "lhand", "", "", "", ""}},
+    {"right_hand", "right hand (wrist)",
+     {"rwrist", "rightwrist", "wristr", "righthand", "handr", "rhand", "", "", "", ""}},
+    {"hips", "hips (pelvis)", {"hips", "hip", "pelvis", "root", "", "", "", "", "", ""}},
+}};
+
+std::string list_joints(const Skeleton& skeleton) {
+  std::string out;
+  for (std::size_t i = 0; i < skeleton.names.size(); ++i) {
+    if (i) out += ", ";
+    out += skeleton.names[i];
+  }
+  return out;
+}
+
+int find_by_names(const Skeleton& skeleton, const RoleNames& role) {
+  std::vector<std::string> normalized;
+  normalized.reserve(skeleton.size());
+  for (const std::string& name : skeleton.names) normalized.push_back(normalize(name));
+  for (const std::string_view candidate : role.names) {
+    if (candidate.empty()) continue;
+    for (std::size_t j = 0; j < normalized.size(); ++j) {
+      if (normalized[j] == candidate) return static_cast<int>(j);
+    }
+  }
+  return -1;
+}
+
+const RoleNames* role_named(std::string_view role) {
+  for (const RoleNames& entry : kRoles) {
+    if (entry.role == role) return &entry;
+  }
+  return nullptr;
+}
+
+std::string known_roles() {
+  std::string out;
+  for (const RoleNames& entry : kRoles) {
+    if (!out.empty()) out += ", ";
+    out += '@';
+    out += entry.role;
+  }
+  return out;
+}
+
+// Deepest joint that is an ancestor of (or equal to) both a and b.
+int common_ancestor(const Skeleton& skeleton, int a, int b) {
+  while (a != b) {
+    // Parents have smaller indices, so stepping up the larger index converges.
+    if (a > b) {
+      a = skeleton.parents[static_cast<std::size_t>(a)];
+    } else {
+      b = skeleton.parents[static_cast<std::size_t>(b)];
+    }
+    if (a < 0 || b < 0) return -1;
+  }
+  return a;
+}
+
+}  // namespace
+
+Result<int> find_bone(const Skeleton& skeleton, std::string_view bone) {
+  if (bone.empty()) return make_error("bone name is empty");
+  if (bone.front() != '@') {
+    const int index = skeleton.find(bone);
+    if (index < 0) {
+      return make_error("bone '" + std::string(bone) + "' not found; the skeleton's joints are: " +
+                        list_joints(skeleton));
+    }
+    return index;
+  }
+  const std::string_view role_name = bone.substr(1);
+  const RoleNames* role = role_named(role_name);
+  if (!role) return make_error("unknown bone role '" + std::string(bone) + "'; known roles: " + known_roles());
+  if (role_name == "hips") {
+    // The pelvis is where the two legs meet: the deepest common ancestor of
+    // the upper legs. This skips static scene roots above it (Bandai's
+    // joint_Root) whatever they are called.
+    const int left = find_by_names(skeleton, *role_named("left_upper_leg"));
+    const int right = find_by_names(skeleton, *role_named("right_upper_leg"));
+    if (left >= 0 && right >= 0 && left != right) {
+      const int hips = common_ancestor(skeleton, left, right);
+      if (hips >= 0) return hips;
+    }
+  }
+  const int index = find_by_names(skeleton, *role);
+  if (index < 0) {
+    std::string names;
+    for (const std::string_view candidate : role->names) {
+      if (candidate.empty()) continue;
+      if (!names.empty()) names += ", ";
+      names += candidate;
+    }
+    return make_error("bone '" + std::string(bone) + "' not found: no joint is named like a " +
+                      std::string(role->description) + " (" + names +
+                      ", compared lower-case without punctuation); the skeleton's joints are: " +
+                      list_joints(skeleton));
+  }
+  return index;
+}
+
+}  // namespace mmvk

@@ -1,13 +1,147 @@
-// Placeholder until the command is implemented; replaced by its owner.
+// mmvk export: the normalized feature matrix as raw float32 plus a JSON
+// sidecar describing its layout, for analysis and training outside mmvk.
+#include <bit>
 #include <cstdio>
+#include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "../../runtime/src/file_io.hpp"
+#include "cli_args.hpp"
 #include "commands.hpp"
+#include "mmvk/database_io.hpp"
 
 namespace mmvk::cli {
 
-int run_export(Args) {
-  std::fputs("mmvk export: not implemented yet\n", stderr);
-  return 1;
+namespace {
+
+constexpr const char* kExportUsage =
+    "usage: mmvk export db.mmdb --features out.f32 [--sidecar out.f32.json]\n"
+    "\n"
+    "Writes the normalized feature matrix as raw little-endian float32, row-major\n"
+    "[frames x dims], and a JSON sidecar (default: <out>.json) with dims, fps,\n"
+    "channel names and groups, per-dimension names, offsets, scales and weights\n"
+    "(raw = normalized * scale + offset; scale already includes 1 / weight), tag\n"
+    "names, clip ranges and the per-frame flags (1 = do_not_use,\n"
+    "2 = block_transition, 4 = edge_excluded).\n";
+
+const char* kind_name(ChannelKind kind) {
+  switch (kind) {
+    case ChannelKind::TrajectoryPosition: return "trajectory_position";
+    case ChannelKind::TrajectoryDirection: return "trajectory_direction";
+    case ChannelKind::BonePosition: return "bone_position";
+    case ChannelKind::BoneVelocity: return "bone_velocity";
+    case ChannelKind::RootVelocity: return "root_velocity";
+    case ChannelKind::Custom: return "custom";
+  }
+  return "?";
+}
+
+const char* mode_name(Normalization mode) {
+  switch (mode) {
+    case Normalization::GroupStd: return "group_std";
+    case Normalization::PerDimStd: return "per_dim_std";
+    case Normalization::MeanAbsDev: return "mean_abs_dev";
+    case Normalization::MinMax: return "min_max";
+  }
+  return "?";
+}
+
+std::string little_endian_floats(std::span<const float> values) {
+  std::string bytes(values.size() * 4, '\0');
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const std::uint32_t bits = std::bit_cast<std::uint32_t>(values[i]);
+    for (int b = 0; b < 4; ++b) bytes[4 * i + b] = static_cast<char>((bits >> (8 * b)) & 0xFF);
+  }
+  return bytes;
+}
+
+nlohmann::json sidecar(const Database& db, const std::string& source, const std::string& features_path) {
+  const FeatureSchema& schema = db.schema();
+  nlohmann::json out;
+  out["format"] = "float32 little-endian, row-major [frames x dims], normalized";
+  out["features"] = std::filesystem::path(features_path).filename().string();
+  out["source"] = source;
+  out["frames"] = db.frame_count();
+  out["dims"] = db.dims();
+  out["fps"] = db.fps();
+  out["content_hash"] = db.content_hash();
+  out["channels"] = nlohmann::json::array();
+  std::vector<std::uint32_t> groups;
+  std::vector<float> weights;
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& channel = schema.channels[c];
+    nlohmann::json ch = {{"name", channel.name},       {"kind", kind_name(channel.kind)},
+                         {"normalization", mode_name(channel.normalization)},
+                         {"weight", channel.weight},   {"offset", schema.offset(c)},
+                         {"dims", channel.dims()}};
+    if (!channel.bone.empty()) ch["bone"] = channel.bone;
+    if (!channel.offsets_seconds.empty()) ch["offsets_seconds"] = channel.offsets_seconds;
+    out["channels"].push_back(std::move(ch));
+    for (std::uint32_t d = 0; d < channel.dims(); ++d) {
+      groups.push_back(static_cast<std::uint32_t>(c));
+      weights.push_back(channel.weight);
+    }
+  }
+  std::vector<std::string> names;
+  std::vector<float> offsets;
+  std::vector<float> scales;
+  for (std::uint32_t d = 0; d < db.dims(); ++d) {
+    names.push_back(schema.dim_name(d));
+    offsets.push_back(db.normalization()[d].offset);
+    scales.push_back(db.normalization()[d].scale);
+  }
+  out["dim_names"] = names;
+  out["groups"] = groups;
+  out["offsets"] = offsets;
+  out["scales"] = scales;
+  out["weights"] = weights;
+  out["tags"] = std::vector<std::string>(db.tag_names().begin(), db.tag_names().end());
+  out["clips"] = nlohmann::json::array();
+  for (const Clip& clip : db.clips()) {
+    std::vector<std::string> tags;
+    for (std::size_t t = 0; t < db.tag_names().size(); ++t) {
+      if (clip.tags & (TagMask{1} << t)) tags.push_back(db.tag_names()[t]);
+    }
+    out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
+                            {"frame_count", clip.frame_count}, {"loop", clip.loop}, {"mirrored", clip.mirrored},
+                            {"cost_multiplier", clip.cost_multiplier}, {"cost_bias", clip.cost_bias}, {"tags", tags}});
+  }
+  out["frame_flags"] = std::vector<std::uint32_t>(db.frame_flags().begin(), db.frame_flags().end());
+  return out;
+}
+
+}  // namespace
+
+int run_export(Args args) {
+  const auto parsed = parse_args("export", args, {"--features", "--sidecar"}, {"--help", "-h"});
+  if (!parsed) return 2;
+  if (parsed->has("--help") || parsed->has("-h")) {
+    std::fputs(kExportUsage, stdout);
+    return 0;
+  }
+  const std::optional<std::string> features = parsed->value("--features");
+  if (parsed->positional.size() != 1 || !features) {
+    std::fputs(kExportUsage, stderr);
+    return 2;
+  }
+  const std::string sidecar_path = parsed->value("--sidecar").value_or(*features + ".json");
+  Result<Database> db = load_database(parsed->positional[0]);
+  if (!db.ok()) {
+    std::fprintf(stderr, "mmvk export: %s\n", db.message().c_str());
+    return 1;
+  }
+  Status written = detail::write_file_atomically(*features, little_endian_floats(db->features()));
+  if (written.ok()) {
+    written = detail::write_file_atomically(sidecar_path, sidecar(*db, parsed->positional[0], *features).dump(1) + "\n");
+  }
+  if (!written.ok()) {
+    std::fprintf(stderr, "mmvk export: %s\n", written.message().c_str());
+    return 1;
+  }
+  std::printf("wrote %s (%u frames x %u dims, float32) and %s\n", features->c_str(), db->frame_count(), db->dims(),
+              sidecar_path.c_str());
+  return 0;
 }
 
 }  // namespace mmvk::cli

@@ -1,13 +1,193 @@
-// Placeholder until the command is implemented; replaced by its owner.
+// mmvk inspect: what is in a database file.
+#include <cinttypes>
 #include <cstdio>
+#include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "cli_args.hpp"
 #include "commands.hpp"
+#include "mmvk/database_io.hpp"
+#include "mmvk/normalization.hpp"
 
 namespace mmvk::cli {
 
-int run_inspect(Args) {
-  std::fputs("mmvk inspect: not implemented yet\n", stderr);
-  return 1;
+namespace {
+
+constexpr const char* kInspectUsage =
+    "usage: mmvk inspect db.mmdb [--json]\n"
+    "\n"
+    "Prints the database's frames, clips, fps, tags, frame flag counts and, per\n"
+    "channel and dimension, the normalization offset and scale and the raw\n"
+    "(unnormalized) mean, std, min and max.\n"
+    "  --json   the same as one JSON object on stdout\n";
+
+const char* kind_name(ChannelKind kind) {
+  switch (kind) {
+    case ChannelKind::TrajectoryPosition: return "trajectory_position";
+    case ChannelKind::TrajectoryDirection: return "trajectory_direction";
+    case ChannelKind::BonePosition: return "bone_position";
+    case ChannelKind::BoneVelocity: return "bone_velocity";
+    case ChannelKind::RootVelocity: return "root_velocity";
+    case ChannelKind::Custom: return "custom";
+  }
+  return "?";
+}
+
+const char* mode_name(Normalization mode) {
+  switch (mode) {
+    case Normalization::GroupStd: return "group_std";
+    case Normalization::PerDimStd: return "per_dim_std";
+    case Normalization::MeanAbsDev: return "mean_abs_dev";
+    case Normalization::MinMax: return "min_max";
+  }
+  return "?";
+}
+
+std::string tag_list(const Database& db, TagMask mask) {
+  std::string out;
+  for (std::size_t t = 0; t < db.tag_names().size(); ++t) {
+    if (mask & (TagMask{1} << t)) out += (out.empty() ? "" : ",") + db.tag_names()[t];
+  }
+  return out.empty() ? "-" : out;
+}
+
+struct RawDimStats {
+  double mean, std, min, max;
+};
+
+// Statistics of the raw features, recovered from the normalized matrix
+// (raw = normalized * scale + offset; scale > 0 keeps min and max in place).
+std::vector<RawDimStats> raw_statistics(const Database& db) {
+  const std::vector<DimStatistics> stats = compute_statistics(db.features(), db.dims());
+  std::vector<RawDimStats> raw(db.dims());
+  for (std::uint32_t d = 0; d < db.dims(); ++d) {
+    const double offset = db.normalization()[d].offset;
+    const double scale = db.normalization()[d].scale;
+    raw[d] = {stats[d].mean * scale + offset, stats[d].std * scale, stats[d].min * scale + offset,
+              stats[d].max * scale + offset};
+  }
+  return raw;
+}
+
+}  // namespace
+
+int run_inspect(Args args) {
+  const auto parsed = parse_args("inspect", args, {}, {"--json", "--help", "-h"});
+  if (!parsed) return 2;
+  if (parsed->has("--help") || parsed->has("-h")) {
+    std::fputs(kInspectUsage, stdout);
+    return 0;
+  }
+  if (parsed->positional.size() != 1) {
+    std::fputs(kInspectUsage, stderr);
+    return 2;
+  }
+  const std::string& path = parsed->positional[0];
+  Result<Database> loaded = load_database(path);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "mmvk inspect: %s\n", loaded.message().c_str());
+    return 1;
+  }
+  const Database& db = *loaded;
+  std::uint64_t do_not_use = 0, block = 0, edge = 0, candidates = 0;
+  for (std::uint32_t flags : db.frame_flags()) {
+    do_not_use += (flags & kFrameDoNotUse) != 0;
+    block += (flags & kFrameBlockTransition) != 0;
+    edge += (flags & kFrameEdgeExcluded) != 0;
+    candidates += (flags & (kFrameDoNotUse | kFrameEdgeExcluded)) == 0;
+  }
+  std::size_t mirrored = 0, looping = 0;
+  std::vector<std::uint64_t> tag_frames(db.tag_names().size(), 0);
+  for (const Clip& clip : db.clips()) {
+    mirrored += clip.mirrored;
+    looping += clip.loop;
+    for (std::size_t t = 0; t < tag_frames.size(); ++t) {
+      if (clip.tags & (TagMask{1} << t)) tag_frames[t] += clip.frame_count;
+    }
+  }
+  const std::vector<RawDimStats> raw = raw_statistics(db);
+  const FeatureSchema& schema = db.schema();
+
+  if (parsed->has("--json")) {
+    nlohmann::json out;
+    out["file"] = path;
+    out["frames"] = db.frame_count();
+    out["dims"] = db.dims();
+    out["fps"] = db.fps();
+    out["content_hash"] = db.content_hash();
+    out["flags"] = {{"do_not_use", do_not_use}, {"block_transition", block}, {"edge_excluded", edge},
+                    {"candidates", candidates}};
+    out["tags"] = nlohmann::json::array();
+    for (std::size_t t = 0; t < tag_frames.size(); ++t) {
+      out["tags"].push_back({{"name", db.tag_names()[t]}, {"frames", tag_frames[t]}});
+    }
+    out["channels"] = nlohmann::json::array();
+    for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+      const FeatureChannel& channel = schema.channels[c];
+      nlohmann::json ch = {{"name", channel.name}, {"kind", kind_name(channel.kind)},
+                           {"normalization", mode_name(channel.normalization)}, {"weight", channel.weight},
+                           {"offset", schema.offset(c)}, {"dims", channel.dims()}};
+      ch["dimensions"] = nlohmann::json::array();
+      for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
+        ch["dimensions"].push_back({{"name", schema.dim_name(d)}, {"offset", db.normalization()[d].offset},
+                                    {"scale", db.normalization()[d].scale}, {"mean", raw[d].mean},
+                                    {"std", raw[d].std}, {"min", raw[d].min}, {"max", raw[d].max}});
+      }
+      out["channels"].push_back(std::move(ch));
+    }
+    out["clips"] = nlohmann::json::array();
+    for (const Clip& clip : db.clips()) {
+      out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
+                              {"frame_count", clip.frame_count}, {"loop", clip.loop}, {"mirrored", clip.mirrored},
+                              {"cost_multiplier", clip.cost_multiplier}, {"cost_bias", clip.cost_bias},
+                              {"tags", tag_list(db, clip.tags)}});
+    }
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+
+  std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n", path.c_str(),
+              thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()), db.clips().size(), mirrored,
+              looping, db.dims(), double(db.fps()));
+  std::printf("content hash: %016" PRIx64 "\n", db.content_hash());
+  std::printf("frame flags: %s do_not_use, %s block_transition, %s edge_excluded; %s candidate frames\n",
+              thousands(do_not_use).c_str(), thousands(block).c_str(), thousands(edge).c_str(),
+              thousands(candidates).c_str());
+  std::printf("tags (%zu):", tag_frames.size());
+  for (std::size_t t = 0; t < tag_frames.size(); ++t) {
+    std::printf(" %s (%s frames)%s", db.tag_names()[t].c_str(), thousands(tag_frames[t]).c_str(),
+                t + 1 < tag_frames.size() ? "," : "");
+  }
+  std::printf("%s\n", tag_frames.empty() ? " none" : "");
+
+  std::printf("\nchannels (raw values: metres, m/s; normalized = (raw - offset) / scale):\n");
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& channel = schema.channels[c];
+    std::string detail = channel.bone;
+    if (channel.kind == ChannelKind::TrajectoryPosition || channel.kind == ChannelKind::TrajectoryDirection) {
+      detail = "offsets (s):";
+      for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);
+    }
+    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", channel.name.c_str(), kind_name(channel.kind),
+                mode_name(channel.normalization), double(channel.weight), detail.c_str());
+    std::printf("    %-32s %10s %10s %10s %10s %10s %10s\n", "dimension", "offset", "scale", "mean", "std", "min", "max");
+    for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
+      std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", schema.dim_name(d).c_str(),
+                  double(db.normalization()[d].offset), double(db.normalization()[d].scale), raw[d].mean, raw[d].std,
+                  raw[d].min, raw[d].max);
+    }
+  }
+
+  std::printf("\nclips:\n  %5s  %-40s %8s %8s  %-5s %-8s %6s %6s  %s\n", "#", "name", "first", "frames", "loop", "mirrored",
+              "mult", "bias", "tags");
+  for (std::size_t c = 0; c < db.clips().size(); ++c) {
+    const Clip& clip = db.clips()[c];
+    std::printf("  %5zu  %-40s %8u %8u  %-5s %-8s %6g %6g  %s\n", c, clip.name.c_str(), clip.first_frame,
+                clip.frame_count, clip.loop ? "yes" : "no", clip.mirrored ? "yes" : "no", double(clip.cost_multiplier),
+                double(clip.cost_bias), tag_list(db, clip.tags).c_str());
+  }
+  return 0;
 }
 
 }  // namespace mmvk::cli

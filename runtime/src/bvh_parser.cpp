@@ -81,7 +81,10 @@ std::optional<Int> parse_integer(std::string_view token) {
 
 class Parser {
  public:
-  Parser(std::string_view text, std::string_view source) : cursor_(text) { file_.source = std::string(source); }
+  Parser(std::string_view text, std::string_view source, const BvhParseOptions& options)
+      : cursor_(text), options_(options) {
+    file_.source = std::string(source);
+  }
 
   Result<BvhFile> run() {
     MMVK_TRY(parse_hierarchy());
@@ -129,8 +132,9 @@ class Parser {
       const std::string_view token = cursor_.next_token(&token_line);
       const std::optional<float> value = detail::parse_float(token);
       if (!value) {
-        return fail(token_line, "OFFSET of " + owner + " (line " + std::to_string(line) +
-                                    ") needs 3 numbers; got " + (token.empty() ? "end of file" : quote(token)));
+        return fail(line, "OFFSET of " + owner + " needs 3 numbers; got " +
+                              (token.empty() ? std::string("end of file") : quote(token)) +
+                              (token_line != line ? " on line " + std::to_string(token_line) : std::string()));
       }
       out[axis] = *value;
     }
@@ -230,7 +234,9 @@ class Parser {
         MMVK_TRY(expect_open_brace(brace, "End Site of " + describe(block.joint)));
         open.push_back({block.joint, true, line, false});
       } else if (token == "}") {
-        if (!block.has_offset) return fail(line, owner + " has no OFFSET");
+        if (!block.has_offset) {
+          return fail(line, owner + " (opened at line " + std::to_string(block.open_line) + ") has no OFFSET");
+        }
         open.pop_back();
       } else if (iequals(token, "MOTION")) {
         return fail(line, "missing '}' to close " + owner + " (opened at line " + std::to_string(block.open_line) +
@@ -314,6 +320,10 @@ class Parser {
     std::vector<float> line_values(channels);
     for (std::size_t frame = 0;; ++frame) {
       if (!cursor_.skip_empty_lines()) {
+        if (!options_.strict_frame_count) {
+          file_.frame_count = static_cast<int>(frame);
+          return {};
+        }
         if (frame < claimed) {
           return fail(cursor_.line(), "frame count mismatch: Frames: " + std::to_string(claimed) +
                                           " but the file ends after " + std::to_string(frame) + " motion lines");
@@ -321,7 +331,10 @@ class Parser {
         return {};
       }
       const int line = cursor_.line();
-      if (frame == claimed) {
+      if (frame >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+        return fail(line, "more than 2^31 - 1 motion lines");
+      }
+      if (frame == claimed && options_.strict_frame_count) {
         return fail(line, "frame count mismatch: more motion lines than Frames: " + std::to_string(claimed));
       }
       std::string_view bad_token;
@@ -340,17 +353,26 @@ class Parser {
   }
 
   BvhCursor cursor_;
+  BvhParseOptions options_;
   BvhFile file_;
 };
 
 }  // namespace
 
-Result<BvhFile> parse_bvh(std::string_view text, std::string_view source) { return Parser(text, source).run(); }
+Result<BvhFile> parse_bvh(std::string_view text, std::string_view source, const BvhParseOptions& options) {
+  return Parser(text, source, options).run();
+}
 
-Result<BvhFile> load_bvh(const std::filesystem::path& path) {
+Result<BvhFile> parse_bvh(std::string_view text, std::string_view source) {
+  return parse_bvh(text, source, BvhParseOptions{});
+}
+
+Result<BvhFile> load_bvh(const std::filesystem::path& path, const BvhParseOptions& options) {
   Result<std::string> text = detail::read_file(path);
   if (!text) return text.error();
-  return parse_bvh(*text, path.string());
+  return parse_bvh(*text, path.string(), options);
 }
+
+Result<BvhFile> load_bvh(const std::filesystem::path& path) { return load_bvh(path, BvhParseOptions{}); }
 
 }  // namespace mmvk

@@ -74,7 +74,11 @@ struct ClusterSearch::Layout {
   std::vector<float> multiplier;             // [tiles x 16]
   std::vector<float> bias;                   // [tiles x 16]
   std::vector<std::uint32_t> flags;          // [tiles x 16], padding: do-not-use
-  std::vector<std::uint32_t> real_rows;      // [clusters]: members (rows evaluated per visit)
+  std::vector<float> tile_lo;                // [tiles x dims]: box of the tile's member rows
+  std::vector<float> tile_hi;                // [tiles x dims]
+  std::vector<float> tile_min_multiplier;    // [tiles]
+  std::vector<float> tile_min_bias;          // [tiles]
+  std::vector<std::uint8_t> tile_rows;       // [tiles]: member rows (the rest is padding)
   std::vector<bool> never_candidate;         // [clusters]: empty or all members excluded by flags
   double radius_margin = 0.0;
   std::vector<Scratch> scratch;              // [pool threads]
@@ -96,11 +100,9 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   }
   const std::uint32_t k = table.cluster_count;
   l.tile_offsets.assign(k + 1, 0);
-  l.real_rows.resize(k);
   l.never_candidate.resize(k);
   for (std::uint32_t c = 0; c < k; ++c) {
     const std::uint32_t size = table.offsets[c + 1] - table.offsets[c];
-    l.real_rows[c] = size;
     l.never_candidate[c] = size == 0 || (table.flags_intersection[c] & kNeverCandidate) != 0;
     l.tile_offsets[c + 1] = l.tile_offsets[c] + (size + kLanes - 1) / kLanes;
   }
@@ -110,6 +112,11 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   l.multiplier.assign(tiles * kLanes, 1.0f);
   l.bias.assign(tiles * kLanes, 0.0f);
   l.flags.assign(tiles * kLanes, kFrameDoNotUse);
+  l.tile_lo.assign(tiles * l.dims, std::numeric_limits<float>::infinity());
+  l.tile_hi.assign(tiles * l.dims, -std::numeric_limits<float>::infinity());
+  l.tile_min_multiplier.assign(tiles, std::numeric_limits<float>::infinity());
+  l.tile_min_bias.assign(tiles, std::numeric_limits<float>::infinity());
+  l.tile_rows.assign(tiles, 0);
   for (std::uint32_t c = 0; c < k; ++c) {
     for (std::uint32_t m = table.offsets[c]; m < table.offsets[c + 1]; ++m) {
       const std::uint32_t f = table.members[m];
@@ -117,7 +124,14 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
       const std::size_t tile = slot / kLanes;
       const std::size_t lane = slot % kLanes;
       const auto row = database.row(f);
-      for (std::uint32_t d = 0; d < l.dims; ++d) l.features[(tile * l.dims + d) * kLanes + lane] = row[d];
+      for (std::uint32_t d = 0; d < l.dims; ++d) {
+        l.features[(tile * l.dims + d) * kLanes + lane] = row[d];
+        l.tile_lo[tile * l.dims + d] = std::min(l.tile_lo[tile * l.dims + d], row[d]);
+        l.tile_hi[tile * l.dims + d] = std::max(l.tile_hi[tile * l.dims + d], row[d]);
+      }
+      l.tile_min_multiplier[tile] = std::min(l.tile_min_multiplier[tile], database.frame_multiplier()[f]);
+      l.tile_min_bias[tile] = std::min(l.tile_min_bias[tile], database.frame_bias()[f]);
+      ++l.tile_rows[tile];
       l.frame[slot] = f;
       l.multiplier[slot] = database.frame_multiplier()[f];
       l.bias[slot] = database.frame_bias()[f];
@@ -152,13 +166,12 @@ std::uint32_t ClusterSearch::cluster_count() const { return layout_->table.clust
 
 namespace {
 
-// Box bound of cluster c before the bias: min_multiplier * sum_ch w_ch *
+// Box bound of a cluster or tile before the bias: min_multiplier * sum_ch w_ch *
 // sum_d gap_d^2 in the reference's order. For a member x, fl(x_d - q_d) is at
 // least fl(gap_d) in magnitude (rounding is monotone), so every step stays at
 // or below the member's own evaluation.
-float box_bound(const ClusterSearch::Layout& l, std::uint32_t c, const float* q, const float* w) {
-  const float* lo = l.table.box_min.data() + std::size_t{c} * l.dims;
-  const float* hi = l.table.box_max.data() + std::size_t{c} * l.dims;
+float box_bound(const ClusterSearch::Layout& l, const float* lo, const float* hi, float min_multiplier, const float* q,
+                const float* w) {
   float total = 0.0f;
   for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
     float sum = 0.0f;
@@ -170,7 +183,7 @@ float box_bound(const ClusterSearch::Layout& l, std::uint32_t c, const float* q,
     }
     total += w[ch] * sum;
   }
-  return l.table.min_multiplier[c] * total;
+  return min_multiplier * total;
 }
 
 // Radius bound before the bias (see the margin proof in create()).
@@ -253,7 +266,10 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
       }
       for (ClusterBound& b : s.order) {
         float bound = 0.0f;
-        if (options.box_bound) bound = box_bound(l, b.cluster, q, w);
+        if (options.box_bound) {
+          bound = box_bound(l, t.box_min.data() + std::size_t{b.cluster} * l.dims,
+                            t.box_max.data() + std::size_t{b.cluster} * l.dims, t.min_multiplier[b.cluster], q, w);
+        }
         if (options.radius_bound) bound = std::max(bound, radius_bound(l, b.cluster, q, w));
         b.bound = bound + t.min_bias[b.cluster];
       }
@@ -263,8 +279,17 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         // Strictly greater: a member costing exactly the k-th best could still
         // win on a lower frame id.
         if (b.bound > best[k - 1].cost) break;
-        s.rows += l.real_rows[b.cluster];
         for (std::uint32_t tile = l.tile_offsets[b.cluster]; tile < l.tile_offsets[b.cluster + 1]; ++tile) {
+          // Members are in frame order, so a tile mostly holds neighbouring
+          // frames of a clip and its box is tight.
+          if (options.tile_bound && box_bound(l, l.tile_lo.data() + std::size_t{tile} * l.dims,
+                                              l.tile_hi.data() + std::size_t{tile} * l.dims,
+                                              l.tile_min_multiplier[tile], q, w) +
+                                            l.tile_min_bias[tile] >
+                                        best[k - 1].cost) {
+            continue;
+          }
+          s.rows += l.tile_rows[tile];
           const std::size_t base = std::size_t{tile} * kLanes;
           tile_costs(l.features.data() + base * l.dims, q, w, l.channel_end.data(), l.channels,
                      l.multiplier.data() + base, l.bias.data() + base, cost);

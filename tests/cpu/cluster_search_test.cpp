@@ -104,6 +104,8 @@ const Variant kExactVariants[] = {
     {"nprobe=all", {.nprobe = 1000000}},
     {"box only", {.nprobe = 0, .box_bound = true, .radius_bound = false}},
     {"radius only", {.nprobe = 0, .box_bound = false, .radius_bound = true}},
+    {"no tile bound", {.nprobe = 0, .box_bound = true, .radius_bound = true, .tile_bound = false}},
+    {"no bounds", {.nprobe = 0, .box_bound = false, .radius_bound = false, .tile_bound = false}},
 };
 
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {

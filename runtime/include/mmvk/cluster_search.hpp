@@ -21,6 +21,9 @@
 // The continuing frame (whose cost may carry a negative continuing_bias) is
 // evaluated first as a seed and skipped during the cluster walk, so the
 // cluster bounds never need to account for continuing_bias.
+// Within a visited cluster, the members (in frame order, so mostly runs of
+// neighbouring frames) are evaluated in tiles of 16 rows, and a tile whose
+// own box bound is above the k-th best is skipped (same box-bound argument).
 // Clusters are skipped without evaluation when their tag union misses the
 // query's require_all mask, their tag intersection hits exclude_any, or all
 // their members are do-not-use, edge-excluded or block-transition.
@@ -47,6 +50,9 @@ struct ClusterSearchOptions {
   std::uint32_t nprobe = 0;  // 0 = exact; else clusters searched per query
   bool box_bound = true;     // use the per-dimension box bound
   bool radius_bound = true;  // use the per-channel radius (triangle) bound
+  // Within a visited cluster, skip 16-row tiles whose own box bound (the
+  // same box bound over the tile's members) is above the k-th best.
+  bool tile_bound = true;
 };
 
 class ClusterSearch final : public SearchBackend {

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cstring>
+#include <span>
 
 #include "file_io.hpp"
 #include "hash.hpp"
@@ -28,6 +29,20 @@ class Writer {
     bytes_.append(s);
   }
   void raw(std::string_view s) { bytes_.append(s); }
+  // Bulk form of f32 for the feature matrix (the bulk of the file).
+  void f32_array(std::span<const float> values) {
+    const std::size_t start = bytes_.size();
+    bytes_.resize(start + values.size() * 4);
+    char* out = bytes_.data() + start;
+    if constexpr (std::endian::native == std::endian::little) {
+      std::memcpy(out, values.data(), values.size_bytes());
+    } else {
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::uint32_t bits = std::bit_cast<std::uint32_t>(values[i]);
+        for (int b = 0; b < 4; ++b) out[4 * i + b] = static_cast<char>((bits >> (8 * b)) & 0xFF);
+      }
+    }
+  }
   std::string& bytes() { return bytes_; }
 
  private:
@@ -68,6 +83,20 @@ class Reader {
     v = std::bit_cast<float>(bits);
     return true;
   }
+  // Precondition: 4 * values.size() <= left().
+  void f32_array(std::span<float> values) {
+    const char* in = bytes_.data() + pos_;
+    if constexpr (std::endian::native == std::endian::little) {
+      std::memcpy(values.data(), in, values.size_bytes());
+    } else {
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        std::uint32_t bits = 0;
+        for (int b = 0; b < 4; ++b) bits |= std::uint32_t{static_cast<std::uint8_t>(in[4 * i + b])} << (8 * b);
+        values[i] = std::bit_cast<float>(bits);
+      }
+    }
+    pos_ += values.size_bytes();
+  }
   bool str(std::string& s) {
     std::uint32_t size = 0;
     if (!u32(size) || size > left()) return false;
@@ -98,44 +127,45 @@ std::uint32_t read_u32_at(std::string_view bytes, std::size_t at) {
 
 std::string serialize_database(const Database& database) {
   const DatabaseParts& parts = database.parts();
-  Writer payload;
-  payload.str(schema_to_json(parts.schema));
-  payload.f32(parts.fps);
-  payload.u32(static_cast<std::uint32_t>(parts.normalization.size()));
-  for (const DimNormalization& n : parts.normalization) {
-    payload.f32(n.offset);
-    payload.f32(n.scale);
-  }
-  payload.u32(static_cast<std::uint32_t>(parts.tag_names.size()));
-  for (const std::string& tag : parts.tag_names) payload.str(tag);
-  payload.u32(static_cast<std::uint32_t>(parts.clips.size()));
-  for (const Clip& clip : parts.clips) {
-    payload.str(clip.name);
-    payload.str(clip.source);
-    payload.u64(clip.tags);
-    payload.u8(clip.loop ? 1 : 0);
-    payload.u8(clip.mirrored ? 1 : 0);
-    payload.f32(clip.cost_multiplier);
-    payload.f32(clip.cost_bias);
-    payload.u32(clip.first_frame);
-    payload.u32(clip.frame_count);
-  }
-  payload.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
-  for (std::uint32_t flags : parts.frame_flags) payload.u32(flags);
-  payload.bytes().reserve(payload.bytes().size() + parts.features.size() * 4 + 64);
-  for (float v : parts.features) payload.f32(v);
-
+  // One buffer: header with a placeholder payload size, payload, checksum.
   Writer file;
+  file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
   file.u32(kDatabaseFormatVersion);
   file.u32(0);
-  file.u64(payload.bytes().size());
-  file.bytes().reserve(kDatabaseHeaderBytes + payload.bytes().size() + 8);
-  file.raw(payload.bytes());
+  file.u64(0);
+  file.str(schema_to_json(parts.schema));
+  file.f32(parts.fps);
+  file.u32(static_cast<std::uint32_t>(parts.normalization.size()));
+  for (const DimNormalization& n : parts.normalization) {
+    file.f32(n.offset);
+    file.f32(n.scale);
+  }
+  file.u32(static_cast<std::uint32_t>(parts.tag_names.size()));
+  for (const std::string& tag : parts.tag_names) file.str(tag);
+  file.u32(static_cast<std::uint32_t>(parts.clips.size()));
+  for (const Clip& clip : parts.clips) {
+    file.str(clip.name);
+    file.str(clip.source);
+    file.u64(clip.tags);
+    file.u8(clip.loop ? 1 : 0);
+    file.u8(clip.mirrored ? 1 : 0);
+    file.f32(clip.cost_multiplier);
+    file.f32(clip.cost_bias);
+    file.u32(clip.first_frame);
+    file.u32(clip.frame_count);
+  }
+  file.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
+  for (std::uint32_t flags : parts.frame_flags) file.u32(flags);
+  file.f32_array(parts.features);
+
+  std::string& bytes = file.bytes();
+  const std::uint64_t payload_size = bytes.size() - kDatabaseHeaderBytes;
+  for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<char>((payload_size >> (8 * i)) & 0xFF);
   detail::Hasher hasher;
-  hasher.add_bytes(file.bytes().data(), file.bytes().size());
+  hasher.add_bytes(bytes.data(), bytes.size());
   file.u64(hasher.digest());
-  return std::move(file.bytes());
+  return std::move(bytes);
 }
 
 Result<Database> deserialize_database(std::string_view bytes, std::string_view source_name) {
@@ -231,9 +261,7 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
                    std::to_string(values * 4) + " bytes, " + std::to_string(in.left()) + " are left");
   }
   parts.features.resize(values);
-  for (float& v : parts.features) {
-    if (!in.f32(v)) return corrupt("features");
-  }
+  in.f32_array(parts.features);
   Result<Database> database = Database::create(std::move(parts));
   if (!database.ok()) return make_error(source + ": invalid mmvk database: " + database.message());
   return database;

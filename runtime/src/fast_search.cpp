@@ -56,6 +56,7 @@ FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOpt
 FastSearch::~FastSearch() = default;
 
 SearchStats FastSearch::stats() const { return stats_; }
+std::string_view FastSearch::kernel_name() const { return layout_->kernels.name; }
 void FastSearch::reset_stats() { stats_ = {}; }
 
 void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
@@ -131,7 +132,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
           }
           for (std::uint32_t i = 0; i < count; ++i) queries[i].threshold = best_of(q + i)[k - 1].cost;
           const std::size_t hits =
-              detail::evaluate_tiles(tiles, queries.data(), count, scratch.tile_ids.data(), tile_count, scratch.hits.data());
+              l.kernels.evaluate_tiles(tiles, queries.data(), count, scratch.tile_ids.data(), tile_count, scratch.hits.data());
           rows += std::uint64_t{group_rows} * count;
           for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q + scratch.hits[h].query);
         }
@@ -154,7 +155,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
     const std::span<Match> list = best_of(q);
     scratch.group_order.clear();
     for (std::uint32_t pack = first_group / detail::kLanes; pack * detail::kLanes < end_group; ++pack) {
-      detail::box_bounds(group_boxes, pack, query, weights, bounds.data());
+      l.kernels.box_bounds(group_boxes, pack, query, weights, bounds.data());
       for (std::uint32_t lane = 0; lane < detail::kLanes; ++lane) {
         const std::uint32_t group = pack * detail::kLanes + lane;
         if (group < first_group || group >= end_group || !detail::block_may_match(l.group_summary[group], params)) continue;
@@ -167,7 +168,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
     detail::KernelQuery kernel_query{query, weights, 0.0f};
     for (const auto& [group_bound, group] : scratch.group_order) {
       if (group_bound > list[k - 1].cost) break;
-      detail::box_bounds(tile_boxes, group, query, weights, bounds.data());
+      l.kernels.box_bounds(tile_boxes, group, query, weights, bounds.data());
       std::size_t tile_count = 0;
       std::uint32_t group_rows = 0;
       const std::uint32_t first_tile = group * kFastGroupTiles;
@@ -180,7 +181,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
       if (tile_count == 0) continue;
       kernel_query.threshold = list[k - 1].cost;
       const std::size_t hits =
-          detail::evaluate_tiles(tiles, &kernel_query, 1, scratch.tile_ids.data(), tile_count, scratch.hits.data());
+          l.kernels.evaluate_tiles(tiles, &kernel_query, 1, scratch.tile_ids.data(), tile_count, scratch.hits.data());
       rows += group_rows;
       for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q);
     }

@@ -11,97 +11,103 @@ namespace mmvk::detail {
 
 namespace {
 
+// Native vector widths: 4 lanes (SSE2, the x86-64 baseline), 8 (AVX2), 16
+// (AVX-512). A 16-row tile is 16 / width vectors. Wider-than-native generic
+// vectors would make GCC spill every accumulator to memory.
+using V4 = float __attribute__((vector_size(16)));
+using V8 = float __attribute__((vector_size(32)));
 using V16 = float __attribute__((vector_size(64)));
-using I16 = std::int32_t __attribute__((vector_size(64)));
-using I8 = std::int32_t __attribute__((vector_size(32)));
-using I4 = std::int32_t __attribute__((vector_size(16)));
+template <class V> struct MaskOf;
+template <> struct MaskOf<V4> { using type = std::int32_t __attribute__((vector_size(16))); };
+template <> struct MaskOf<V8> { using type = std::int32_t __attribute__((vector_size(32))); };
+template <> struct MaskOf<V16> { using type = std::int32_t __attribute__((vector_size(64))); };
 
 #define MMVK_INLINE inline __attribute__((always_inline))
 
-// The helpers below take and return vectors but are always inlined inside
-// this file, so the ABI note GCC gives for 64-byte vectors does not apply.
+// The helpers below take and return vectors but are always inlined into
+// this file's entry points, so the ABI note GCC gives for them is moot.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
-MMVK_INLINE V16 load(const float* p) {
-  V16 v;
+template <class T>
+MMVK_INLINE T load(const void* p) {
+  T v;
   std::memcpy(&v, p, sizeof(v));
   return v;
 }
 
-MMVK_INLINE I16 load_mask(const std::int32_t* p) {
-  I16 v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
+template <class M>
+MMVK_INLINE bool any_lane(const M& m) {
+  std::uint64_t words[sizeof(M) / 8];
+  std::memcpy(words, &m, sizeof(M));
+  std::uint64_t any = 0;
+  for (std::uint64_t w : words) any |= w;
+  return any != 0;
 }
 
-MMVK_INLINE bool any_lane(const I16& m) {
-  const I8 a = __builtin_shufflevector(m, m, 0, 1, 2, 3, 4, 5, 6, 7) |
-               __builtin_shufflevector(m, m, 8, 9, 10, 11, 12, 13, 14, 15);
-  const I4 b = __builtin_shufflevector(a, a, 0, 1, 2, 3) | __builtin_shufflevector(a, a, 4, 5, 6, 7);
-  std::uint64_t lo = 0;
-  std::uint64_t hi = 0;
-  std::memcpy(&lo, &b, 8);
-  std::memcpy(&hi, reinterpret_cast<const char*>(&b) + 8, 8);
-  return (lo | hi) != 0;
-}
-
-template <int Q>
+template <class V, int Q>
 MMVK_INLINE std::size_t evaluate_tiles_q(const TileArrays& t, const KernelQuery* queries, const std::uint32_t* tile_ids,
                                          std::size_t count, LaneHit* hits) {
+  using M = typename MaskOf<V>::type;
+  constexpr int W = sizeof(V) / sizeof(float);
+  constexpr int P = kLanes / W;
   std::size_t hit_count = 0;
   const std::size_t tile_floats = std::size_t{t.dims} * kLanes;
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t tile = tile_ids[i];
     const float* x = t.features + tile * tile_floats;
-    V16 total[Q];
-    for (int q = 0; q < Q; ++q) total[q] = V16{} + 0.0f;
+    V total[Q][P];
+    for (int q = 0; q < Q; ++q)
+      for (int p = 0; p < P; ++p) total[q][p] = V{} + 0.0f;
     std::uint32_t d = 0;
     for (std::uint32_t c = 0; c < t.channels; ++c) {
       const std::uint32_t end = t.channel_end[c];
-      V16 sum[Q];
-      for (int q = 0; q < Q; ++q) sum[q] = V16{} + 0.0f;
+      V sum[Q][P];
+      for (int q = 0; q < Q; ++q)
+        for (int p = 0; p < P; ++p) sum[q][p] = V{} + 0.0f;
       for (; d < end; ++d) {
-        const V16 row = load(x + std::size_t{d} * kLanes);
+        V row[P];
+        for (int p = 0; p < P; ++p) row[p] = load<V>(x + std::size_t{d} * kLanes + p * W);
         for (int q = 0; q < Q; ++q) {
-          const V16 diff = row - queries[q].features[d];
-          sum[q] += diff * diff;
+          const float value = queries[q].features[d];
+          for (int p = 0; p < P; ++p) {
+            const V diff = row[p] - value;
+            sum[q][p] += diff * diff;
+          }
         }
       }
-      for (int q = 0; q < Q; ++q) total[q] += queries[q].weights[c] * sum[q];
+      for (int q = 0; q < Q; ++q)
+        for (int p = 0; p < P; ++p) total[q][p] += queries[q].weights[c] * sum[q][p];
     }
-    const V16 multiplier = load(t.multiplier + std::size_t{tile} * kLanes);
-    const V16 bias = load(t.bias + std::size_t{tile} * kLanes);
-    const I16 valid = load_mask(t.lane_valid + std::size_t{tile} * kLanes);
-    for (int q = 0; q < Q; ++q) {
-      const V16 cost = multiplier * total[q] + bias;
-      const I16 pass = (cost <= queries[q].threshold) & valid;
-      if (!any_lane(pass)) continue;
-      for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
-        if (pass[lane] != 0) hits[hit_count++] = LaneHit{tile * kLanes + lane, cost[lane], std::uint32_t(q)};
+    for (int p = 0; p < P; ++p) {
+      const std::size_t lane0 = std::size_t{tile} * kLanes + p * W;
+      const V multiplier = load<V>(t.multiplier + lane0);
+      const V bias = load<V>(t.bias + lane0);
+      const M valid = load<M>(t.lane_valid + lane0);
+      for (int q = 0; q < Q; ++q) {
+        const V cost = multiplier * total[q][p] + bias;
+        const M pass = (cost <= queries[q].threshold) & valid;
+        if (!any_lane(pass)) continue;
+        for (int lane = 0; lane < W; ++lane) {
+          if (pass[lane] != 0) {
+            hits[hit_count++] = LaneHit{static_cast<std::uint32_t>(lane0) + lane, cost[lane], std::uint32_t(q)};
+          }
+        }
       }
     }
   }
   return hit_count;
 }
 
-}  // namespace
-
-// One clone per instruction set; the dynamic loader picks the best one.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define MMVK_KERNEL_CLONES __attribute__((target_clones("default", "avx2", "avx512f")))
-#else
-#define MMVK_KERNEL_CLONES
-#endif
-
-MMVK_KERNEL_CLONES
-std::size_t evaluate_tiles(const TileArrays& tiles, const KernelQuery* queries, std::uint32_t query_count,
-                           const std::uint32_t* tile_ids, std::size_t count, LaneHit* hits) {
+template <class V>
+MMVK_INLINE std::size_t evaluate_tiles_v(const TileArrays& tiles, const KernelQuery* queries,
+                                         std::uint32_t query_count, const std::uint32_t* tile_ids, std::size_t count,
+                                         LaneHit* hits) {
   switch (query_count) {
-    case 1: return evaluate_tiles_q<1>(tiles, queries, tile_ids, count, hits);
-    case 2: return evaluate_tiles_q<2>(tiles, queries, tile_ids, count, hits);
-    default: return evaluate_tiles_q<4>(tiles, queries, tile_ids, count, hits);
+    case 1: return evaluate_tiles_q<V, 1>(tiles, queries, tile_ids, count, hits);
+    case 2: return evaluate_tiles_q<V, 2>(tiles, queries, tile_ids, count, hits);
+    default: return evaluate_tiles_q<V, 4>(tiles, queries, tile_ids, count, hits);
   }
 }
 
@@ -109,26 +115,71 @@ std::size_t evaluate_tiles(const TileArrays& tiles, const KernelQuery* queries, 
 // the distance from q to the box (0 inside it). Rounding is monotonic, so
 // every step stays <= the matching step of any row in the box, and the
 // bound never exceeds a member's computed cost.
-MMVK_KERNEL_CLONES
-void box_bounds(const BoxArrays& b, std::size_t pack, const float* query, const float* weights, float* out) {
+template <class V>
+MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t pack, const float* query, const float* weights,
+                              float* out) {
+  constexpr int W = sizeof(V) / sizeof(float);
+  constexpr int P = kLanes / W;
   const float* lo = b.lo + pack * b.dims * kLanes;
   const float* hi = b.hi + pack * b.dims * kLanes;
-  V16 total = V16{} + 0.0f;
+  V total[P];
+  for (int p = 0; p < P; ++p) total[p] = V{} + 0.0f;
   std::uint32_t d = 0;
   for (std::uint32_t c = 0; c < b.channels; ++c) {
     const std::uint32_t end = b.channel_end[c];
-    V16 sum = V16{} + 0.0f;
+    V sum[P];
+    for (int p = 0; p < P; ++p) sum[p] = V{} + 0.0f;
     for (; d < end; ++d) {
-      const V16 below = load(lo + std::size_t{d} * kLanes) - query[d];
-      const V16 above = query[d] - load(hi + std::size_t{d} * kLanes);
-      V16 diff = below > above ? below : above;
-      diff = diff > 0.0f ? diff : V16{} + 0.0f;
-      sum += diff * diff;
+      for (int p = 0; p < P; ++p) {
+        const V below = load<V>(lo + std::size_t{d} * kLanes + p * W) - query[d];
+        const V above = query[d] - load<V>(hi + std::size_t{d} * kLanes + p * W);
+        V diff = below > above ? below : above;
+        diff = diff > 0.0f ? diff : V{} + 0.0f;
+        sum[p] += diff * diff;
+      }
     }
-    total += weights[c] * sum;
+    for (int p = 0; p < P; ++p) total[p] += weights[c] * sum[p];
   }
-  const V16 bound = load(b.min_multiplier + pack * kLanes) * total + load(b.min_bias + pack * kLanes);
-  std::memcpy(out, &bound, sizeof(bound));
+  for (int p = 0; p < P; ++p) {
+    const V bound = load<V>(b.min_multiplier + pack * kLanes + p * W) * total[p] +
+                    load<V>(b.min_bias + pack * kLanes + p * W);
+    std::memcpy(out + p * W, &bound, sizeof(bound));
+  }
+}
+
+#define MMVK_DEFINE_KERNELS(suffix, V)                                                                         \
+  std::size_t evaluate_tiles_##suffix(const TileArrays& tiles, const KernelQuery* queries,                    \
+                                      std::uint32_t query_count, const std::uint32_t* tile_ids,                \
+                                      std::size_t count, LaneHit* hits) {                                      \
+    return evaluate_tiles_v<V>(tiles, queries, query_count, tile_ids, count, hits);                            \
+  }                                                                                                            \
+  void box_bounds_##suffix(const BoxArrays& boxes, std::size_t pack, const float* query, const float* weights, \
+                           float* out) {                                                                       \
+    box_bounds_v<V>(boxes, pack, query, weights, out);                                                         \
+  }
+
+MMVK_DEFINE_KERNELS(generic, V4)
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define MMVK_HAS_X86_KERNELS 1
+#pragma GCC push_options
+#pragma GCC target("avx2")
+MMVK_DEFINE_KERNELS(avx2, V8)
+#pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+MMVK_DEFINE_KERNELS(avx512, V16)
+#pragma GCC pop_options
+#endif
+
+}  // namespace
+
+Kernels select_kernels() {
+#if defined(MMVK_HAS_X86_KERNELS)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return {evaluate_tiles_avx512, box_bounds_avx512, "avx512f"};
+  if (__builtin_cpu_supports("avx2")) return {evaluate_tiles_avx2, box_bounds_avx2, "avx2"};
+#endif
+  return {evaluate_tiles_generic, box_bounds_generic, "generic"};
 }
 
 }  // namespace mmvk::detail

@@ -49,13 +49,20 @@ struct BoxArrays {
   std::uint32_t dims;
 };
 
+// The kernels for one instruction set, chosen once at run time.
+struct Kernels {
 // Evaluates the tiles tile_ids[0..count) for `query_count` queries (1, 2 or
 // 4), with the reference's per-row accumulation order, and writes the hits
 // to `hits` (capacity count * 16 * query_count). Returns the number of hits.
-std::size_t evaluate_tiles(const TileArrays& tiles, const KernelQuery* queries, std::uint32_t query_count,
-                           const std::uint32_t* tile_ids, std::size_t count, LaneHit* hits);
+  std::size_t (*evaluate_tiles)(const TileArrays& tiles, const KernelQuery* queries, std::uint32_t query_count,
+                                const std::uint32_t* tile_ids, std::size_t count, LaneHit* hits);
 
 // Lower bounds of the 16 boxes of pack `pack` for one query, into out[16].
-void box_bounds(const BoxArrays& boxes, std::size_t pack, const float* query, const float* weights, float* out);
+  void (*box_bounds)(const BoxArrays& boxes, std::size_t pack, const float* query, const float* weights, float* out);
+  const char* name;  // "avx512f", "avx2" or "generic"
+};
+
+// The widest kernels this CPU runs.
+Kernels select_kernels();
 
 }  // namespace mmvk::detail

@@ -73,6 +73,7 @@ void merge_summary(detail::BlockSummary& into, const detail::BlockSummary& block
 std::unique_ptr<FastSearch::Layout> FastSearch::Layout::build(const Database& db) {
   auto layout = std::make_unique<Layout>();
   Layout& l = *layout;
+  l.kernels = detail::select_kernels();
   l.frames = db.frame_count();
   l.dims = db.dims();
   l.tiles = (l.frames + kLanes - 1) / kLanes;

@@ -56,6 +56,7 @@ struct FastSearch::Layout {
   std::uint32_t groups = 0;       // ceil(tiles / 16)
   std::uint32_t group_packs = 0;  // ceil(groups / 16)
   std::vector<std::uint32_t> channel_end;
+  detail::Kernels kernels{};
 
   detail::AlignedFloats features;    // [tiles][dims][16]
   detail::AlignedFloats multiplier;  // [tiles][16]

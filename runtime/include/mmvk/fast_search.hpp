@@ -52,6 +52,8 @@ class FastSearch final : public SearchBackend {
   void reset_stats() override;
 
   const FastSearchOptions& options() const { return options_; }
+  // The instruction set the kernels use: "avx512f", "avx2" or "generic".
+  std::string_view kernel_name() const;
 
   struct Layout;     // the tiled copy and the boxes (fast_search_layout.cpp)
   struct Workspace;  // per-thread scratch, allocated once (fast_search.cpp)

@@ -1,0 +1,202 @@
+// Exact CPU search: the reference vs FastSearch brute force vs FastSearch
+// with box pruning, for B in {1, 64, 1024} and the three query streams
+// (query_streams.hpp), on synthetic motion-like data of the default 27-d
+// schema: 21,791 frames (the Bandai locomotion set's size) and 417,000 (the
+// volume set's). register_search_benchmarks() takes any Database provider,
+// so real sets plug in the same way.
+//
+//   build/bench/mmvk_bench --benchmark_filter='^search/'
+//
+// Counters: queries/s; rows_fraction (rows whose full cost was evaluated,
+// per query and frame); row_dims/s (evaluated rows x dims per second, the
+// throughput to compare with the machine's limit, see machine/fma_peak).
+// The reference runs one iteration at B = 1024 and at the large size.
+#include <benchmark/benchmark.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mmvk/fast_search.hpp"
+#include "mmvk/reference_search.hpp"
+#include "mmvk/thread_pool.hpp"
+#include "query_streams.hpp"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
+
+namespace mmvk::bench {
+
+using DatabaseProvider = std::function<const Database*()>;
+
+namespace {
+
+// Clips of smooth random walks in the default schema (normalized units):
+// neighbouring frames are close, as in motion capture, so boxes over
+// consecutive frames mean something.
+Database synthetic_motion_database(std::uint32_t frames, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  DatabaseParts parts;
+  parts.schema = default_schema();
+  parts.fps = 30.0f;
+  const std::uint32_t dims = parts.schema.dims();
+  parts.normalization.assign(dims, DimNormalization{});
+  parts.frame_flags.assign(frames, 0);
+  parts.features.resize(std::size_t{frames} * dims);
+  constexpr std::uint32_t kClipFrames = 300;
+  std::vector<float> value(dims), velocity(dims);
+  for (std::uint32_t first = 0; first < frames; first += kClipFrames) {
+    Clip clip;
+    clip.name = "clip" + std::to_string(parts.clips.size());
+    clip.first_frame = first;
+    clip.frame_count = std::min(kClipFrames, frames - first);
+    for (std::uint32_t d = 0; d < dims; ++d) {
+      value[d] = normal(rng);
+      velocity[d] = 0.0f;
+    }
+    for (std::uint32_t f = first; f < first + clip.frame_count; ++f) {
+      for (std::uint32_t d = 0; d < dims; ++d) {
+        velocity[d] = 0.9f * velocity[d] + 0.05f * normal(rng);
+        value[d] = 0.98f * value[d] + velocity[d];
+        parts.features[std::size_t{f} * dims + d] = value[d];
+      }
+    }
+    parts.clips.push_back(clip);
+  }
+  return std::move(Database::create(std::move(parts)).value());
+}
+
+// FastBrute1 runs on a one-thread pool: its CPU time is the single-core
+// kernel throughput, which a loaded machine disturbs less than wall time.
+enum class Backend { Reference, FastBrute, FastPruned, FastBrute1 };
+
+const char* backend_name(Backend backend) {
+  switch (backend) {
+    case Backend::Reference: return "reference";
+    case Backend::FastBrute: return "fast-brute";
+    case Backend::FastPruned: return "fast-pruned";
+    case Backend::FastBrute1: return "fast-brute-1thread";
+  }
+  return "?";
+}
+
+struct Fixture {
+  const Database* db = nullptr;
+  ThreadPool pool;  // all cores
+  ThreadPool single{1};
+  std::map<Backend, std::unique_ptr<SearchBackend>> backends;
+};
+
+Fixture& fixture(const std::string& label, const DatabaseProvider& provider) {
+  static std::map<std::string, std::unique_ptr<Fixture>> fixtures;
+  std::unique_ptr<Fixture>& f = fixtures[label];
+  if (!f) {
+    f = std::make_unique<Fixture>();
+    f->db = provider();
+    if (f->db) {
+      f->backends[Backend::Reference] = std::make_unique<ReferenceSearch>(*f->db);
+      f->backends[Backend::FastBrute] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = false});
+      f->backends[Backend::FastPruned] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = true});
+      f->backends[Backend::FastBrute1] = std::make_unique<FastSearch>(*f->db, f->single, FastSearchOptions{.prune = false});
+    }
+  }
+  return *f;
+}
+
+void run(benchmark::State& state, const std::string& label, const DatabaseProvider& provider, QueryStream stream,
+         Backend which) {
+  Fixture& f = fixture(label, provider);
+  if (!f.db) {
+    state.SkipWithError("database unavailable (see stderr)");
+    return;
+  }
+  const std::size_t batch = static_cast<std::size_t>(state.range(0));
+  const std::vector<float> queries = make_queries(*f.db, stream, batch);
+  const QueryBatch query_batch{.features = queries, .params = {}, .size = batch};
+  SearchBackend& backend = *f.backends.at(which);
+  std::vector<Match> results(batch);
+  backend.reset_stats();
+  for (auto _ : state) {
+    if (Status status = backend.search(query_batch, 1, results); !status) {
+      state.SkipWithError(status.message().c_str());
+      return;
+    }
+    benchmark::DoNotOptimize(results.data());
+  }
+  const SearchStats stats = backend.stats();
+  state.counters["queries/s"] = benchmark::Counter(double(batch), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["rows_fraction"] = stats.rows_fraction(f.db->frame_count());
+  state.counters["row_dims/s"] =
+      benchmark::Counter(double(stats.rows_evaluated) * f.db->dims(), benchmark::Counter::kIsRate);
+  state.counters["frames"] = f.db->frame_count();
+  if (const auto* fast = dynamic_cast<const FastSearch*>(&backend)) state.SetLabel(std::string(fast->kernel_name()));
+}
+
+}  // namespace
+
+// Registers search/<label>/<stream>/<backend>/B:{1,64,1024}. The provider
+// is called once, on first use; nullptr marks the data as unavailable.
+void register_search_benchmarks(const std::string& label, DatabaseProvider provider, bool large) {
+  for (QueryStream stream : {QueryStream::Continue, QueryStream::Transition, QueryStream::Uniform}) {
+    for (Backend which : {Backend::Reference, Backend::FastBrute, Backend::FastPruned, Backend::FastBrute1}) {
+      const std::string name = "search/" + label + "/" + std::string(query_stream_name(stream)) + "/" + backend_name(which);
+      auto* b = benchmark::RegisterBenchmark(name.c_str(), run, label, provider, stream, which);
+      b->ArgName("B")->Arg(1)->Arg(64)->Arg(1024)->Unit(benchmark::kMicrosecond)->UseRealTime();
+      if (which == Backend::Reference && large) b->Iterations(1);
+    }
+  }
+}
+
+namespace {
+
+// The machine's single-thread FMA throughput (8-lane FMA, 10 independent
+// chains), for the fraction-of-peak figure: multiply by the core count.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target("avx2,fma"))) float fma_loop(std::int64_t iterations) {
+  __m256 acc[10];
+  for (int i = 0; i < 10; ++i) acc[i] = _mm256_set1_ps(float(i));
+  const __m256 a = _mm256_set1_ps(0.999f), b = _mm256_set1_ps(0.001f);
+  for (std::int64_t it = 0; it < iterations; ++it) {
+    for (int i = 0; i < 10; ++i) acc[i] = _mm256_fmadd_ps(acc[i], a, b);
+    // Keeps the compiler from collapsing the loop.
+    for (int i = 0; i < 10; ++i) asm volatile("" : "+x"(acc[i]));
+  }
+  __m256 sum = acc[0];
+  for (int i = 1; i < 10; ++i) sum = _mm256_add_ps(sum, acc[i]);
+  float lanes[8];
+  _mm256_storeu_ps(lanes, sum);
+  return lanes[0];
+}
+
+void fma_peak(benchmark::State& state) {
+  if (!__builtin_cpu_supports("fma") || !__builtin_cpu_supports("avx2")) {
+    state.SkipWithError("no AVX2 + FMA on this CPU");
+    return;
+  }
+  constexpr std::int64_t kIterations = 1 << 20;
+  for (auto _ : state) benchmark::DoNotOptimize(fma_loop(kIterations));
+  // 10 chains x 8 lanes x 2 flops per iteration.
+  state.counters["flops/s"] = benchmark::Counter(double(kIterations) * 160.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(fma_peak)->Name("machine/fma_peak_1thread")->UseRealTime();
+#endif
+
+const bool registered = [] {
+  register_search_benchmarks("synthetic22k", [] {
+    static const Database db = synthetic_motion_database(21791, 22);
+    return &db;
+  }, false);
+  register_search_benchmarks("synthetic417k", [] {
+    static const Database db = synthetic_motion_database(417000, 417);
+    return &db;
+  }, true);
+  return true;
+}();
+
+}  // namespace
+}  // namespace mmvk::bench

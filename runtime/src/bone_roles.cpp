@@ -79,6 +79,22 @@ int find_by_names(const Skeleton& skeleton, const RoleNames& role) {
       if (normalized[j] == candidate) return static_cast<int>(j);
     }
   }
+  // Then a namespaced or prefixed name ("mixamorig:LeftFoot", "Bip01 L
+  // Thigh" -> "bip01lthigh"): a unique joint whose name ends with a
+  // candidate of at least 5 characters.
+  for (const std::string_view candidate : role.names) {
+    if (candidate.size() < 5) continue;
+    int found = -1;
+    int matches = 0;
+    for (std::size_t j = 0; j < normalized.size(); ++j) {
+      const std::string& name = normalized[j];
+      if (name.size() > candidate.size() && name.compare(name.size() - candidate.size(), candidate.size(), candidate) == 0) {
+        found = static_cast<int>(j);
+        ++matches;
+      }
+    }
+    if (matches == 1) return found;
+  }
   return -1;
 }
 

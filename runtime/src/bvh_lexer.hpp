@@ -113,6 +113,7 @@ class BvhCursor {
   // number, returns -1 and sets `bad_token`.
   int read_number_line(float* out, int capacity, std::string_view* bad_token) {
     int count = 0;
+    const char* const end = text_.data() + text_.size();
     for (;;) {
       skip_blanks();
       if (pos_ >= text_.size()) return count;
@@ -120,13 +121,24 @@ class BvhCursor {
         consume_line_break();
         return count;
       }
-      const std::string_view token = read_token();
-      const std::optional<float> value = parse_float(token);
-      if (!value) {
-        *bad_token = token;
+      // Hot path: parse in place, then check that the number is the whole
+      // token. Only a leading digit, '.', '-' or '+' may start a number
+      // (from_chars would also take "inf" and "nan").
+      const char* first = text_.data() + pos_;
+      if (*first == '+' && first + 1 != end) ++first;
+      const char lead = *first == '-' && first + 1 != end ? first[1] : *first;
+      float value = 0.0f;
+      const char* stop = first;
+      if ((lead >= '0' && lead <= '9') || lead == '.') {
+        const auto result = std::from_chars(first, end, value, std::chars_format::general);
+        stop = result.ec == std::errc{} && std::isfinite(value) ? result.ptr : first;
+      }
+      if (stop == first || (stop != end && !is_space(*stop))) {
+        *bad_token = read_token();
         return -1;
       }
-      if (count < capacity) out[count] = *value;
+      pos_ = static_cast<std::size_t>(stop - text_.data());
+      if (count < capacity) out[count] = value;
       ++count;
     }
   }

@@ -184,14 +184,15 @@ class Parser {
     file_.joints.back().name = root_name->first;
     MMVK_TRY(expect_open_brace(root_name->second, "ROOT " + root_name->first));
 
-    // Open blocks: a joint index, or -1 - parent for an End Site of `parent`.
+    // Open blocks: a joint, or an End Site of that joint.
     struct Block {
       int joint;
       bool end_site;
       int open_line;
       bool has_offset;
+      bool keep_end_site;
     };
-    std::vector<Block> open{{0, false, line, false}};
+    std::vector<Block> open{{0, false, line, false, false}};
     while (!open.empty()) {
       Block& block = open.back();
       const std::string owner = block.end_site ? "End Site of " + describe(block.joint) : describe(block.joint);
@@ -203,7 +204,9 @@ class Parser {
       BvhJoint& joint = file_.joints[static_cast<std::size_t>(block.joint)];
       if (iequals(token, "OFFSET")) {
         if (block.has_offset) return fail(line, "second OFFSET in " + owner);
-        MMVK_TRY(read_offset(line, block.end_site ? joint.end_site_offset : joint.offset, owner));
+        glm::vec3 ignored{0.0f};
+        glm::vec3& target = !block.end_site ? joint.offset : block.keep_end_site ? joint.end_site_offset : ignored;
+        MMVK_TRY(read_offset(line, target, owner));
         block.has_offset = true;
       } else if (iequals(token, "CHANNELS")) {
         if (block.end_site) return fail(line, "an End Site has no CHANNELS (" + owner + ")");
@@ -219,7 +222,7 @@ class Parser {
         file_.joints.back().name = name->first;
         file_.joints.back().parent = parent;
         MMVK_TRY(expect_open_brace(name->second, "JOINT " + name->first));
-        open.push_back({static_cast<int>(file_.joints.size()) - 1, false, line, false});
+        open.push_back({static_cast<int>(file_.joints.size()) - 1, false, line, false, false});
       } else if (iequals(token, "End")) {
         if (block.end_site) return fail(line, "End Site inside an End Site (" + owner + ")");
         const std::string_view site = cursor_.next_token_on_line();
@@ -229,10 +232,12 @@ class Parser {
         } else if (!iequals(site, "Site")) {
           return fail(line, "expected 'End Site', got 'End " + std::string(site.substr(0, 40)) + "'");
         }
-        if (joint.has_end_site) return fail(line, "second End Site in " + owner);
+        // A second End Site (some exporters write one per tip) is parsed and
+        // checked but not kept: BvhJoint holds one.
+        const bool keep = !joint.has_end_site;
         joint.has_end_site = true;
         MMVK_TRY(expect_open_brace(brace, "End Site of " + describe(block.joint)));
-        open.push_back({block.joint, true, line, false});
+        open.push_back({block.joint, true, line, false, keep});
       } else if (token == "}") {
         if (!block.has_offset) {
           return fail(line, owner + " (opened at line " + std::to_string(block.open_line) + ") has no OFFSET");

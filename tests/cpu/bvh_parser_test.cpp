@@ -159,6 +159,14 @@ TEST(BvhParser, AcceptsBracesOnTheNameLineAndNamesWithSpaces) {
   EXPECT_TRUE(file->joints[1].has_end_site);
 }
 
+TEST(BvhParser, KeepsTheFirstOfSeveralEndSites) {
+  const std::string text = replace_all(kValid, "      OFFSET 0 -10 0\n    }\n",
+                                       "      OFFSET 0 -10 0\n    }\n    End Site\n    {\n      OFFSET 5 5 5\n    }\n");
+  const auto file = parse_bvh(text, "t.bvh");
+  ASSERT_TRUE(file.ok()) << file.message();
+  EXPECT_EQ(file->joints[1].end_site_offset, glm::vec3(0.0f, -10.0f, 0.0f));
+}
+
 TEST(BvhParser, LenientFrameCountTakesTheLinesRead) {
   const std::string text = replace_all(kValid, "Frames: 2", "Frames: 1");
   EXPECT_FALSE(parse_bvh(text, "t.bvh").ok());

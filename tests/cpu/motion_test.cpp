@@ -376,6 +376,10 @@ TEST(BoneRoles, KnowEachSourceConvention) {
       {{"hip", "rButtock", "rThigh", "rShin", "rFoot"}, "@right_lower_leg", "rShin"},
       {{"hip", "rButtock", "rThigh", "rShin", "rFoot"}, "@right_upper_leg", "rThigh"},
       {{"joint_Root", "Hips", "UpperLeg_R", "LowerLeg_R", "Foot_R", "Toes_R"}, "@right_toe", "Toes_R"},
+      // Namespaced and prefixed exports.
+      {{"mixamorig:Hips", "mixamorig:LeftUpLeg", "mixamorig:LeftLeg", "mixamorig:LeftFoot"}, "@left_foot",
+       "mixamorig:LeftFoot"},
+      {{"Bip01 Pelvis", "Bip01 L Thigh", "Bip01 L Calf", "Bip01 L Foot"}, "@left_upper_leg", "Bip01 L Thigh"},
   };
   for (const Case& c : cases) {
     Skeleton skeleton = skeleton_named(c.names);

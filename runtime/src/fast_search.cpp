@@ -46,7 +46,7 @@ FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOpt
     : database_(&database),
       pool_(&pool),
       options_(options),
-      layout_(Layout::build(database)),
+      layout_(Layout::build(database, options.baseline_kernels)),
       workspace_(std::make_unique<Workspace>()),
       thread_rows_(pool.thread_count(), 0) {
   workspace_->threads.resize(pool.thread_count());

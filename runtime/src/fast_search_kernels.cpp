@@ -173,11 +173,14 @@ MMVK_DEFINE_KERNELS(avx512, V16)
 
 }  // namespace
 
-Kernels select_kernels() {
+Kernels select_kernels(bool baseline) {
 #if defined(MMVK_HAS_X86_KERNELS)
+  if (baseline) return {evaluate_tiles_generic, box_bounds_generic, "generic"};
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx512f")) return {evaluate_tiles_avx512, box_bounds_avx512, "avx512f"};
   if (__builtin_cpu_supports("avx2")) return {evaluate_tiles_avx2, box_bounds_avx2, "avx2"};
+#else
+  (void)baseline;
 #endif
   return {evaluate_tiles_generic, box_bounds_generic, "generic"};
 }

@@ -62,7 +62,7 @@ struct Kernels {
   const char* name;  // "avx512f", "avx2" or "generic"
 };
 
-// The widest kernels this CPU runs.
-Kernels select_kernels();
+// The widest kernels this CPU runs, or the baseline ones.
+Kernels select_kernels(bool baseline);
 
 }  // namespace mmvk::detail

@@ -70,7 +70,7 @@ struct FastSearch::Layout {
   // Group boxes, packed by 16 groups: [group_packs][dims][16], [group_packs][16].
   detail::AlignedFloats group_lo, group_hi, group_min_multiplier, group_min_bias;
 
-  static std::unique_ptr<Layout> build(const Database& database);
+  static std::unique_ptr<Layout> build(const Database& database, bool baseline_kernels);
 
   detail::TileArrays tile_arrays() const {
     return {features.data(), multiplier.data(), bias.data(), lane_valid.data(), channel_end.data(),

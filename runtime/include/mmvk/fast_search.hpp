@@ -36,6 +36,9 @@ struct FastSearchOptions {
   // a thread walks one block before the next, so the block stays in L2.
   // Rounded up to whole groups.
   std::uint32_t rows_per_block = 2048;
+  // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
+  // AVX-512F; tests use it to check every kernel against the reference.
+  bool baseline_kernels = false;
 };
 
 class FastSearch final : public SearchBackend {

@@ -79,16 +79,30 @@ void forward_kinematics(const Motion& motion, std::uint32_t frame, std::span<glm
 void forward_kinematics_clip(const Motion& motion, std::span<glm::vec3> global_positions,
                              std::span<glm::quat> global_rotations);
 
-// Resamples to `fps` (> 0): positions are interpolated linearly and rotations
-// with slerp; the clip's duration is kept.
+// Resamples to `fps` (> 0, any rate): positions are interpolated linearly and
+// rotations with slerp (shorter arc); the clip's duration is kept. A clip of
+// n frames (duration (n - 1) / motion.fps) becomes round(duration * fps) + 1
+// frames; output frame k samples source time k / fps, clamped to the last
+// frame. Output frames that fall on source frames copy them exactly. 0 and 1
+// frame clips stay 0 and 1 frames.
 Result<Motion> resample(const Motion& motion, float fps);
 
-// Swaps left and right: joints are paired by name (_L/_R, Left/Right, l/r
-// prefixes) and the motion is reflected across the YZ plane (x -> -x).
-// mirror(mirror(m)) == m.
+// Swaps left and right and reflects across the world YZ plane (x -> -x): in
+// the result, joint j's model-space position is its partner's original one
+// with x negated (exactly so for symmetric skeletons). Joints are paired by
+// mirror_pairs(); the skeleton (names, parents, rest offsets) is unchanged.
+// Skeletons whose local frames are not world aligned (Bandai) are handled by
+// a per-joint local reflection chosen from the rest offsets (see mirror.cpp).
+// mirror(mirror(m)) == m bit for bit. Errors: partners whose parents are not
+// partners, inconsistent sizes.
 Result<Motion> mirror(const Motion& motion);
 
-// Index of each joint's mirror partner (itself when it has none).
+// Index of each joint's mirror partner (itself when it has none). Names are
+// paired when swapping a side marker gives another joint's name: "Left" <->
+// "Right" (any case, anywhere: LeftUpLeg, leftEye, mixamorig:LeftFoot), a
+// suffix "_L"/".L"/"-L"/" L" (Foot_L), an infix " L "/"_L_" (Bip01 L Thigh),
+// or a leading L/l/R/r (LHipJoint, lThigh, lCollar, lfemur; "lowerback" stays
+// unpaired as no "rowerback" exists). Only mutual pairs are kept.
 std::vector<int> mirror_pairs(const Skeleton& skeleton);
 
 }  // namespace mmvk

@@ -14,6 +14,14 @@ Result<CharacterRoot> compute_character_root(const Motion& motion, const Charact
     return make_error("character root: facing_smoothing_seconds must be >= 0, got " +
                       std::to_string(options.facing_smoothing_seconds));
   }
+  const std::size_t expected = motion.frame_count * motion.joint_count();
+  if (motion.local_positions.size() != expected || motion.local_rotations.size() != expected ||
+      motion.skeleton.parents.size() != motion.joint_count()) {
+    return make_error("character root: the motion's transforms are not sized frame_count x joints");
+  }
+  if (!(motion.fps > 0.0f) || !std::isfinite(motion.fps)) {
+    return make_error("character root: the motion's fps must be positive, got " + std::to_string(motion.fps));
+  }
   const Result<int> source = find_bone(motion.skeleton, options.source_bone);
   if (!source) return make_error("character root: source bone: " + source.message());
   const Result<int> left = find_bone(motion.skeleton, "@left_upper_leg");

@@ -230,7 +230,7 @@ class Parser {
         if (iequals(site, "Site{")) {
           brace = true;
         } else if (!iequals(site, "Site")) {
-          return fail(line, "expected 'End Site', got 'End " + std::string(site.substr(0, 40)) + "'");
+          return fail(line, "expected 'End Site', got 'End' followed by " + (site.empty() ? "nothing" : quote(site)));
         }
         // A second End Site (some exporters write one per tip) is parsed and
         // checked but not kept: BvhJoint holds one.

@@ -210,6 +210,9 @@ struct Expected {
 const std::map<std::string, Expected>& corpus_expectations() {
   static const std::map<std::string, Expected> kExpected{
       {"bad_channel_count.bvh", {9, "CHANNELS count must be an integer from 0 to 6"}},
+      {"bad_end_site.bvh", {10, "expected 'End Site', got 'End' followed by 'Sight'"}},
+      {"joint_without_name.bvh", {6, "JOINT without a name"}},
+      {"unexpected_keyword.bvh", {9, "unexpected 'ROTATION' in JOINT Leg"}},
       {"binary_garbage.bvh", {1, "expected HIERARCHY"}},
       {"blank_only.bvh", {4, "file is empty"}},
       {"channel_count_mismatch.bvh", {9, "CHANNELS declares 3 channels but lists 2"}},

@@ -246,5 +246,25 @@ TEST(DatabaseFromMotions, FlagsTagsMirrorsAndNormalization) {
   EXPECT_NE(mixed.message().find("b.bvh"), std::string::npos) << mixed.message();
 }
 
+TEST(DatabaseFromMotions, AtMost64Tags) {
+  std::vector<MotionClip> clips(2);
+  for (MotionClip& clip : clips) {
+    clip.motion = walker(40, 1.0f + float(&clip - clips.data()), 0.0f, 0.5f, 0.3f);
+    clip.meta.file = "c.bvh";
+    clip.meta.name = "c";
+  }
+  for (int t = 0; t < 40; ++t) clips[0].meta.tags.push_back("t" + std::to_string(t));
+  for (int t = 30; t < 64; ++t) clips[1].meta.tags.push_back("t" + std::to_string(t));
+  Result<Database> full = build_database_from_motions(clips, {});
+  ASSERT_TRUE(full.ok()) << full.message();
+  EXPECT_EQ(full->tag_names().size(), 64u);
+  EXPECT_EQ(full->clips()[1].tags, ~TagMask{0} << 30);
+  clips[1].meta.tags.push_back("one_too_many");
+  Result<Database> over = build_database_from_motions(clips, {});
+  ASSERT_FALSE(over.ok());
+  EXPECT_NE(over.message().find("more than 64 distinct tags"), std::string::npos) << over.message();
+  EXPECT_NE(over.message().find("one_too_many"), std::string::npos) << over.message();
+}
+
 }  // namespace
 }  // namespace mmvk

@@ -1,13 +1,297 @@
-// Placeholder until the command is implemented; replaced by its owner.
+// mmvk query: batched search from a file of query vectors, one result line
+// per query, so anyone can check the engine against their own brute force.
+#include <bit>
+#include <chrono>
 #include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
 
+#include "../../runtime/src/file_io.hpp"
+#include "cli_args.hpp"
 #include "commands.hpp"
+#include "mmvk/cluster_search.hpp"
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/database_io.hpp"
+#include "mmvk/explain.hpp"
+#include "mmvk/fast_search.hpp"
+#include "mmvk/query_builder.hpp"
+#include "mmvk/reference_search.hpp"
+#include "mmvk/thread_pool.hpp"
 
 namespace mmvk::cli {
 
-int run_query(Args) {
-  std::fputs("mmvk query: not implemented yet\n", stderr);
-  return 1;
+namespace {
+
+constexpr const char* kQueryUsage =
+    "usage: mmvk query db.mmdb --queries q.f32 [--normalized] [--backend NAME] [--k K]\n"
+    "                  [--threads N] [--out results.tsv] [query options]\n"
+    "                  [--explain [--frames F,F,...]]\n"
+    "\n"
+    "Reads B queries as raw little-endian float32 [B x dims] (dims and their order\n"
+    "as in `mmvk export`'s sidecar). Values are raw features, normalized here with\n"
+    "the database's offsets and scales, or already normalized with --normalized.\n"
+    "(--features is a synonym of --queries.)\n"
+    "\n"
+    "backends: reference (the CPU oracle), fast (exact, box-pruned, default),\n"
+    "  fast-brute (exact brute force), clusters (exact, k-means cluster-pruned),\n"
+    "  nprobe (approximate: --nprobe N nearest clusters, default 4), vulkan.\n"
+    "  clusters/nprobe load --clusters table.mmkc when given, else train the\n"
+    "  tables with the default k-means parameters.\n"
+    "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores.\n"
+    "\n"
+    "query options (applied to every query):\n"
+    "  --continuing F, --continuing-bias X, --exclusion-window N,\n"
+    "  --require TAG,TAG  --exclude TAG,TAG  --weights CHANNEL=W,CHANNEL=W\n"
+    "\n"
+    "Output (--out, default stdout), tab-separated, '#' lines are comments:\n"
+    "  <query index>\\t<frame>:<cost>\\t<frame>:<cost> ...   best first, k entries;\n"
+    "  'none' where fewer than k frames are candidates. Costs are printed with\n"
+    "  %.9g, which round-trips float32 exactly.\n"
+    "--explain prints the first query's explanation to stderr: the winner's and\n"
+    "the --frames' per-channel costs, and why frames are not candidates.\n";
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+std::optional<std::uint64_t> parse_unsigned(std::string_view option, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const unsigned long long value = std::stoull(text, &used);
+    if (used == text.size() && text.find('-') == std::string::npos) return value;
+  } catch (...) {
+  }
+  std::fprintf(stderr, "mmvk query: %.*s expects a non-negative integer, got '%s'\n", int(option.size()),
+               option.data(), text.c_str());
+  return std::nullopt;
+}
+
+std::optional<float> parse_float(std::string_view option, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const float value = std::stof(text, &used);
+    if (used == text.size()) return value;
+  } catch (...) {
+  }
+  std::fprintf(stderr, "mmvk query: %.*s expects a number, got '%s'\n", int(option.size()), option.data(),
+               text.c_str());
+  return std::nullopt;
+}
+
+Result<std::vector<float>> read_queries(const std::string& path, std::uint32_t dims) {
+  Result<std::string> bytes = detail::read_file(path);
+  if (!bytes) return bytes.status();
+  const std::size_t row_bytes = std::size_t{dims} * 4;
+  if (bytes->empty() || bytes->size() % row_bytes != 0) {
+    return make_error(path + ": " + std::to_string(bytes->size()) + " bytes is not a whole number of queries of " +
+                      std::to_string(dims) + " float32 dims (" + std::to_string(row_bytes) + " bytes each)");
+  }
+  std::vector<float> values(bytes->size() / 4);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint32_t bits = 0;
+    for (int b = 0; b < 4; ++b) bits |= std::uint32_t(static_cast<unsigned char>((*bytes)[4 * i + b])) << (8 * b);
+    values[i] = std::bit_cast<float>(bits);
+  }
+  return values;
+}
+
+struct BackendHolder {
+  ThreadPool pool;
+  ClusterTable table;
+  std::unique_ptr<SearchBackend> backend;
+  explicit BackendHolder(unsigned threads) : pool(threads) {}
+};
+
+Status make_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args) {
+  if (name == "reference") {
+    holder.backend = std::make_unique<ReferenceSearch>(db);
+  } else if (name == "fast" || name == "fast-brute") {
+    holder.backend = std::make_unique<FastSearch>(db, holder.pool, FastSearchOptions{.prune = name == "fast"});
+  } else if (name == "clusters" || name == "nprobe") {
+    if (const auto path = args.value("--clusters")) {
+      Result<ClusterTable> table = load_cluster_table(*path);
+      if (!table) return table.status();
+      holder.table = std::move(table.value());
+    } else {
+      std::fputs("mmvk query: training k-means cluster tables (default parameters; pass --clusters to reuse)\n",
+                 stderr);
+      Result<ClusterTable> table = train_cluster_table(db, KMeansParams{});
+      if (!table) return table.status();
+      holder.table = std::move(table.value());
+    }
+    ClusterSearchOptions options;
+    if (name == "nprobe") {
+      options.nprobe = 4;
+      if (const auto text = args.value("--nprobe")) {
+        const auto nprobe = parse_unsigned("--nprobe", *text);
+        if (!nprobe || *nprobe == 0) return make_error("--nprobe must be a positive integer");
+        options.nprobe = static_cast<std::uint32_t>(*nprobe);
+      }
+    }
+    Result<std::unique_ptr<ClusterSearch>> made = ClusterSearch::create(db, holder.table, holder.pool, options);
+    if (!made) return made.status();
+    holder.backend = std::move(made.value());
+  } else if (name == "vulkan") {
+    return make_error("backend 'vulkan' is not available in this build of mmvk query yet");
+  } else {
+    return make_error("unknown backend '" + name + "' (reference, fast, fast-brute, clusters, nprobe, vulkan)");
+  }
+  return {};
+}
+
+Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
+  QueryParams params;
+  if (const auto text = args.value("--continuing")) {
+    const auto frame = parse_unsigned("--continuing", *text);
+    if (!frame) return make_error("bad --continuing");
+    params.continuing_frame = static_cast<std::uint32_t>(*frame);
+  }
+  if (const auto text = args.value("--continuing-bias")) {
+    const auto bias = parse_float("--continuing-bias", *text);
+    if (!bias) return make_error("bad --continuing-bias");
+    params.continuing_bias = *bias;
+  }
+  if (const auto text = args.value("--exclusion-window")) {
+    const auto window = parse_unsigned("--exclusion-window", *text);
+    if (!window) return make_error("bad --exclusion-window");
+    params.exclusion_window = static_cast<std::uint32_t>(*window);
+  }
+  for (const auto& [option, mask] : {std::pair{"--require", &params.require_all}, std::pair{"--exclude", &params.exclude_any}}) {
+    if (const auto text = args.value(option)) {
+      Result<TagMask> tags = db.tag_mask(split_list(*text));
+      if (!tags) return make_error(std::string(option) + ": " + tags.message());
+      *mask = *tags;
+    }
+  }
+  if (const auto text = args.value("--weights")) {
+    for (const std::string& item : split_list(*text)) {
+      const std::size_t equals = item.find('=');
+      if (equals == std::string::npos) return make_error("--weights: expected CHANNEL=WEIGHT, got '" + item + "'");
+      const auto weight = parse_float("--weights", item.substr(equals + 1));
+      if (!weight) return make_error("bad --weights");
+      MMVK_TRY(set_channel_weight(db.schema(), params, item.substr(0, equals), *weight));
+    }
+  }
+  return params;
+}
+
+std::string format_results(std::span<const Match> results, std::size_t count, std::uint32_t k) {
+  std::string text;
+  char cell[64];
+  for (std::size_t q = 0; q < count; ++q) {
+    text += std::to_string(q);
+    for (std::uint32_t r = 0; r < k; ++r) {
+      const Match& m = results[q * k + r];
+      if (m.frame == kNoFrame) {
+        text += "\tnone";
+      } else {
+        std::snprintf(cell, sizeof(cell), "\t%u:%.9g", m.frame, double(m.cost));
+        text += cell;
+      }
+    }
+    text += '\n';
+  }
+  return text;
+}
+
+}  // namespace
+
+int run_query(Args args) {
+  const auto parsed = parse_args("query", args,
+                                 {"--queries", "--features", "--backend", "--k", "--threads", "--out", "--frames",
+                                  "--frame", "--clusters", "--nprobe", "--continuing", "--continuing-bias",
+                                  "--exclusion-window", "--require", "--exclude", "--weights"},
+                                 {"--normalized", "--explain", "--help", "-h"});
+  if (!parsed) return 2;
+  if (parsed->has("--help") || parsed->has("-h")) {
+    std::fputs(kQueryUsage, stdout);
+    return 0;
+  }
+  const auto queries_path = parsed->value("--queries") ? parsed->value("--queries") : parsed->value("--features");
+  if (parsed->positional.size() != 1 || !queries_path) {
+    std::fputs(kQueryUsage, stderr);
+    return 2;
+  }
+  auto fail = [](const std::string& message) {
+    std::fprintf(stderr, "mmvk query: %s\n", message.c_str());
+    return 1;
+  };
+  std::uint64_t k = 1;
+  if (const auto text = parsed->value("--k")) {
+    const auto value = parse_unsigned("--k", *text);
+    if (!value) return 2;
+    k = *value;
+  }
+  if (k < 1 || k > kMaxK) return fail("--k " + std::to_string(k) + " is out of range [1, " + std::to_string(kMaxK) + "]");
+  std::uint64_t threads = 0;
+  if (const auto text = parsed->value("--threads")) {
+    const auto value = parse_unsigned("--threads", *text);
+    if (!value) return 2;
+    threads = *value;
+  }
+  Result<Database> db = load_database(parsed->positional[0]);
+  if (!db) return fail(db.message());
+  Result<std::vector<float>> features = read_queries(*queries_path, db->dims());
+  if (!features) return fail(features.message());
+  const std::size_t count = features->size() / db->dims();
+  if (!parsed->has("--normalized")) {
+    std::vector<float> raw = *features;
+    for (std::size_t q = 0; q < count; ++q) {
+      db->normalize(std::span<const float>(raw).subspan(q * db->dims(), db->dims()),
+                    std::span<float>(*features).subspan(q * db->dims(), db->dims()));
+    }
+  }
+  Result<QueryParams> params = query_params(*db, *parsed);
+  if (!params) return fail(params.message());
+  const std::vector<QueryParams> all_params(count, *params);
+
+  BackendHolder holder(static_cast<unsigned>(threads));
+  const std::string backend_name = parsed->value("--backend").value_or("fast");
+  if (Status made = make_backend(holder, *db, backend_name, *parsed); !made) return fail(made.message());
+  std::vector<Match> results(count * k);
+  const auto start = std::chrono::steady_clock::now();
+  const Status searched =
+      holder.backend->search(QueryBatch{*features, all_params, count}, static_cast<std::uint32_t>(k), results);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!searched) return fail(searched.message());
+  std::fprintf(stderr, "mmvk query: %zu queries, backend %s, %.3f ms (%.0f queries/s), %.2f%% of rows evaluated\n",
+               count, std::string(holder.backend->name()).c_str(), seconds * 1e3, double(count) / seconds,
+               100.0 * holder.backend->stats().rows_fraction(db->frame_count()));
+
+  std::string text = "# mmvk query: " + parsed->positional[0] + ", backend " + std::string(holder.backend->name()) +
+                     ", k " + std::to_string(k) + ", " + std::to_string(count) + " queries\n" +
+                     "# query\tframe:cost ... (best first; none = no further candidate)\n";
+  text += format_results(results, count, static_cast<std::uint32_t>(k));
+  if (const auto out = parsed->value("--out")) {
+    if (Status written = detail::write_file_atomically(*out, text); !written) return fail(written.message());
+  } else {
+    std::fputs(text.c_str(), stdout);
+  }
+
+  if (parsed->has("--explain")) {
+    std::vector<std::uint32_t> frames;
+    const auto list = parsed->value("--frames") ? parsed->value("--frames") : parsed->value("--frame");
+    if (list) {
+      for (const std::string& item : split_list(*list)) {
+        const auto frame = parse_unsigned("--frames", item);
+        if (!frame) return 2;
+        frames.push_back(static_cast<std::uint32_t>(*frame));
+      }
+    }
+    Result<Explanation> explanation = explain_query(*db, std::span<const float>(*features).first(db->dims()),
+                                                    all_params[0], frames, static_cast<std::uint32_t>(k));
+    if (!explanation) return fail(explanation.message());
+    std::fputs(("explain, query 0:\n" + format_explanation(*db, *explanation)).c_str(), stderr);
+  }
+  return 0;
 }
 
 }  // namespace mmvk::cli

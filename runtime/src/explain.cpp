@@ -120,7 +120,7 @@ std::string format_explanation(const Database& db, const Explanation& e) {
   for (std::size_t i = 0; i < e.frames.size(); ++i) {
     const FrameExplanation& f = e.frames[i];
     const bool winner = i == 0 && !e.results.empty() && e.results[0].frame == f.frame;
-    append("%s frame %u (clip %u '%s', frame %u): %s\n", winner ? "winner" : "frame", f.frame, f.clip,
+    append("%s %u (clip %u '%s', frame %u): %s\n", winner ? "winner frame" : "frame", f.frame, f.clip,
            db.clips()[f.clip].name.c_str(), f.frame_in_clip, std::string(exclusion_name(f.exclusion)).c_str());
     for (const ChannelCost& c : f.channels) {
       append("  %-28s weight %-9.6g sum %-13.9g weighted %.9g\n", c.name.c_str(), double(c.weight), double(c.sum),

@@ -1,0 +1,116 @@
+// The Vulkan context: instance, physical device, logical device and one
+// compute queue. Either mmvk creates them (Context::create) or it adopts the
+// embedding application's own (Context::adopt), e.g. a crowd simulation
+// that already renders with Vulkan; adopted handles are used, never
+// destroyed. No global state: every VulkanSearch takes a Context&.
+//
+// Not thread-safe: use a Context (and the searches on it) from one thread at
+// a time. With an adopted queue, the application must not use that queue
+// concurrently with mmvk's submit calls (Vulkan's external sync rule).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "mmvk/status.hpp"
+
+namespace mmvk::vulkan {
+
+struct ContextOptions {
+  // Index into vkEnumeratePhysicalDevices; nullopt picks the best device:
+  // discrete GPU, then integrated, then virtual, then CPU (lavapipe).
+  std::optional<std::uint32_t> device_index;
+  // Enables VK_LAYER_KHRONOS_validation (with synchronization validation)
+  // and a debug messenger that collects every warning and error.
+  bool validation = false;
+  std::string application_name = "mmvk";
+};
+
+// The application's handles, for Context::adopt. The device must support
+// Vulkan 1.2 and `queue` must come from `queue_family`, which must support
+// compute. mmvk enables no device feature or extension of its own.
+struct AdoptedDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  std::uint32_t queue_family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+};
+
+// One line per physical device, for tools and error messages.
+struct DeviceInfo {
+  std::string name;
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  std::uint32_t api_version = 0;
+};
+
+class Context {
+ public:
+  // Errors (never exits): no Vulkan driver or device, the requested index
+  // out of range, no compute queue, validation requested but not installed.
+  static Result<std::unique_ptr<Context>> create(const ContextOptions& options = {});
+  static Result<std::unique_ptr<Context>> adopt(const AdoptedDevice& handles);
+
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physical_device() const { return physical_device_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  std::uint32_t queue_family() const { return queue_family_; }
+  bool owns_device() const { return owns_device_; }
+
+  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
+  std::uint32_t subgroup_size() const { return subgroup_size_; }
+  // Valid bits of the queue's timestamps; 0 = no timestamp support.
+  std::uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
+  std::string device_name() const { return properties_.deviceName; }
+  // VkPhysicalDeviceMaintenance3Properties::maxMemoryAllocationSize.
+  VkDeviceSize max_memory_allocation_size() const { return max_allocation_size_; }
+
+  // Validation messages (warnings and errors) collected so far; empty when
+  // validation is off. Tests assert it stays empty.
+  std::vector<std::string> validation_messages() const;
+  std::size_t validation_message_count() const;
+
+  // The physical devices the loader reports (creates a throwaway instance).
+  static Result<std::vector<DeviceInfo>> enumerate_devices();
+
+  // For the debug messenger callback only.
+  void record_validation_message(std::string message);
+
+ private:
+  Context() = default;
+  Status init_device_info();
+
+  // Declaration order = reverse destruction order; the destructor destroys
+  // only what this Context created (owns_*).
+  bool owns_instance_ = false;
+  bool owns_device_ = false;
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  std::uint32_t queue_family_ = 0;
+
+  VkPhysicalDeviceProperties properties_{};
+  VkPhysicalDeviceMemoryProperties memory_properties_{};
+  std::uint32_t subgroup_size_ = 1;
+  std::uint32_t timestamp_valid_bits_ = 0;
+  VkDeviceSize max_allocation_size_ = 0;
+
+  mutable std::mutex messages_mutex_;
+  std::vector<std::string> messages_;
+};
+
+}  // namespace mmvk::vulkan

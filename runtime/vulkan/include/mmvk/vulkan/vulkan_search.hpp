@@ -1,0 +1,112 @@
+// VulkanSearch: the SearchBackend whose costs are evaluated and reduced to
+// the best k frames per query in Vulkan compute shaders, bit-identical to
+// ReferenceSearch (same frames, same cost bits; see docs/search.md and
+// mmvk/search.hpp for the semantics).
+//
+// Created once per (Context, Database): the feature matrix and per-frame
+// metadata are uploaded into device-local buffers, and every per-search
+// resource (mapped query/parameter/result buffers for `max_batch` queries,
+// scratch, command buffers, descriptor sets, timestamp queries) is created
+// up front, so submit() allocates nothing.
+//
+// Asynchronous use (a crowd simulation overlapping the search with its own
+// work): submit() returns a Ticket at once; poll() says whether it is done;
+// wait() blocks and copies the matches out. `slots` submissions can be in
+// flight at a time. search() is submit() + wait().
+//
+// Not thread-safe; the Context and the Database must outlive the search.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/database.hpp"
+#include "mmvk/search.hpp"
+#include "mmvk/status.hpp"
+#include "mmvk/vulkan/context.hpp"
+
+namespace mmvk::vulkan {
+
+enum class SearchMode {
+  BruteForce,     // every row, exact
+  ClustersExact,  // cluster-pruned, exact (needs a ClusterTable; not implemented yet)
+  NProbe,         // the nprobe nearest clusters, approximate (not implemented yet)
+};
+
+struct VulkanSearchOptions {
+  std::uint32_t max_batch = 1024;  // queries per submit, >= 1
+  std::uint32_t max_k = kMaxK;     // largest k a submit may ask for, in [1, kMaxK]
+  std::uint32_t slots = 2;         // submissions in flight at a time, >= 1
+  SearchMode mode = SearchMode::BruteForce;
+  std::uint32_t nprobe = 8;        // NProbe: clusters visited per query
+  // Rows each scan invocation covers; 0 picks one from the frame count.
+  // At most 32768, as llvmpipe stops loops at 65,535 iterations.
+  std::uint32_t rows_per_invocation = 0;
+  // Largest query tile held in registers (1, 4 or 16; 16 only for k = 1).
+  // Bigger tiles are faster on large batches and slower to compile
+  // (lavapipe compiles the 16-query kernel for seconds at the first use).
+  std::uint32_t max_tile = 16;
+  // Per-slot scratch budget for the per-block best pairs, bytes; batches
+  // whose scratch would not fit are processed in chunks inside one submit.
+  std::uint64_t scratch_bytes = std::uint64_t{32} << 20;
+  // Runs every kernel variant once at creation: drivers such as lavapipe
+  // compile at the first dispatch, which would otherwise land in a search.
+  bool warm_up = true;
+};
+
+// A submitted batch; valid until wait() consumed it.
+struct Ticket {
+  std::uint32_t slot = 0;
+  std::uint64_t serial = 0;
+};
+
+class VulkanSearch final : public SearchBackend {
+ public:
+  // Errors: database too large for the device (texel buffer elements,
+  // allocation size), dims over 128, options out of range, a cluster table
+  // from another database, out of device memory, missing format support.
+  static Result<std::unique_ptr<VulkanSearch>> create(Context& context, const Database& database,
+                                                      const VulkanSearchOptions& options = {},
+                                                      const ClusterTable* clusters = nullptr);
+  ~VulkanSearch() override;
+  VulkanSearch(const VulkanSearch&) = delete;
+  VulkanSearch& operator=(const VulkanSearch&) = delete;
+
+  std::string_view name() const override;
+  const Database& database() const override;
+  // Blocking: submit() + wait().
+  Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
+  SearchStats stats() const override;
+  void reset_stats() override;
+
+  // Validates the batch (validate_search, batch <= max_batch, k <= max_k),
+  // copies it into a free slot's mapped buffers and submits the kernels.
+  // Error when every slot is in flight: wait() for one first.
+  Result<Ticket> submit(const QueryBatch& batch, std::uint32_t k);
+  // True once the ticket's results are ready (wait() then returns at once).
+  Result<bool> poll(const Ticket& ticket) const;
+  // Blocks until the ticket is done and writes its B*k matches to `out`
+  // (layout as SearchBackend::search). Consumes the ticket.
+  Status wait(const Ticket& ticket, std::span<Match> out);
+
+  // GPU time of the last waited-for submit from timestamp queries, seconds;
+  // nullopt when the queue has no timestamps.
+  std::optional<double> last_kernel_seconds() const;
+
+  const VulkanSearchOptions& options() const;
+  std::uint32_t rows_per_invocation() const;
+  std::uint32_t workgroup_size() const;
+
+  struct Impl;
+
+ private:
+  explicit VulkanSearch(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mmvk::vulkan

@@ -1,0 +1,295 @@
+#include "mmvk/vulkan/context.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include "check.hpp"
+
+namespace mmvk::vulkan {
+
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                              VkDebugUtilsMessageTypeFlagsEXT /*types*/,
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  // Only warnings and errors count; the loader also reports info lines.
+  if ((severity & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)) != 0) {
+    static_cast<Context*>(user)->record_validation_message(data != nullptr && data->pMessage != nullptr ? data->pMessage
+                                                                                                         : "(no message)");
+  }
+  return VK_FALSE;
+}
+
+VkDebugUtilsMessengerCreateInfoEXT messenger_info(Context* context) {
+  VkDebugUtilsMessengerCreateInfoEXT info{};
+  info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  info.pfnUserCallback = debug_callback;
+  info.pUserData = context;
+  return info;
+}
+
+bool layer_available(const char* name) {
+  std::uint32_t count = 0;
+  if (vkEnumerateInstanceLayerProperties(&count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkLayerProperties> layers(count);
+  if (vkEnumerateInstanceLayerProperties(&count, layers.data()) != VK_SUCCESS) return false;
+  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+int type_rank(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+    default: return 4;
+  }
+}
+
+// A queue family with compute, preferring one with timestamps.
+std::optional<std::uint32_t> find_compute_family(VkPhysicalDevice device) {
+  std::uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
+  std::optional<std::uint32_t> found;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0 || families[i].queueCount == 0) continue;
+    if (!found || (families[*found].timestampValidBits == 0 && families[i].timestampValidBits != 0)) found = i;
+  }
+  return found;
+}
+
+std::string version_string(std::uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+Result<std::vector<VkPhysicalDevice>> physical_devices(VkInstance instance) {
+  std::uint32_t count = 0;
+  MMVK_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+  std::vector<VkPhysicalDevice> devices(count);
+  MMVK_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+  devices.resize(count);
+  return devices;
+}
+
+Result<VkInstance> create_instance(const ContextOptions& options, Context* context) {
+  VkApplicationInfo app{};
+  app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+  app.pApplicationName = options.application_name.c_str();
+  app.pEngineName = "mmvk";
+  app.apiVersion = VK_API_VERSION_1_2;
+
+  std::vector<const char*> layers;
+  std::vector<const char*> extensions;
+  const std::array<VkValidationFeatureEnableEXT, 1> enabled_features = {
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT validation_features{};
+  VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(context);
+  VkInstanceCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+  info.pApplicationInfo = &app;
+  if (options.validation) {
+    if (!layer_available(kValidationLayer)) {
+      return make_error(std::string("Vulkan context: validation requested but ") + kValidationLayer +
+                        " is not installed (Debian: vulkan-validationlayers)");
+    }
+    layers.push_back(kValidationLayer);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+    validation_features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+    validation_features.enabledValidationFeatureCount = static_cast<std::uint32_t>(enabled_features.size());
+    validation_features.pEnabledValidationFeatures = enabled_features.data();
+    // Chained so messages from vkCreateInstance itself are collected too.
+    validation_features.pNext = &messenger;
+    info.pNext = &validation_features;
+  }
+  info.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+  info.ppEnabledLayerNames = layers.data();
+  info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
+  VkInstance instance = VK_NULL_HANDLE;
+  const VkResult result = vkCreateInstance(&info, nullptr, &instance);
+  if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
+    return make_error("Vulkan context: no Vulkan driver found (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER)");
+  }
+  MMVK_VK_CHECK(result);
+  return instance;
+}
+
+}  // namespace
+
+Context::~Context() {
+  if (owns_device_ && device_ != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(device_);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (owns_instance_ && instance_ != VK_NULL_HANDLE) {
+    if (messenger_ != VK_NULL_HANDLE) {
+      auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+      if (destroy != nullptr) destroy(instance_, messenger_, nullptr);
+    }
+    vkDestroyInstance(instance_, nullptr);
+  }
+}
+
+Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) {
+  std::unique_ptr<Context> context(new Context());
+  Result<VkInstance> instance = create_instance(options, context.get());
+  if (!instance) return instance.error();
+  context->instance_ = *instance;
+  context->owns_instance_ = true;
+
+  if (options.validation) {
+    const VkDebugUtilsMessengerCreateInfoEXT info = messenger_info(context.get());
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(context->instance_, "vkCreateDebugUtilsMessengerEXT"));
+    if (create == nullptr) return make_error("Vulkan context: vkCreateDebugUtilsMessengerEXT is not available");
+    MMVK_VK_CHECK(create(context->instance_, &info, nullptr, &context->messenger_));
+  }
+
+  Result<std::vector<VkPhysicalDevice>> devices = physical_devices(context->instance_);
+  if (!devices) return devices.error();
+  if (devices->empty()) return make_error("Vulkan context: no Vulkan device found (the loader reports no physical device)");
+
+  // Candidates: Vulkan 1.2+ with a compute queue, ranked by device type;
+  // enumeration order breaks ties.
+  std::optional<std::uint32_t> chosen;
+  if (options.device_index) {
+    if (*options.device_index >= devices->size()) {
+      return make_error("Vulkan context: device_index " + std::to_string(*options.device_index) + " is out of range (" +
+                        std::to_string(devices->size()) + " devices)");
+    }
+    chosen = *options.device_index;
+  } else {
+    int best_rank = 1 << 30;
+    for (std::uint32_t i = 0; i < devices->size(); ++i) {
+      VkPhysicalDeviceProperties props;
+      vkGetPhysicalDeviceProperties((*devices)[i], &props);
+      if (props.apiVersion < VK_API_VERSION_1_2 || !find_compute_family((*devices)[i])) continue;
+      if (type_rank(props.deviceType) < best_rank) {
+        best_rank = type_rank(props.deviceType);
+        chosen = i;
+      }
+    }
+    if (!chosen) return make_error("Vulkan context: no device supports Vulkan 1.2 with a compute queue");
+  }
+  context->physical_device_ = (*devices)[*chosen];
+  vkGetPhysicalDeviceProperties(context->physical_device_, &context->properties_);
+  if (context->properties_.apiVersion < VK_API_VERSION_1_2) {
+    return make_error("Vulkan context: device '" + std::string(context->properties_.deviceName) + "' supports Vulkan " +
+                      version_string(context->properties_.apiVersion) + ", mmvk needs 1.2");
+  }
+  const std::optional<std::uint32_t> family = find_compute_family(context->physical_device_);
+  if (!family) return make_error("Vulkan context: device '" + std::string(context->properties_.deviceName) + "' has no compute queue");
+  context->queue_family_ = *family;
+
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{};
+  queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+  queue_info.queueFamilyIndex = *family;
+  queue_info.queueCount = 1;
+  queue_info.pQueuePriorities = &priority;
+  VkDeviceCreateInfo device_info{};
+  device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  device_info.queueCreateInfoCount = 1;
+  device_info.pQueueCreateInfos = &queue_info;
+  MMVK_VK_CHECK(vkCreateDevice(context->physical_device_, &device_info, nullptr, &context->device_));
+  context->owns_device_ = true;
+  vkGetDeviceQueue(context->device_, *family, 0, &context->queue_);
+  MMVK_TRY(context->init_device_info());
+  return context;
+}
+
+Result<std::unique_ptr<Context>> Context::adopt(const AdoptedDevice& handles) {
+  if (handles.instance == VK_NULL_HANDLE || handles.physical_device == VK_NULL_HANDLE ||
+      handles.device == VK_NULL_HANDLE || handles.queue == VK_NULL_HANDLE) {
+    return make_error("Vulkan context: adopt() needs an instance, a physical device, a device and a queue");
+  }
+  std::unique_ptr<Context> context(new Context());
+  context->instance_ = handles.instance;
+  context->physical_device_ = handles.physical_device;
+  context->device_ = handles.device;
+  context->queue_ = handles.queue;
+  context->queue_family_ = handles.queue_family;
+  vkGetPhysicalDeviceProperties(context->physical_device_, &context->properties_);
+  if (context->properties_.apiVersion < VK_API_VERSION_1_2) {
+    return make_error("Vulkan context: the adopted device supports Vulkan " +
+                      version_string(context->properties_.apiVersion) + ", mmvk needs 1.2");
+  }
+  std::uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(context->physical_device_, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(context->physical_device_, &count, families.data());
+  if (handles.queue_family >= count || (families[handles.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) {
+    return make_error("Vulkan context: adopted queue family " + std::to_string(handles.queue_family) +
+                      " does not exist or has no compute support");
+  }
+  MMVK_TRY(context->init_device_info());
+  return context;
+}
+
+Status Context::init_device_info() {
+  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+  VkPhysicalDeviceMaintenance3Properties maintenance3{};
+  maintenance3.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES;
+  VkPhysicalDeviceSubgroupProperties subgroup{};
+  subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+  subgroup.pNext = &maintenance3;
+  VkPhysicalDeviceProperties2 props2{};
+  props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  props2.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(physical_device_, &props2);
+  subgroup_size_ = std::max<std::uint32_t>(1, subgroup.subgroupSize);
+  max_allocation_size_ = maintenance3.maxMemoryAllocationSize;
+
+  std::uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &count, families.data());
+  timestamp_valid_bits_ = queue_family_ < count ? families[queue_family_].timestampValidBits : 0;
+  if (properties_.limits.timestampPeriod <= 0.0f) timestamp_valid_bits_ = 0;
+  return {};
+}
+
+std::vector<std::string> Context::validation_messages() const {
+  std::lock_guard lock(messages_mutex_);
+  return messages_;
+}
+
+std::size_t Context::validation_message_count() const {
+  std::lock_guard lock(messages_mutex_);
+  return messages_.size();
+}
+
+void Context::record_validation_message(std::string message) {
+  std::lock_guard lock(messages_mutex_);
+  messages_.push_back(std::move(message));
+}
+
+Result<std::vector<DeviceInfo>> Context::enumerate_devices() {
+  Result<VkInstance> instance = create_instance(ContextOptions{}, nullptr);
+  if (!instance) return instance.error();
+  Result<std::vector<VkPhysicalDevice>> devices = physical_devices(*instance);
+  std::vector<DeviceInfo> infos;
+  if (devices) {
+    for (VkPhysicalDevice device : *devices) {
+      VkPhysicalDeviceProperties props;
+      vkGetPhysicalDeviceProperties(device, &props);
+      infos.push_back(DeviceInfo{props.deviceName, props.deviceType, props.apiVersion});
+    }
+  }
+  vkDestroyInstance(*instance, nullptr);
+  if (!devices) return devices.error();
+  return infos;
+}
+
+}  // namespace mmvk::vulkan

@@ -1,0 +1,97 @@
+#include "device_database.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "check.hpp"
+
+namespace mmvk::vulkan::detail {
+
+namespace {
+
+template <class T>
+std::span<const std::byte> bytes_of(const std::vector<T>& values) {
+  return std::as_bytes(std::span<const T>(values));
+}
+
+Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool, VkFormat format,
+                                      std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what) {
+  const std::uint64_t texels = data.size() / texel_bytes;
+  const VkPhysicalDeviceLimits& limits = context.properties().limits;
+  if (texels > limits.maxTexelBufferElements) {
+    return make_error(std::string("Vulkan: the database is too large for this device: ") + what + " needs " +
+                      std::to_string(texels) + " texels, maxTexelBufferElements is " +
+                      std::to_string(limits.maxTexelBufferElements));
+  }
+  VkFormatProperties format_props;
+  vkGetPhysicalDeviceFormatProperties(context.physical_device(), format, &format_props);
+  if ((format_props.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT) == 0) {
+    return make_error(std::string("Vulkan: the device cannot read ") + what + " as a uniform texel buffer");
+  }
+  Result<Buffer> buffer = create_buffer(context, data.size(),
+                                        VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                        MemoryUse::DeviceLocal, what);
+  if (!buffer) return buffer.error();
+  MMVK_TRY(upload(context, pool, *buffer, data));
+
+  VkBufferViewCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+  info.buffer = buffer->buffer.get();
+  info.format = format;
+  info.offset = 0;
+  info.range = data.size();
+  VkBufferView view = VK_NULL_HANDLE;
+  MMVK_VK_CHECK(vkCreateBufferView(context.device(), &info, nullptr, &view));
+  TexelBuffer result;
+  result.buffer = std::move(*buffer);
+  result.view = UniqueBufferView(context.device(), view);
+  return result;
+}
+
+}  // namespace
+
+Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database) {
+  DeviceDatabase device;
+  device.frame_count = database.frame_count();
+  device.dims = database.dims();
+  device.dim_vec4s = (device.dims + 3) / 4;
+  const std::size_t frames = device.frame_count;
+  const std::size_t padded = std::size_t{device.dim_vec4s} * 4;
+
+  // Host copies in the kernels' layouts; creation-time only.
+  {
+    std::vector<float> features(frames * padded, 0.0f);
+    const std::span<const float> source = database.features();
+    for (std::size_t f = 0; f < frames; ++f) {
+      for (std::size_t d = 0; d < device.dims; ++d) features[f * padded + d] = source[f * device.dims + d];
+    }
+    Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(features),
+                                                   "the feature matrix");
+    if (!buffer) return buffer.error();
+    device.features = std::move(*buffer);
+  }
+  {
+    std::vector<std::array<std::uint32_t, 4>> meta(frames);
+    for (std::size_t f = 0; f < frames; ++f) {
+      const TagMask tags = database.frame_tags()[f];
+      meta[f] = {database.frame_flags()[f], static_cast<std::uint32_t>(tags), static_cast<std::uint32_t>(tags >> 32),
+                 database.frame_clip()[f]};
+    }
+    Result<TexelBuffer> buffer =
+        make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(meta), "the frame metadata");
+    if (!buffer) return buffer.error();
+    device.frame_meta = std::move(*buffer);
+  }
+  {
+    std::vector<std::array<float, 2>> cost(frames);
+    for (std::size_t f = 0; f < frames; ++f) cost[f] = {database.frame_multiplier()[f], database.frame_bias()[f]};
+    Result<TexelBuffer> buffer =
+        make_texel_buffer(context, pool, VK_FORMAT_R32G32_SFLOAT, 8, bytes_of(cost), "the frame cost terms");
+    if (!buffer) return buffer.error();
+    device.frame_cost = std::move(*buffer);
+  }
+  return device;
+}
+
+}  // namespace mmvk::vulkan::detail

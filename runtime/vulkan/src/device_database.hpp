@@ -1,0 +1,36 @@
+// A Database in device-local memory, in the layout the kernels read:
+//  features   [frames x dims/4] RGBA32F texels, dims padded to 4 with zeros
+//  frame_meta [frames] RGBA32UI texels (flags, tags low, tags high, clip)
+//  frame_cost [frames] RG32F texels (cost multiplier, cost bias)
+// Texel buffers, not storage buffers: texelFetch is a vectorized gather on
+// lavapipe, and maxTexelBufferElements (128 Mi texels there) is far above
+// maxStorageBufferRange (128 MiB).
+#pragma once
+
+#include <cstdint>
+
+#include "handles.hpp"
+#include "memory.hpp"
+#include "mmvk/database.hpp"
+#include "mmvk/status.hpp"
+#include "mmvk/vulkan/context.hpp"
+
+namespace mmvk::vulkan::detail {
+
+struct TexelBuffer {
+  Buffer buffer;          // before `view`: the view is destroyed first
+  UniqueBufferView view;
+};
+
+struct DeviceDatabase {
+  std::uint32_t frame_count = 0;
+  std::uint32_t dims = 0;
+  std::uint32_t dim_vec4s = 0;  // ceil(dims / 4)
+  TexelBuffer features;
+  TexelBuffer frame_meta;
+  TexelBuffer frame_cost;
+};
+
+Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database);
+
+}  // namespace mmvk::vulkan::detail

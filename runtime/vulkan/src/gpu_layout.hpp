@@ -1,0 +1,72 @@
+// The C++ side of shaders/search_layout.glsl: the structs the kernels read,
+// declared once per side, next to each other, with their sizes and offsets
+// checked here. Change both files together.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace mmvk::vulkan::detail {
+
+// GLSL: QueryGpu (std430 array element).
+struct QueryGpu {
+  std::uint32_t continuing_frame;  // kNoFrame: none
+  std::uint32_t exclusion_window;
+  std::uint32_t require_lo;
+  std::uint32_t require_hi;
+  std::uint32_t exclude_lo;
+  std::uint32_t exclude_hi;
+  std::uint32_t window_clip;  // clip of the continuing frame, kNoFrame when no window applies
+  std::uint32_t clip_first;
+  std::uint32_t clip_count;
+  std::uint32_t clip_loop;
+  float continuing_bias;
+  std::uint32_t pad0;
+};
+static_assert(sizeof(QueryGpu) == 48);
+static_assert(offsetof(QueryGpu, window_clip) == 24);
+static_assert(offsetof(QueryGpu, continuing_bias) == 40);
+
+// GLSL: SearchPush (push constants of every search kernel).
+struct SearchPush {
+  std::uint32_t frame_count;
+  std::uint32_t rows_per_invocation;
+  std::uint32_t block_count;
+  std::uint32_t query_base;
+  std::uint32_t query_count;
+  std::uint32_t pad0;
+  std::uint32_t pad1;
+  std::uint32_t pad2;
+};
+static_assert(sizeof(SearchPush) == 32);
+static_assert(sizeof(SearchPush) <= 128, "Vulkan guarantees only 128 bytes of push constants");
+static_assert(offsetof(SearchPush, query_count) == 16);
+
+// Descriptor bindings of set 0 (search_layout.glsl).
+enum Binding : std::uint32_t {
+  kBindingFeatures = 0,   // uniform texel buffer, RGBA32F
+  kBindingFrameMeta = 1,  // uniform texel buffer, RGBA32UI
+  kBindingFrameCost = 2,  // uniform texel buffer, RG32F
+  kBindingQueries = 3,    // storage buffer
+  kBindingParams = 4,     // storage buffer
+  kBindingWeights = 5,    // storage buffer
+  kBindingScratch = 6,    // storage buffer
+  kBindingResults = 7,    // storage buffer
+  kBindingCount = 8,
+};
+inline constexpr std::uint32_t kTexelBindings = 3;
+inline constexpr std::uint32_t kStorageBindings = 5;
+
+// Specialization constant ids of the kernels.
+enum SpecId : std::uint32_t {
+  kSpecWorkgroupSize = 0,
+  kSpecDimVec4s = 1,
+  kSpecDims = 2,
+  kSpecTile = 3,
+  kSpecK = 4,
+  kSpecChannels = 5,
+  kSpecEndMask0 = 6,  // .. kSpecEndMask0 + 3
+};
+inline constexpr std::uint32_t kMaxKernelDims = 128;  // four 32-bit end masks
+
+}  // namespace mmvk::vulkan::detail

@@ -1,0 +1,74 @@
+// The data layout shared by the search kernels: descriptor bindings, the
+// per-query parameter struct and the push constants. The C++ side of every
+// struct here is in runtime/vulkan/src/gpu_layout.hpp, with static_asserts
+// on its size and offsets; change both together.
+#ifndef MMVK_SEARCH_LAYOUT_GLSL
+#define MMVK_SEARCH_LAYOUT_GLSL
+
+const uint kNone = 0xFFFFFFFFu;
+
+// Per-frame flag bits (mmvk::FrameFlag).
+const uint kFrameDoNotUse = 1u;
+const uint kFrameBlockTransition = 2u;
+const uint kFrameEdgeExcluded = 4u;
+
+// gpu_layout.hpp: QueryGpu (48 bytes, std430).
+struct QueryGpu {
+  uint continuing_frame;   // kNone: no continuing frame
+  uint exclusion_window;
+  uint require_lo;
+  uint require_hi;
+  uint exclude_lo;
+  uint exclude_hi;
+  uint window_clip;        // clip of the continuing frame, kNone when no window applies
+  uint clip_first;         // that clip's first frame
+  uint clip_count;         // that clip's frame count
+  uint clip_loop;          // 1 when that clip loops
+  float continuing_bias;
+  uint pad0;
+};
+
+// gpu_layout.hpp: SearchPush (32 bytes).
+layout(push_constant) uniform SearchPush {
+  uint frame_count;
+  uint rows_per_invocation;
+  uint block_count;        // ceil(frame_count / rows_per_invocation)
+  uint query_base;         // first query of this chunk in the query buffers
+  uint query_count;        // queries in this chunk
+  uint pad0;
+  uint pad1;
+  uint pad2;
+} pc;
+
+// [frames x dims/4] texels: the feature matrix, dims padded to 4 with zeros.
+layout(set = 0, binding = 0) uniform samplerBuffer features;
+// [frames] texels: (flags, tags low 32 bits, tags high 32 bits, clip index).
+layout(set = 0, binding = 1) uniform usamplerBuffer frame_meta;
+// [frames] texels: (cost multiplier, cost bias).
+layout(set = 0, binding = 2) uniform samplerBuffer frame_cost;
+// [max_batch x dims/4] query features, padded like the rows.
+layout(std430, set = 0, binding = 3) readonly buffer Queries { vec4 query_features[]; };
+// [max_batch] query parameters.
+layout(std430, set = 0, binding = 4) readonly buffer Params { QueryGpu query_params[]; };
+// [max_batch x channels] channel weights (non-empty channels only).
+layout(std430, set = 0, binding = 5) readonly buffer Weights { float query_weights[]; };
+// [chunk queries x blocks x K] per-block best (key, frame) pairs.
+layout(std430, set = 0, binding = 6) buffer Scratch { uvec2 scratch[]; };
+// [max_batch x max_k] final best (key, frame) pairs, sorted.
+layout(std430, set = 0, binding = 7) writeonly buffer Results { uvec2 results[]; };
+
+// A (cost, frame) pair as (orderable cost bits, frame): unsigned comparison
+// of the key follows float order, negative costs included.
+uint orderable_bits(float cost) {
+  uint bits = floatBitsToUint(cost);
+  if (cost == 0.0) bits = 0u;  // -0.0 and +0.0 compare equal in the reference
+  return (bits & 0x80000000u) != 0u ? ~bits : bits | 0x80000000u;
+}
+
+// Strict (cost, frame) order; an empty slot is (kNone, kNone) and loses to
+// every candidate, an infinite cost included.
+bool pair_less(uvec2 a, uvec2 b) {
+  return a.x < b.x || (a.x == b.x && a.y < b.y);
+}
+
+#endif

@@ -1,0 +1,309 @@
+// VulkanSearch against ReferenceSearch on cases the shared backend suite
+// does not cover: the large-N loop-limit pitfall, every kernel variant
+// (K 1/4/16 x tile 1/4/16), chunked batches, async submit/poll/wait,
+// timestamps and the validation layer with zero messages.
+#include <bit>
+#include <chrono>
+#include <cstdlib>
+#include <optional>
+#include <thread>
+
+#include "mmvk/reference_search.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#include "support/backend_suite.hpp"
+#include "support/test_data.hpp"
+#include "vulkan_test_env.hpp"
+
+namespace mmvk::test {
+
+// This file uses the suite's data helpers; the suite itself runs in
+// vulkan_backend_suite_test.cpp.
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BackendSuite);
+
+namespace {
+
+using vulkan::Context;
+using vulkan::ContextOptions;
+using vulkan::VulkanSearch;
+using vulkan::VulkanSearchOptions;
+
+// Options without designated initializers (GCC warns about the members
+// they leave out).
+VulkanSearchOptions search_options(std::uint32_t max_batch, std::uint32_t max_k, std::uint32_t max_tile = 16,
+                                   bool warm_up = true) {
+  VulkanSearchOptions options;
+  options.max_batch = max_batch;
+  options.max_k = max_k;
+  options.max_tile = max_tile;
+  options.warm_up = warm_up;
+  return options;
+}
+
+ContextOptions validation_options() {
+  ContextOptions options;
+  options.validation = true;
+  return options;
+}
+
+ContextOptions index_options(std::uint32_t index) {
+  ContextOptions options;
+  options.device_index = index;
+  return options;
+}
+
+std::unique_ptr<VulkanSearch> make_search(Context& context, const Database& db, const VulkanSearchOptions& options = {}) {
+  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(context, db, options);
+  EXPECT_TRUE(search.ok()) << search.message();
+  return search.ok() ? std::move(search).value() : nullptr;
+}
+
+void compare(SearchBackend& backend, const Database& db, std::span<const float> queries,
+             std::span<const QueryParams> params, std::size_t count, std::uint32_t k) {
+  ReferenceSearch reference(db);
+  expect_identical(run_search(reference, queries, params, count, k), run_search(backend, queries, params, count, k), k,
+                   params, backend.name());
+}
+
+TEST(VulkanSearch, EveryVariantMatchesReference) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 5000, .seed = 101, .constraints = true});
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db);
+  ASSERT_NE(search, nullptr);
+  for (std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{7}, std::size_t{64}, std::size_t{100}}) {
+    const std::vector<float> queries = synthetic_queries(db, count, 200 + count);
+    const std::vector<QueryParams> params = random_params(db, count, 300 + count);
+    for (std::uint32_t k : {1u, 2u, 4u, 5u, 16u}) {
+      SCOPED_TRACE("batch " + std::to_string(count) + ", k " + std::to_string(k));
+      compare(*search, db, queries, params, count, k);
+      compare(*search, db, queries, {}, count, k);
+    }
+  }
+}
+// llvmpipe stops a loop after 65,535 iterations and the kernel then returns
+// wrong answers silently (shared/LAVAPIPE.md). 16k rows per invocation with
+// 16-query tiles and 4 dims: any inner loop left rolled would pass that
+// limit, and the large N gives hundreds of thousands of rows in total.
+TEST(VulkanSearch, LargeDatabaseStaysExact) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 320000, .clips = 64, .seed = 103, .channel_dims = {2, 2}});
+  const std::vector<float> queries = synthetic_queries(db, 64, 104);
+  for (std::uint32_t rows : {0u, 16384u}) {
+    SCOPED_TRACE("rows_per_invocation " + std::to_string(rows));
+    VulkanSearchOptions options;
+    options.max_batch = 64;
+    options.max_k = 1;
+    options.rows_per_invocation = rows;
+    std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
+    ASSERT_NE(search, nullptr);
+    compare(*search, db, queries, {}, 64, 1);
+  }
+  // Queries equal to the last rows: a scan cut short would miss them.
+  std::vector<float> tail;
+  for (std::uint32_t f : {db.frame_count() - 1, db.frame_count() - 2, 200000u, 17u}) {
+    tail.insert(tail.end(), db.row(f).begin(), db.row(f).end());
+  }
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, search_options(4, 1));
+  ASSERT_NE(search, nullptr);
+  const std::vector<Match> out = run_search(*search, tail, {}, 4, 1);
+  EXPECT_EQ(out[0].frame, db.frame_count() - 1);
+  EXPECT_EQ(out[1].frame, db.frame_count() - 2);
+  EXPECT_EQ(out[2].frame, 200000u);
+  EXPECT_EQ(out[3].frame, 17u);
+}
+
+TEST(VulkanSearch, ChunkedBatchesMatchReference) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 6000, .seed = 105, .constraints = true});
+  VulkanSearchOptions options;
+  options.max_batch = 200;
+  options.scratch_bytes = 1;  // one chunk per query tile or query: many scan/merge pairs
+  options.warm_up = false;
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
+  ASSERT_NE(search, nullptr);
+  const std::vector<float> queries = synthetic_queries(db, 200, 106);
+  const std::vector<QueryParams> params = random_params(db, 200, 107);
+  compare(*search, db, queries, params, 200, 1);
+  compare(*search, db, std::span<const float>(queries).first(37 * db.dims()), std::span(params).first(37), 37, 16);
+}
+
+TEST(VulkanSearch, AsyncSubmitPollWait) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 4000, .seed = 109, .constraints = true});
+  VulkanSearchOptions options;
+  options.max_batch = 32;
+  options.slots = 2;
+  options.max_tile = 4;
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
+  ASSERT_NE(search, nullptr);
+  ReferenceSearch reference(db);
+  const std::vector<float> a = synthetic_queries(db, 32, 110);
+  const std::vector<float> b = synthetic_queries(db, 5, 111);
+  const std::vector<QueryParams> params = random_params(db, 32, 112);
+
+  Result<vulkan::Ticket> first = search->submit(QueryBatch{a, params, 32}, 3);
+  ASSERT_TRUE(first.ok()) << first.message();
+  Result<vulkan::Ticket> second = search->submit(QueryBatch{b, {}, 5}, 1);
+  ASSERT_TRUE(second.ok()) << second.message();
+  // Every slot is in flight: a third submit is an error, not a block.
+  Result<vulkan::Ticket> third = search->submit(QueryBatch{b, {}, 5}, 1);
+  ASSERT_FALSE(third.ok());
+  EXPECT_NE(third.message().find("in flight"), std::string::npos) << third.message();
+
+  // poll() turns true without wait(); then wait() out of submission order.
+  for (int i = 0; i < 2000; ++i) {
+    Result<bool> done = search->poll(*second);
+    ASSERT_TRUE(done.ok()) << done.message();
+    if (*done) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::vector<Match> out_b(5);
+  ASSERT_TRUE(search->wait(*second, out_b).ok());
+  expect_identical(run_search(reference, b, {}, 5, 1), out_b, 1, {}, "vulkan async");
+  std::vector<Match> out_a(32 * 3);
+  ASSERT_TRUE(search->wait(*first, out_a).ok());
+  expect_identical(run_search(reference, a, params, 32, 3), out_a, 3, params, "vulkan async");
+
+  // A ticket is consumed by wait(); its slot is reused by the next submit.
+  EXPECT_FALSE(search->wait(*first, out_a).ok());
+  EXPECT_FALSE(search->poll(*second).ok());
+  Result<vulkan::Ticket> again = search->submit(QueryBatch{b, {}, 5}, 1);
+  ASSERT_TRUE(again.ok()) << again.message();
+  std::vector<Match> wrong_size(4);
+  EXPECT_FALSE(search->wait(*again, wrong_size).ok());
+  ASSERT_TRUE(search->wait(*again, out_b).ok());
+  expect_identical(run_search(reference, b, {}, 5, 1), out_b, 1, {}, "vulkan async");
+
+  // lavapipe's queue has timestamps: the kernel time is measured.
+  if (context->timestamp_valid_bits() != 0) {
+    ASSERT_TRUE(search->last_kernel_seconds().has_value());
+    EXPECT_GT(*search->last_kernel_seconds(), 0.0);
+  }
+  EXPECT_EQ(search->stats().queries, 42u);
+}
+
+TEST(VulkanSearch, ErrorsAreReturned) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 1000, .seed = 113});
+  std::unique_ptr<VulkanSearch> search =
+      make_search(*context, db, search_options(8, 4, 4));
+  ASSERT_NE(search, nullptr);
+  const std::vector<float> queries = synthetic_queries(db, 9, 114);
+  std::vector<Match> out(9 * 4);
+  // A batch over max_batch, k over max_k.
+  Status status = search->search(QueryBatch{queries, {}, 9}, 1, std::span<Match>(out).first(9));
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("max_batch"), std::string::npos) << status.message();
+  status = search->search(QueryBatch{std::span<const float>(queries).first(8 * db.dims()), {}, 8}, 5,
+                          std::span<Match>(out).first(8 * 5));
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("max_k"), std::string::npos) << status.message();
+  // Still usable.
+  EXPECT_TRUE(search->search(QueryBatch{std::span<const float>(queries).first(8 * db.dims()), {}, 8}, 4,
+                             std::span<Match>(out).first(8 * 4))
+                  .ok());
+
+  // Options out of range.
+  EXPECT_FALSE(VulkanSearch::create(*context, db, search_options(0, 1)).ok());
+  EXPECT_FALSE(VulkanSearch::create(*context, db, search_options(8, 17)).ok());
+  EXPECT_FALSE(VulkanSearch::create(*context, db, search_options(8, 1, 8)).ok());
+  VulkanSearchOptions too_many_rows;
+  too_many_rows.rows_per_invocation = 40000;
+  EXPECT_FALSE(VulkanSearch::create(*context, db, too_many_rows).ok());
+
+  // A cluster table from another database.
+  const Database other = synthetic_database({.frames = 1000, .seed = 115});
+  ClusterTable table;
+  table.database_hash = other.content_hash();
+  table.dims = other.dims();
+  table.cluster_count = 1;
+  table.offsets = {0, other.frame_count()};
+  table.members.resize(other.frame_count());
+  VulkanSearchOptions cluster_options;
+  cluster_options.mode = vulkan::SearchMode::ClustersExact;
+  Result<std::unique_ptr<VulkanSearch>> mismatched = VulkanSearch::create(*context, db, cluster_options, &table);
+  ASSERT_FALSE(mismatched.ok());
+  EXPECT_NE(mismatched.message().find("does not belong"), std::string::npos) << mismatched.message();
+
+  // More dims than the kernels support.
+  const Database wide = synthetic_database({.frames = 50, .clips = 1, .seed = 116, .channel_dims = {100, 40}});
+  Result<std::unique_ptr<VulkanSearch>> too_wide = VulkanSearch::create(*context, wide);
+  ASSERT_FALSE(too_wide.ok());
+  EXPECT_NE(too_wide.message().find("128"), std::string::npos) << too_wide.message();
+}
+
+// The loader pointed at no driver: Context::create returns an error.
+TEST(VulkanContext, NoDriverIsAnError) {
+  struct EnvOverride {
+    std::string name;
+    std::optional<std::string> saved;
+    EnvOverride(std::string n, const char* value) : name(std::move(n)) {
+      if (const char* old = std::getenv(name.c_str())) saved = old;
+      setenv(name.c_str(), value, 1);
+    }
+    ~EnvOverride() {
+      if (saved) {
+        setenv(name.c_str(), saved->c_str(), 1);
+      } else {
+        unsetenv(name.c_str());
+      }
+    }
+  };
+  const std::string missing = (make_temp_dir() / "no_such_icd.json").string();
+  EnvOverride driver_files("VK_DRIVER_FILES", missing.c_str());
+  EnvOverride icd_filenames("VK_ICD_FILENAMES", missing.c_str());
+  Result<std::unique_ptr<Context>> context = Context::create();
+  ASSERT_FALSE(context.ok());
+  EXPECT_NE(context.message().find("no Vulkan"), std::string::npos) << context.message();
+}
+
+TEST(VulkanContext, ExplicitIndexAndAdoption) {
+  MMVK_VULKAN_CONTEXT(owner, ContextOptions{});
+  Result<std::vector<vulkan::DeviceInfo>> devices = Context::enumerate_devices();
+  ASSERT_TRUE(devices.ok()) << devices.message();
+  ASSERT_FALSE(devices->empty());
+  EXPECT_FALSE(Context::create(index_options(static_cast<std::uint32_t>(devices->size()))).ok());
+  Result<std::unique_ptr<Context>> first = Context::create(index_options(0));
+  ASSERT_TRUE(first.ok()) << first.message();
+
+  // A second Context on the application's own handles; it destroys none.
+  const Database db = synthetic_database({.frames = 2000, .seed = 117});
+  const std::vector<float> queries = synthetic_queries(db, 6, 118);
+  for (int round = 0; round < 2; ++round) {
+    Result<std::unique_ptr<Context>> adopted = Context::adopt(vulkan::AdoptedDevice{
+        owner->instance(), owner->physical_device(), owner->device(), owner->queue_family(), owner->queue()});
+    ASSERT_TRUE(adopted.ok()) << adopted.message();
+    EXPECT_FALSE((*adopted)->owns_device());
+    std::unique_ptr<VulkanSearch> search =
+        make_search(**adopted, db, search_options(6, 2, 16, false));
+    ASSERT_NE(search, nullptr);
+    compare(*search, db, queries, {}, 6, 2);
+  }
+  EXPECT_FALSE(Context::adopt(vulkan::AdoptedDevice{}).ok());
+}
+
+// The validation layer is really on: a deliberate misuse is reported, and
+// a full search reports nothing.
+TEST(VulkanContext, ValidationCollectsMessages) {
+  MMVK_VULKAN_CONTEXT(context, validation_options());
+  const Database db = synthetic_database({.frames = 3000, .seed = 119, .constraints = true});
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, search_options(16, 16));
+  ASSERT_NE(search, nullptr);
+  const std::vector<float> queries = synthetic_queries(db, 16, 120);
+  compare(*search, db, queries, random_params(db, 16, 121), 16, 5);
+  search.reset();
+  EXPECT_EQ(context->validation_message_count(), 0u)
+      << (context->validation_messages().empty() ? "" : context->validation_messages().front());
+
+  VkBufferCreateInfo bad{};
+  bad.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  bad.size = 0;  // invalid: size must be > 0
+  bad.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  if (vkCreateBuffer(context->device(), &bad, nullptr, &buffer) == VK_SUCCESS && buffer != VK_NULL_HANDLE) {
+    vkDestroyBuffer(context->device(), buffer, nullptr);
+  }
+  EXPECT_GT(context->validation_message_count(), 0u);
+}
+
+}  // namespace
+}  // namespace mmvk::test

@@ -120,6 +120,26 @@ TEST(ImportData, EveryFileParsesWithTheManifestFrameCount) {
   EXPECT_GT(total_frames, 50000);
 }
 
+TEST(ImportData, LineEndingVariantsParseIdentically) {
+  MMVK_REQUIRE_DATA_DIR(dir);
+  const auto lf = mmvk::load_bvh(dir / "tiny/cmu_max_131_01_head60_lf.bvh");
+  const auto crlf = mmvk::load_bvh(dir / "tiny/cmu_max_131_01_head60_crlf.bvh");
+  const auto mixed = mmvk::load_bvh(dir / "tiny/cmu_max_131_01_head60_mixed_eol.bvh");
+  const auto full = mmvk::load_bvh(dir / "cmu/cgspeed-max/131_01.bvh");
+  ASSERT_TRUE(lf.ok() && crlf.ok() && mixed.ok() && full.ok());
+  EXPECT_EQ(lf->values, crlf->values);
+  EXPECT_EQ(lf->values, mixed->values);
+  ASSERT_EQ(lf->joints.size(), mixed->joints.size());
+  for (std::size_t j = 0; j < lf->joints.size(); ++j) {
+    EXPECT_EQ(lf->joints[j].name, mixed->joints[j].name);
+    EXPECT_EQ(lf->joints[j].offset, crlf->joints[j].offset);
+  }
+  // The excerpt is frames 200-259 of the full take.
+  const std::size_t columns = static_cast<std::size_t>(full->channel_count);
+  ASSERT_EQ(lf->values.size(), 60 * columns);
+  EXPECT_TRUE(std::equal(lf->values.begin(), lf->values.end(), full->values.begin() + 200 * columns));
+}
+
 TEST(ImportData, UnitsAreGuessedPerSource) {
   MMVK_REQUIRE_DATA_DIR(dir);
   const std::map<std::string, float> expected{

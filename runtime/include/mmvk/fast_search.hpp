@@ -44,7 +44,8 @@ struct FastSearchOptions {
 class FastSearch final : public SearchBackend {
  public:
   // `database` and `pool` must outlive the backend; the pool may be shared
-  // with other work but serves one search() at a time.
+  // with other work but serves one search() at a time. search() itself is
+  // not reentrant (it reuses per-thread scratch): one call at a time.
   FastSearch(const Database& database, ThreadPool& pool, FastSearchOptions options = {});
   ~FastSearch() override;
 

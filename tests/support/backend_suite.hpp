@@ -16,6 +16,9 @@
 //   using MyBackends = ::testing::Types<MyFactory>;
 //   INSTANTIATE_TYPED_TEST_SUITE_P(My, BackendSuite, MyBackends);
 //
+// make() may be called several times in one test, for different databases,
+// while backends it returned earlier are still alive: keep what each backend
+// needs (cluster tables, uploads) alive with it, e.g. in a std::vector.
 // Sizes stay in the thousands of frames so software Vulkan runs it quickly.
 #pragma once
 

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string_view>
 
@@ -22,9 +23,10 @@ inline bool is_space(char c) { return is_blank(c) || is_line_break(c); }
 inline std::optional<float> parse_float(std::string_view token) {
   const char* first = token.data();
   const char* last = token.data() + token.size();
-  if (first != last && *first == '+') ++first;
+  const bool plus = first != last && *first == '+';
+  if (plus) ++first;
   if (first == last) return std::nullopt;
-  const char lead = *first == '-' && first + 1 != last ? first[1] : *first;
+  const char lead = !plus && *first == '-' && first + 1 != last ? first[1] : *first;
   if (!((lead >= '0' && lead <= '9') || lead == '.')) return std::nullopt;  // rejects inf/nan
   float value = 0.0f;
   const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
@@ -35,14 +37,69 @@ inline std::optional<float> parse_float(std::string_view token) {
 inline std::optional<double> parse_double(std::string_view token) {
   const char* first = token.data();
   const char* last = token.data() + token.size();
-  if (first != last && *first == '+') ++first;
+  const bool plus = first != last && *first == '+';
+  if (plus) ++first;
   if (first == last) return std::nullopt;
-  const char lead = *first == '-' && first + 1 != last ? first[1] : *first;
+  const char lead = !plus && *first == '-' && first + 1 != last ? first[1] : *first;
   if (!((lead >= '0' && lead <= '9') || lead == '.')) return std::nullopt;
   double value = 0.0;
   const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
   if (error != std::errc{} || end != last || !std::isfinite(value)) return std::nullopt;
   return value;
+}
+
+// Clinger's fast path for the common case: a plain decimal ("-375.227000",
+// no exponent) with at most 7 significant digits (trailing fraction zeros do
+// not count) is m / 10^k with m < 2^24 and k <= 10, both exactly
+// representable in float, so one IEEE division is correctly rounded: the same
+// float that from_chars returns. Returns false (leaving the number to
+// from_chars) for anything else.
+inline bool parse_short_decimal(const char* p, const char* end, float* value, const char** stop) {
+  static constexpr float kPowersOf10[] = {1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f, 1e6f, 1e7f, 1e8f, 1e9f, 1e10f};
+  const bool negative = p != end && *p == '-';
+  if (negative) ++p;
+  std::uint32_t mantissa = 0;
+  int significant = 0;
+  int pending_zeros = 0;  // zeros after the last non-zero digit, not yet in `mantissa`
+  int fraction_digits = 0;
+  bool dot = false;
+  bool any_digit = false;
+  const auto flush_zeros = [&]() {
+    significant += pending_zeros;
+    if (significant > 7) return false;
+    for (; pending_zeros > 0; --pending_zeros) mantissa *= 10;
+    return true;
+  };
+  for (; p != end; ++p) {
+    const char c = *p;
+    if (c >= '0' && c <= '9') {
+      any_digit = true;
+      if (dot) ++fraction_digits;
+      if (c == '0') {
+        if (mantissa != 0) ++pending_zeros;  // leading zeros are not significant
+        continue;
+      }
+      if (!flush_zeros() || ++significant > 7) return false;
+      mantissa = mantissa * 10 + static_cast<std::uint32_t>(c - '0');
+    } else if (c == '.' && !dot) {
+      if (!flush_zeros()) return false;  // "1200." keeps its integer zeros
+      dot = true;
+    } else {
+      break;
+    }
+  }
+  if (!any_digit) return false;
+  if (p != end && (*p == 'e' || *p == 'E')) return false;
+  if (dot) {
+    fraction_digits -= pending_zeros;  // "88.510500" is 885105 / 10^4
+  } else if (!flush_zeros()) {
+    return false;  // "1200" is 1200
+  }
+  if (fraction_digits > 10) return false;
+  const float magnitude = static_cast<float>(mantissa) / kPowersOf10[fraction_digits];
+  *value = negative ? -magnitude : magnitude;
+  *stop = p;
+  return true;
 }
 
 class BvhCursor {
@@ -125,11 +182,12 @@ class BvhCursor {
       // token. Only a leading digit, '.', '-' or '+' may start a number
       // (from_chars would also take "inf" and "nan").
       const char* first = text_.data() + pos_;
-      if (*first == '+' && first + 1 != end) ++first;
-      const char lead = *first == '-' && first + 1 != end ? first[1] : *first;
+      const bool plus = *first == '+' && first + 1 != end;
+      if (plus) ++first;
+      const char lead = !plus && *first == '-' && first + 1 != end ? first[1] : *first;
       float value = 0.0f;
       const char* stop = first;
-      if ((lead >= '0' && lead <= '9') || lead == '.') {
+      if (((lead >= '0' && lead <= '9') || lead == '.') && !parse_short_decimal(first, end, &value, &stop)) {
         const auto result = std::from_chars(first, end, value, std::chars_format::general);
         stop = result.ec == std::errc{} && std::isfinite(value) ? result.ptr : first;
       }

@@ -2,6 +2,8 @@
 // corpus in tests/corpus/bvh/ (each file with its specific error and line),
 // and garbage (truncations and byte flips must give an error, never a crash).
 #include <algorithm>
+#include <bit>
+#include <charconv>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -109,6 +111,57 @@ TEST(BvhParser, AcceptsNumberVariants) {
   EXPECT_EQ(file->values[9 + 2], 1.0f);
   EXPECT_FLOAT_EQ(file->values[9 + 4], -2.47945e-15f);
   EXPECT_EQ(file->values[9 + 5], 5.0f);
+}
+
+// The motion reader has a fast path for short decimals; whatever path a
+// number takes, the float must be the one std::from_chars gives (correctly
+// rounded), bit for bit.
+TEST(BvhParser, NumbersMatchFromCharsBitForBit) {
+  std::mt19937 rng(42);
+  std::vector<std::string> numbers;
+  for (int i = 0; i < 20000; ++i) {
+    std::string number;
+    if (rng() % 3 == 0) number += '-';
+    const int integer_digits = static_cast<int>(rng() % 5);
+    const int fraction_digits = static_cast<int>(rng() % 11);
+    for (int d = 0; d < integer_digits; ++d) number += static_cast<char>('0' + rng() % 10);
+    if (fraction_digits > 0 || rng() % 2) number += '.';
+    for (int d = 0; d < fraction_digits; ++d) number += static_cast<char>('0' + (rng() % 4 == 0 ? 0 : rng() % 10));
+    if (rng() % 4 == 0) number += std::string(rng() % 6, '0');  // trailing zeros
+    if (number.find_first_of("0123456789") == std::string::npos) number += '7';
+    if (rng() % 10 == 0) {
+      number += 'e';
+      number += std::to_string(static_cast<int>(rng() % 20) - 10);
+    }
+    numbers.push_back(number);
+  }
+  for (const char* fixed : {"0", "-0", "-0.0000", "16777216", "16777217", "9999999", "0.0000001", "1.", ".5",
+                            "-.5", "+3.25", "0.00833333", "93.3139", "-2.47945e-15", "3.4028234e38", "1e-45",
+                            "-375.227000", "88.510500", "1200", "1200.", "12000000", "1234567.0000", "0.0000000001",
+                            "100.00000000001", "0.10000000"}) {
+    numbers.push_back(fixed);
+  }
+  std::string text = "HIERARCHY\nROOT R\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: " +
+                     std::to_string(numbers.size()) + "\nFrame Time: 0.01\n";
+  for (const std::string& number : numbers) text += number + "\n";
+  const auto file = parse_bvh(text, "numbers.bvh");
+  ASSERT_TRUE(file.ok()) << file.message();
+  ASSERT_EQ(file->values.size(), numbers.size());
+  for (std::size_t i = 0; i < numbers.size(); ++i) {
+    const std::string& number = numbers[i];
+    const char* first = number.data() + (number[0] == '+' ? 1 : 0);
+    float expected = 0.0f;
+    std::from_chars(first, number.data() + number.size(), expected);
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(file->values[i]), std::bit_cast<std::uint32_t>(expected)) << number;
+  }
+  // Not numbers: a sign after '+', a lone sign or dot, two dots, hex, inf.
+  for (const char* bad : {"+-5", "-", ".", "1.2.3", "0x10", "inf", "-nan", "1e", "5,0"}) {
+    const std::string one = "HIERARCHY\nROOT R\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: 1\n"
+                            "Frame Time: 0.01\n" + std::string(bad) + "\n";
+    const auto rejected = parse_bvh(one, "bad.bvh");
+    ASSERT_FALSE(rejected.ok()) << bad;
+    EXPECT_NE(rejected.message().find("bad.bvh:10: non-numeric token"), std::string::npos) << rejected.message();
+  }
 }
 
 TEST(BvhParser, AcceptsZeroAndOneFrame) {

@@ -2,14 +2,29 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
+
+// The vectorizable loops are compiled for AVX2 and for the baseline; the
+// loader picks the clone the CPU supports (no -march=native, so the library
+// stays portable). Lanes never mix, so every clone gives the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define MMVK_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define MMVK_KERNEL
+#endif
 
 namespace mmvk {
 
 namespace {
 
 constexpr std::uint32_t kLanes = 16;  // rows per tile, stored dim-major
+// 8 floats, one AVX register (two SSE registers in the baseline clone).
+typedef float V8 __attribute__((vector_size(32)));
+
+std::size_t pad8(std::size_t n) { return (n + 7) / 8 * 8; }
+
 constexpr std::uint32_t kNeverCandidate = kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition;
 
 struct ClusterBound {
@@ -22,32 +37,46 @@ struct ClusterBound {
 
 struct Scratch {
   std::vector<ClusterBound> order;
+  std::vector<float> total, box;              // [max(clusters, tiles per cluster), padded to 8]
+  std::vector<double> radius_sum, radius_total;  // [clusters]
   std::uint64_t rows = 0;
+  ClusterSearchCounters counters;
 };
 
 // Costs of the 16 rows of one tile, each lane in the reference's order
 // (frame_cost): per channel a float sum of squared differences from 0, the
 // weighted channel sums added in schema order, then multiplier and bias.
-// The lanes are independent, so the compiler vectorizes across rows without
-// reassociating any lane's sum.
-void tile_costs(const float* tile, const float* query, const float* weights, const std::uint32_t* channel_end,
-                std::uint32_t channels, const float* multiplier, const float* bias, float* cost) {
-  float total[kLanes] = {};
+// Explicit 8-lane vectors across rows: no lane's sum is ever reassociated.
+MMVK_KERNEL void tile_costs(const float* tile, const float* query, const float* weights, const std::uint32_t* channel_end,
+                            std::uint32_t channels, const float* multiplier, const float* bias, float* cost) {
+  V8 total0 = {};
+  V8 total1 = {};
   std::uint32_t d = 0;
   for (std::uint32_t ch = 0; ch < channels; ++ch) {
-    float sum[kLanes] = {};
+    V8 sum0 = {};
+    V8 sum1 = {};
     for (; d < channel_end[ch]; ++d) {
-      const float q = query[d];
-      const float* x = tile + std::size_t{d} * kLanes;
-      for (std::uint32_t l = 0; l < kLanes; ++l) {
-        const float diff = x[l] - q;
-        sum[l] += diff * diff;
-      }
+      V8 x0;
+      V8 x1;
+      std::memcpy(&x0, tile + std::size_t{d} * kLanes, sizeof(V8));
+      std::memcpy(&x1, tile + std::size_t{d} * kLanes + 8, sizeof(V8));
+      const V8 diff0 = x0 - query[d];
+      const V8 diff1 = x1 - query[d];
+      sum0 += diff0 * diff0;
+      sum1 += diff1 * diff1;
     }
-    const float w = weights[ch];
-    for (std::uint32_t l = 0; l < kLanes; ++l) total[l] += w * sum[l];
+    total0 += weights[ch] * sum0;
+    total1 += weights[ch] * sum1;
   }
-  for (std::uint32_t l = 0; l < kLanes; ++l) cost[l] = multiplier[l] * total[l] + bias[l];
+  V8 m0, m1, b0, b1;
+  std::memcpy(&m0, multiplier, sizeof(V8));
+  std::memcpy(&m1, multiplier + 8, sizeof(V8));
+  std::memcpy(&b0, bias, sizeof(V8));
+  std::memcpy(&b1, bias + 8, sizeof(V8));
+  const V8 cost0 = m0 * total0 + b0;
+  const V8 cost1 = m1 * total1 + b1;
+  std::memcpy(cost, &cost0, sizeof(V8));
+  std::memcpy(cost + 8, &cost1, sizeof(V8));
 }
 
 // Inserts into a (cost, frame)-sorted list of k (the reference's rule).
@@ -74,11 +103,20 @@ struct ClusterSearch::Layout {
   std::vector<float> multiplier;             // [tiles x 16]
   std::vector<float> bias;                   // [tiles x 16]
   std::vector<std::uint32_t> flags;          // [tiles x 16], padding: do-not-use
-  std::vector<float> tile_lo;                // [tiles x dims]: box of the tile's member rows
-  std::vector<float> tile_hi;                // [tiles x dims]
+  // Boxes are stored dim-major, with the box count padded to a multiple of
+  // 8 (padding boxes are [0, 0]), so bounds of many boxes vectorize: tile i
+  // of cluster c at [tile_box_offset[c] + d * pad8(tiles_c) + i].
+  std::vector<float> tile_lo;                // box of the tile's member rows
+  std::vector<float> tile_hi;
+  std::vector<std::size_t> tile_box_offset;  // [clusters]
   std::vector<float> tile_min_multiplier;    // [tiles]
   std::vector<float> tile_min_bias;          // [tiles]
   std::vector<std::uint8_t> tile_rows;       // [tiles]: member rows (the rest is padding)
+  std::uint32_t max_cluster_tiles = 0;
+  std::vector<float> cluster_lo;             // [dims x pad8(clusters)] (table.box_min transposed)
+  std::vector<float> cluster_hi;             // [dims x pad8(clusters)]
+  std::vector<float> centroid_t;             // [dims x clusters]
+  std::vector<float> radius_t;               // [channels x clusters]
   std::vector<bool> never_candidate;         // [clusters]: empty or all members excluded by flags
   double radius_margin = 0.0;
   std::vector<Scratch> scratch;              // [pool threads]
@@ -112,12 +150,20 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   l.multiplier.assign(tiles * kLanes, 1.0f);
   l.bias.assign(tiles * kLanes, 0.0f);
   l.flags.assign(tiles * kLanes, kFrameDoNotUse);
-  l.tile_lo.assign(tiles * l.dims, std::numeric_limits<float>::infinity());
-  l.tile_hi.assign(tiles * l.dims, -std::numeric_limits<float>::infinity());
+  l.tile_box_offset.resize(k);
+  std::size_t box_values = 0;
+  for (std::uint32_t c = 0; c < k; ++c) {
+    l.tile_box_offset[c] = box_values;
+    box_values += pad8(l.tile_offsets[c + 1] - l.tile_offsets[c]) * l.dims;
+  }
+  l.tile_lo.assign(box_values, std::numeric_limits<float>::infinity());
+  l.tile_hi.assign(box_values, -std::numeric_limits<float>::infinity());
   l.tile_min_multiplier.assign(tiles, std::numeric_limits<float>::infinity());
   l.tile_min_bias.assign(tiles, std::numeric_limits<float>::infinity());
   l.tile_rows.assign(tiles, 0);
   for (std::uint32_t c = 0; c < k; ++c) {
+    const std::uint32_t tiles_c = l.tile_offsets[c + 1] - l.tile_offsets[c];
+    l.max_cluster_tiles = std::max(l.max_cluster_tiles, tiles_c);
     for (std::uint32_t m = table.offsets[c]; m < table.offsets[c + 1]; ++m) {
       const std::uint32_t f = table.members[m];
       const std::size_t slot = std::size_t{l.tile_offsets[c]} * kLanes + (m - table.offsets[c]);
@@ -126,8 +172,9 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
       const auto row = database.row(f);
       for (std::uint32_t d = 0; d < l.dims; ++d) {
         l.features[(tile * l.dims + d) * kLanes + lane] = row[d];
-        l.tile_lo[tile * l.dims + d] = std::min(l.tile_lo[tile * l.dims + d], row[d]);
-        l.tile_hi[tile * l.dims + d] = std::max(l.tile_hi[tile * l.dims + d], row[d]);
+        const std::size_t at = l.tile_box_offset[c] + std::size_t{d} * pad8(tiles_c) + (tile - l.tile_offsets[c]);
+        l.tile_lo[at] = std::min(l.tile_lo[at], row[d]);
+        l.tile_hi[at] = std::max(l.tile_hi[at], row[d]);
       }
       l.tile_min_multiplier[tile] = std::min(l.tile_min_multiplier[tile], database.frame_multiplier()[f]);
       l.tile_min_bias[tile] = std::min(l.tile_min_bias[tile], database.frame_bias()[f]);
@@ -151,8 +198,33 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   // (with room to spare). Underflow breaks relative error bounds, so radius
   // bounds below 1e-30 are dropped to 0.
   l.radius_margin = 2.0 * (l.dims + l.channels + 8) * 0x1.0p-24;
+  for (std::size_t i = 0; i < box_values; ++i) {
+    if (l.tile_lo[i] > l.tile_hi[i]) l.tile_lo[i] = l.tile_hi[i] = 0.0f;  // padding boxes
+  }
+  const std::size_t k8 = pad8(k);
+  l.cluster_lo.assign(k8 * l.dims, 0.0f);
+  l.cluster_hi.assign(k8 * l.dims, 0.0f);
+  l.centroid_t.resize(std::size_t{k} * l.dims);
+  l.radius_t.resize(std::size_t{k} * l.channels);
+  for (std::uint32_t c = 0; c < k; ++c) {
+    for (std::uint32_t d = 0; d < l.dims; ++d) {
+      l.cluster_lo[d * k8 + c] = table.box_min[std::size_t{c} * l.dims + d];
+      l.cluster_hi[d * k8 + c] = table.box_max[std::size_t{c} * l.dims + d];
+      l.centroid_t[std::size_t{d} * k + c] = table.centroids[std::size_t{c} * l.dims + d];
+    }
+    for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
+      l.radius_t[std::size_t{ch} * k + c] = table.channel_radius[std::size_t{c} * l.channels + ch];
+    }
+  }
   l.scratch.resize(pool.thread_count());
-  for (Scratch& s : l.scratch) s.order.reserve(k);
+  const std::size_t width = std::max<std::size_t>(k8, pad8(l.max_cluster_tiles));
+  for (Scratch& s : l.scratch) {
+    s.order.reserve(k);
+    s.total.resize(width);
+    s.box.resize(width);
+    s.radius_sum.resize(k);
+    s.radius_total.resize(k);
+  }
   return std::unique_ptr<ClusterSearch>(new ClusterSearch(database, pool, options, std::move(layout)));
 }
 
@@ -166,48 +238,78 @@ std::uint32_t ClusterSearch::cluster_count() const { return layout_->table.clust
 
 namespace {
 
-// Box bound of a cluster or tile before the bias: min_multiplier * sum_ch w_ch *
-// sum_d gap_d^2 in the reference's order. For a member x, fl(x_d - q_d) is at
-// least fl(gap_d) in magnitude (rounding is monotone), so every step stays at
-// or below the member's own evaluation.
-float box_bound(const ClusterSearch::Layout& l, const float* lo, const float* hi, float min_multiplier, const float* q,
-                const float* w) {
-  float total = 0.0f;
-  for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
-    float sum = 0.0f;
-    for (std::uint32_t d = l.channel_begin[ch]; d < l.channel_end[ch]; ++d) {
-      float gap = 0.0f;
-      if (q[d] < lo[d]) gap = lo[d] - q[d];
-      if (q[d] > hi[d]) gap = q[d] - hi[d];
-      sum += gap * gap;
+// Box bounds of n boxes stored dim-major (lo[d * stride + i], stride a
+// multiple of 8), before the bias: out[i] = min_multiplier[i] * sum_ch w_ch *
+// sum_d gap_d^2 in the reference's order, gap_d = the distance of q_d to
+// [lo, hi]. For a member x, |fl(x_d - q_d)| >= fl(gap_d) (rounding is
+// monotone), so every later step stays at or below the member's own
+// evaluation. Channels of weight 0 are skipped: adding +0 changes no sum.
+// Explicit 8-lane vectors: the compiler will not if-convert float compares
+// by itself (they may trap); each lane keeps the scalar order.
+MMVK_KERNEL void box_bounds(const ClusterSearch::Layout& l, const float* lo, const float* hi, std::size_t stride,
+                            std::size_t n, const float* min_multiplier, const float* q, const float* w, Scratch& s,
+                            float* out) {
+  float* total = s.total.data();
+  for (std::size_t i = 0; i < stride; i += 8) {
+    V8 lane_total = {};
+    for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
+      const float weight = w[ch];
+      if (weight == 0.0f) continue;
+      V8 sum = {};
+      for (std::uint32_t d = l.channel_begin[ch]; d < l.channel_end[ch]; ++d) {
+        V8 lo_v;
+        V8 hi_v;
+        std::memcpy(&lo_v, lo + std::size_t{d} * stride + i, sizeof(V8));
+        std::memcpy(&hi_v, hi + std::size_t{d} * stride + i, sizeof(V8));
+        // At most one is > 0 (lo <= hi): below exactly when q_d < lo,
+        // above exactly when q_d > hi.
+        const V8 below = lo_v - q[d];
+        const V8 above = q[d] - hi_v;
+        const V8 outside = below > above ? below : above;
+        const V8 gap = outside > 0.0f ? outside : V8{};
+        sum += gap * gap;
+      }
+      lane_total += weight * sum;
     }
-    total += w[ch] * sum;
+    std::memcpy(total + i, &lane_total, sizeof(V8));
   }
-  return min_multiplier * total;
+  for (std::size_t i = 0; i < n; ++i) out[i] = min_multiplier[i] * total[i];
 }
 
-// Radius bound before the bias (see the margin proof in create()).
-float radius_bound(const ClusterSearch::Layout& l, std::uint32_t c, const float* q, const float* w) {
-  const float* centroid = l.table.centroids.data() + std::size_t{c} * l.dims;
-  const float* radius = l.table.channel_radius.data() + std::size_t{c} * l.channels;
-  double total = 0.0;
+// Radius bounds of every cluster before the bias, raised into out[] (see the
+// margin proof in create()).
+void radius_bounds(const ClusterSearch::Layout& l, const float* q, const float* w, Scratch& s, float* out) {
+  const std::size_t n = l.table.cluster_count;
+  double* sum = s.radius_sum.data();
+  double* total = s.radius_total.data();
+  std::fill_n(total, n, 0.0);
   for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
-    if (w[ch] == 0.0f) continue;
-    double sum = 0.0;
+    const double weight = w[ch];
+    if (weight == 0.0) continue;
+    std::fill_n(sum, n, 0.0);
     for (std::uint32_t d = l.channel_begin[ch]; d < l.channel_end[ch]; ++d) {
-      const double diff = double(q[d]) - double(centroid[d]);
-      sum += diff * diff;
+      const double qd = q[d];
+      const float* centroid_d = l.centroid_t.data() + std::size_t{d} * n;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double diff = qd - double(centroid_d[i]);
+        sum[i] += diff * diff;
+      }
     }
-    // 1 - 1e-12 absorbs the double rounding of the distance itself, which
-    // a cancellation against the radius could otherwise magnify.
-    const double gap = std::sqrt(sum) * (1.0 - 1e-12) - double(radius[ch]);
-    if (gap > 0.0) total += double(w[ch]) * gap * gap;
+    const float* radius = l.radius_t.data() + std::size_t{ch} * n;
+    for (std::size_t i = 0; i < n; ++i) {
+      // 1 - 1e-12 absorbs the double rounding of the distance itself, which
+      // a cancellation against the radius could otherwise magnify.
+      const double gap = std::sqrt(sum[i]) * (1.0 - 1e-12) - double(radius[i]);
+      total[i] += gap > 0.0 ? weight * gap * gap : 0.0;
+    }
   }
-  const double bound = double(l.table.min_multiplier[c]) * total * (1.0 - l.radius_margin);
-  if (!(bound >= 1e-30)) return 0.0f;
-  float down = static_cast<float>(bound);
-  if (double(down) > bound) down = std::nextafter(down, 0.0f);
-  return down;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double bound = double(l.table.min_multiplier[i]) * total[i] * (1.0 - l.radius_margin);
+    if (!(bound >= 1e-30)) continue;
+    float down = static_cast<float>(bound);
+    if (double(down) > bound) down = std::nextafter(down, 0.0f);
+    out[i] = std::max(out[i], down);
+  }
 }
 
 float centroid_distance(const ClusterSearch::Layout& l, std::uint32_t c, const float* q, const float* w) {
@@ -233,7 +335,10 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   const ClusterTable& t = l.table;
   const QueryParams default_params;
   const ClusterSearchOptions options = options_;
-  for (Scratch& s : l.scratch) s.rows = 0;
+  for (Scratch& s : l.scratch) {
+    s.rows = 0;
+    s.counters = {};
+  }
 
   pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
     Scratch& s = l.scratch[thread];
@@ -264,14 +369,16 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
         s.order.resize(options.nprobe);
       }
-      for (ClusterBound& b : s.order) {
-        float bound = 0.0f;
+      if (!s.order.empty()) {
+        float* bound = s.box.data();
         if (options.box_bound) {
-          bound = box_bound(l, t.box_min.data() + std::size_t{b.cluster} * l.dims,
-                            t.box_max.data() + std::size_t{b.cluster} * l.dims, t.min_multiplier[b.cluster], q, w);
+          box_bounds(l, l.cluster_lo.data(), l.cluster_hi.data(), pad8(t.cluster_count), t.cluster_count,
+                     t.min_multiplier.data(), q, w, s, bound);
+        } else {
+          std::fill_n(bound, t.cluster_count, 0.0f);
         }
-        if (options.radius_bound) bound = std::max(bound, radius_bound(l, b.cluster, q, w));
-        b.bound = bound + t.min_bias[b.cluster];
+        if (options.radius_bound) radius_bounds(l, q, w, s, bound);
+        for (ClusterBound& b : s.order) b.bound = bound[b.cluster] + t.min_bias[b.cluster];
       }
       std::sort(s.order.begin(), s.order.end());
 
@@ -279,16 +386,21 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         // Strictly greater: a member costing exactly the k-th best could still
         // win on a lower frame id.
         if (b.bound > best[k - 1].cost) break;
-        for (std::uint32_t tile = l.tile_offsets[b.cluster]; tile < l.tile_offsets[b.cluster + 1]; ++tile) {
+        ++s.counters.clusters_visited;
+        const std::uint32_t first_tile = l.tile_offsets[b.cluster];
+        const std::uint32_t tiles = l.tile_offsets[b.cluster + 1] - first_tile;
+        float* tile_bound = s.box.data();
+        if (options.tile_bound) {
           // Members are in frame order, so a tile mostly holds neighbouring
           // frames of a clip and its box is tight.
-          if (options.tile_bound && box_bound(l, l.tile_lo.data() + std::size_t{tile} * l.dims,
-                                              l.tile_hi.data() + std::size_t{tile} * l.dims,
-                                              l.tile_min_multiplier[tile], q, w) +
-                                            l.tile_min_bias[tile] >
-                                        best[k - 1].cost) {
-            continue;
-          }
+          const std::size_t at = l.tile_box_offset[b.cluster];
+          box_bounds(l, l.tile_lo.data() + at, l.tile_hi.data() + at, pad8(tiles), tiles,
+                     l.tile_min_multiplier.data() + first_tile, q, w, s, tile_bound);
+          s.counters.tiles_checked += tiles;
+        }
+        for (std::uint32_t i = 0; i < tiles; ++i) {
+          const std::uint32_t tile = first_tile + i;
+          if (options.tile_bound && tile_bound[i] + l.tile_min_bias[tile] > best[k - 1].cost) continue;
           s.rows += l.tile_rows[tile];
           const std::size_t base = std::size_t{tile} * kLanes;
           tile_costs(l.features.data() + base * l.dims, q, w, l.channel_end.data(), l.channels,
@@ -308,7 +420,11 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   });
 
   stats_.queries += batch.size;
-  for (const Scratch& s : l.scratch) stats_.rows_evaluated += s.rows;
+  for (const Scratch& s : l.scratch) {
+    stats_.rows_evaluated += s.rows;
+    counters_.clusters_visited += s.counters.clusters_visited;
+    counters_.tiles_checked += s.counters.tiles_checked;
+  }
   return {};
 }
 

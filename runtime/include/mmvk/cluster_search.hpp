@@ -55,6 +55,12 @@ struct ClusterSearchOptions {
   bool tile_bound = true;
 };
 
+// Work counters beyond SearchStats (benchmarks report them).
+struct ClusterSearchCounters {
+  std::uint64_t clusters_visited = 0;  // clusters whose tiles were walked
+  std::uint64_t tiles_checked = 0;     // tiles whose bound was computed
+};
+
 class ClusterSearch final : public SearchBackend {
  public:
   // Validates `table` against `database` (validate_cluster_table) and copies
@@ -68,7 +74,11 @@ class ClusterSearch final : public SearchBackend {
   const Database& database() const override { return *database_; }
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
   SearchStats stats() const override { return stats_; }
-  void reset_stats() override { stats_ = {}; }
+  void reset_stats() override {
+    stats_ = {};
+    counters_ = {};
+  }
+  const ClusterSearchCounters& counters() const { return counters_; }
 
   const ClusterSearchOptions& options() const { return options_; }
   void set_nprobe(std::uint32_t nprobe) { options_.nprobe = nprobe; }
@@ -84,6 +94,7 @@ class ClusterSearch final : public SearchBackend {
   ClusterSearchOptions options_;
   std::unique_ptr<Layout> layout_;
   SearchStats stats_;
+  ClusterSearchCounters counters_;
 };
 
 }  // namespace mmvk

@@ -1,0 +1,38 @@
+// Factories of the cluster-pruned CPU backend for the typed backend suites
+// (backend_suite.hpp, backend_data_suite.hpp). Each trains its own table
+// with the default KMeansParams (round(sqrt(frames)) clusters).
+#pragma once
+
+#include <memory>
+
+#include "mmvk/cluster_search.hpp"
+#include "mmvk/thread_pool.hpp"
+
+namespace mmvk::test {
+
+template <std::uint32_t NProbe, bool Box = true, bool Radius = true>
+struct ClusterFactory {
+  // The table must outlive the backend: the factory owns both its pool and
+  // the tables it trained.
+  ThreadPool pool{2};
+  std::vector<std::unique_ptr<ClusterTable>> tables;
+
+  Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
+    Result<ClusterTable> trained = train_cluster_table(db, KMeansParams{}, pool);
+    if (!trained.ok()) return trained.error();
+    tables.push_back(std::make_unique<ClusterTable>(std::move(trained).value()));
+    ClusterSearchOptions options;
+    options.nprobe = NProbe;
+    options.box_bound = Box;
+    options.radius_bound = Radius;
+    Result<std::unique_ptr<ClusterSearch>> backend = ClusterSearch::create(db, *tables.back(), pool, options);
+    if (!backend.ok()) return backend.error();
+    return std::unique_ptr<SearchBackend>(std::move(backend).value());
+  }
+};
+
+// Exact, and nprobe = all (which must give the exact results).
+using ClusterExactFactory = ClusterFactory<0>;
+using ClusterProbeAllFactory = ClusterFactory<0xFFFFFFFFu>;
+
+}  // namespace mmvk::test

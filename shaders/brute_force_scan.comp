@@ -68,6 +68,7 @@ void main() {
   float w[T][CHANNELS];
   QueryGpu p[T];
   uvec2 best[T][K];
+  float worst[T];  // cost of best[t][K - 1], +inf while that slot is empty
   [[unroll]] for (uint t = 0; t < T; ++t) {
     const uint query = query_index(tile_first + t);
     [[unroll]] for (uint v = 0; v < DV; ++v) q[t][v] = query_features[query * DV + v];
@@ -76,6 +77,7 @@ void main() {
     // rarely taken branch, made the kernel 2x slower on lavapipe.
     p[t] = query_params[query];
     [[unroll]] for (uint j = 0; j < K; ++j) best[t][j] = uvec2(kNone, kNone);
+    worst[t] = uintBitsToFloat(0x7F800000u);
   }
 
   const uint row_begin = block * pc.rows_per_invocation;
@@ -103,17 +105,21 @@ void main() {
       const bool continuing = r == p[t].continuing_frame;
       if (continuing) cost = cost + p[t].continuing_bias;
 
-      // The candidate rules only for a pair that would enter the best K:
-      // rare once the scan has found good rows.
-      const uvec2 candidate = uvec2(orderable_bits(cost), r);
-      if (pair_less(candidate, best[t][K - 1u]) && !isnan(cost) && is_candidate(r, meta, continuing, p[t])) {
-        best[t][K - 1u] = candidate;
-        [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
-          if (pair_less(best[t][j], best[t][j - 1u])) {
-            const uvec2 swap = best[t][j];
-            best[t][j] = best[t][j - 1u];
-            best[t][j - 1u] = swap;
+      // One float compare on the hot path (NaN and ties pass it); the exact
+      // (cost, frame) order and the candidate rules run only for a pair that
+      // may enter the best K, which is rare once good rows were seen.
+      if (!(cost > worst[t])) {
+        const uvec2 candidate = uvec2(orderable_bits(cost), r);
+        if (pair_less(candidate, best[t][K - 1u]) && !isnan(cost) && is_candidate(r, meta, continuing, p[t])) {
+          best[t][K - 1u] = candidate;
+          [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
+            if (pair_less(best[t][j], best[t][j - 1u])) {
+              const uvec2 swap = best[t][j];
+              best[t][j] = best[t][j - 1u];
+              best[t][j - 1u] = swap;
+            }
           }
+          worst[t] = best[t][K - 1u].y == kNone ? uintBitsToFloat(0x7F800000u) : cost_of_key(best[t][K - 1u].x);
         }
       }
     }

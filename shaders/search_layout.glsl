@@ -65,6 +65,11 @@ uint orderable_bits(float cost) {
   return (bits & 0x80000000u) != 0u ? ~bits : bits | 0x80000000u;
 }
 
+// The cost a key was made from (+0.0 for a zero cost).
+float cost_of_key(uint key) {
+  return uintBitsToFloat((key & 0x80000000u) != 0u ? key & 0x7FFFFFFFu : ~key);
+}
+
 // Strict (cost, frame) order; an empty slot is (kNone, kNone) and loses to
 // every candidate, an infinite cost included.
 bool pair_less(uvec2 a, uvec2 b) {

@@ -48,7 +48,8 @@ struct CharacterRootOptions {
 // mean of the raw facings over a centred window of facing_smoothing_seconds
 // (half a window each side, cut at the clip's ends); a window whose mean
 // vanishes keeps the previous facing (+Z on the first frame). Errors: an
-// unknown source bone, no upper legs, a negative smoothing window.
+// unknown source bone, no upper legs, a negative smoothing window, a motion
+// with fps <= 0 or transforms not sized frame_count x joints.
 struct CharacterRoot {
   std::vector<glm::vec3> positions;  // [frame_count]
   std::vector<glm::vec3> facings;    // [frame_count]

@@ -55,9 +55,11 @@ struct ImportOptions {
 // Rotation channels compose in the file's channel order as intrinsic
 // rotations ("Zrotation Xrotation Yrotation" -> Rz * Rx * Ry); position
 // channels replace the OFFSET's components. fps = 1 / frame_time, snapped to
-// the nearest integer when within 0.01% (".0083333" -> 120). Rest offsets and
-// the root's translation and rotation are converted to Y-up when the file is
-// Z-up. Errors name the file (an inconsistent BvhFile, a bad option).
+// the nearest integer when within 0.01% (".0083333" -> 120). For a Z-up file
+// the root's rest offset, translation and rotation are turned to Y-up by a
+// -90 degree rotation about X ((x, y, z) -> (x, z, -y)); other joints stay in
+// their parents' frames. Errors name the file (an inconsistent BvhFile, a bad
+// option).
 Result<Motion> motion_from_bvh(const BvhFile& file, const ImportOptions& options);
 
 // The unit guess used when metres_per_unit is 0. Rule: take the skeleton's

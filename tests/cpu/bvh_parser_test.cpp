@@ -90,6 +90,8 @@ TEST(BvhParser, AcceptsEveryLineEnding) {
   expect_valid_two_frames(replace_all(kValid.substr(0, motion), "\n", "\r\n") + kValid.substr(motion));
   // No line break after the last frame.
   expect_valid_two_frames(kValid.substr(0, kValid.size() - 1));
+  // A UTF-8 byte order mark.
+  expect_valid_two_frames("\xEF\xBB\xBF" + kValid);
 }
 
 TEST(BvhParser, AcceptsTabsTrailingBlanksAndBlankLines) {

@@ -5,13 +5,15 @@
 //
 // Data: a synthetic motion-like database (clips of smooth walks on a 6-d
 // latent manifold embedded in the default schema's 27-d channel layout), MMVK_BENCH_CLUSTER_FRAMES frames
-// (default 417000, the Bandai volume set's size). register_cluster_benchmarks()
-// takes any Database provider, so the real sets plug in the same way.
+// (default 417000, the Bandai volume set's size), and the Bandai locomotion
+// set (~22k frames, default schema). register_cluster_benchmarks() takes any
+// Database provider, so the volume sets plug in the same way.
 //
 // Query streams (1024 queries each, fixed seeds):
 //   continue   - a frame's own features plus small noise;
-//   transition - the pose channels of one frame with the trajectory channels
-//                of another (a character changing direction);
+//   transition - the first 15 dims (the default schema's pose: feet
+//                positions and velocities, hip velocity) of one frame with
+//                the trajectory of another (a character changing direction);
 //   random     - uniform within the data's per-dimension range.
 // Recall@1 compares the frame found with the exact one (FastSearch brute
 // force, which is bit-identical to the reference and much faster to run).
@@ -21,6 +23,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -29,6 +32,8 @@
 #include <vector>
 
 #include "mmvk/cluster_search.hpp"
+#include "mmvk/database_build.hpp"
+#include "mmvk/manifest.hpp"
 #include "mmvk/fast_search.hpp"
 
 namespace mmvk::bench {
@@ -166,8 +171,8 @@ Setup& setup_for(const std::string& label, const std::function<const Database*()
     s.backends[name] = std::move(backend).value();
   }
   // Bound variants, to measure which bound helps.
-  s.backends["clusters-box"] =
-      std::move(ClusterSearch::create(*s.db, s.table, s.pool, {.nprobe = 0, .box_bound = true, .radius_bound = false}).value());
+  s.backends["clusters+radius"] =
+      std::move(ClusterSearch::create(*s.db, s.table, s.pool, {.nprobe = 0, .box_bound = true, .radius_bound = true}).value());
   s.backends["clusters-radius"] =
       std::move(ClusterSearch::create(*s.db, s.table, s.pool, {.nprobe = 0, .box_bound = false, .radius_bound = true}).value());
   for (const char* stream : kStreams) {
@@ -236,7 +241,7 @@ void register_cluster_benchmarks(const std::string& label, std::function<const D
     state.counters["frames"] = s.db ? s.db->frame_count() : 0;
   })->Iterations(1);
   for (const char* stream : kStreams) {
-    for (const char* backend : {"fast-brute", "fast-box", "clusters", "clusters-box", "clusters-radius", "nprobe1",
+    for (const char* backend : {"fast-brute", "fast-box", "clusters", "clusters+radius", "clusters-radius", "nprobe1",
                                 "nprobe4", "nprobe16"}) {
       for (std::uint32_t batch : kBatchSizes) {
         const std::string name = "clusters/" + label + "/" + stream + "/" + backend + "/B:" + std::to_string(batch);
@@ -250,7 +255,34 @@ void register_cluster_benchmarks(const std::string& label, std::function<const D
 
 namespace {
 
+// The Bandai locomotion set (bandai-namco-nc/locomotion-normal under
+// MMVK_DATA or ../shared/data), built with the default schema on first use.
+const Database* locomotion_database() {
+  static std::unique_ptr<Database> db;
+  static bool tried = false;
+  if (tried) return db.get();
+  tried = true;
+  const char* env = std::getenv("MMVK_DATA");
+  const std::filesystem::path data = env && *env ? std::filesystem::path(env) : std::filesystem::path(MMVK_DEFAULT_DATA_DIR);
+  Result<Manifest> manifest = manifest_from_directory(data / "bandai-namco-nc" / "locomotion-normal");
+  if (!manifest.ok()) {
+    std::fprintf(stderr, "cluster_bench: %s\n", manifest.message().c_str());
+    return nullptr;
+  }
+  ThreadPool pool;
+  BuildOptions options;
+  options.pool = &pool;
+  Result<Database> built = build_database(*manifest, options);
+  if (!built.ok()) {
+    std::fprintf(stderr, "cluster_bench: %s\n", built.message().c_str());
+    return nullptr;
+  }
+  db = std::make_unique<Database>(std::move(built).value());
+  return db.get();
+}
+
 const bool registered = [] {
+  register_cluster_benchmarks("locomotion", locomotion_database);
   const char* env = std::getenv("MMVK_BENCH_CLUSTER_FRAMES");
   const std::uint32_t frames = env && *env ? static_cast<std::uint32_t>(std::strtoul(env, nullptr, 10)) : 417000;
   register_cluster_benchmarks("synthetic" + std::to_string(frames / 1000) + "k", [frames]() -> const Database* {

@@ -380,9 +380,14 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         if (options.radius_bound) radius_bounds(l, q, w, s, bound);
         for (ClusterBound& b : s.order) b.bound = bound[b.cluster] + t.min_bias[b.cluster];
       }
-      std::sort(s.order.begin(), s.order.end());
+      // A min-heap: usually only a few clusters are visited, so popping them
+      // in order beats sorting all of them.
+      const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
+      std::make_heap(s.order.begin(), s.order.end(), heap_order);
 
-      for (const ClusterBound& b : s.order) {
+      for (auto heap_end = s.order.end(); heap_end != s.order.begin(); --heap_end) {
+        std::pop_heap(s.order.begin(), heap_end, heap_order);
+        const ClusterBound& b = *(heap_end - 1);
         // Strictly greater: a member costing exactly the k-th best could still
         // win on a lower frame id.
         if (b.bound > best[k - 1].cost) break;

@@ -102,7 +102,7 @@ struct Variant {
 const Variant kExactVariants[] = {
     {"exact", {}},
     {"nprobe=all", {.nprobe = 1000000}},
-    {"box only", {.nprobe = 0, .box_bound = true, .radius_bound = false}},
+    {"box + radius", {.nprobe = 0, .box_bound = true, .radius_bound = true}},
     {"radius only", {.nprobe = 0, .box_bound = false, .radius_bound = true}},
     {"no tile bound", {.nprobe = 0, .box_bound = true, .radius_bound = true, .tile_bound = false}},
     {"no bounds", {.nprobe = 0, .box_bound = false, .radius_bound = false, .tile_bound = false}},

@@ -10,7 +10,7 @@
 
 namespace mmvk::test {
 
-template <std::uint32_t NProbe, bool Box = true, bool Radius = true>
+template <std::uint32_t NProbe, bool Box = true, bool Radius = false>
 struct ClusterFactory {
   // The table must outlive the backend: the factory owns both its pool and
   // the tables it trained.

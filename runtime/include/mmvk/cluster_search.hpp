@@ -49,7 +49,10 @@ namespace mmvk {
 struct ClusterSearchOptions {
   std::uint32_t nprobe = 0;  // 0 = exact; else clusters searched per query
   bool box_bound = true;     // use the per-dimension box bound
-  bool radius_bound = true;  // use the per-channel radius (triangle) bound
+  // Use the per-channel radius (triangle) bound as well. Off by default: on
+  // the Bandai locomotion features it visited no fewer clusters than the box
+  // bound alone and doubled the time per query (see bench/cluster_bench.cpp).
+  bool radius_bound = false;
   // Within a visited cluster, skip 16-row tiles whose own box bound (the
   // same box bound over the tile's members) is above the k-th best.
   bool tile_bound = true;

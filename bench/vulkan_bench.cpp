@@ -8,8 +8,9 @@
 // (BM_VulkanKernel uses it as manual time) next to the end-to-end wall time
 // from submit to results in host memory (BM_VulkanEndToEnd).
 //
-// Real databases plug in through database_for(): replace or extend the
-// synthetic generator there.
+// The BM_Real* group runs the same comparison on the real databases of
+// bench_data.hpp (Bandai locomotion ~22k frames, volume ~417k, mirrored
+// ~834k; built once and cached in the build tree).
 //
 //   build-vulkan/bench/mmvk_bench --benchmark_filter='Vulkan|FastBrute|Reference'
 #include <benchmark/benchmark.h>
@@ -22,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_data.hpp"
 #include "mmvk/database.hpp"
 #include "mmvk/fast_search.hpp"
 #include "mmvk/reference_search.hpp"
@@ -160,18 +162,17 @@ VulkanState& vulkan_state() {
 
 // kernel_time: report the timestamp-query kernel time as the iteration time
 // (UseManualTime); else wall time from submit to results in host memory.
-void run_vulkan(benchmark::State& state, bool kernel_time) {
+void run_vulkan(benchmark::State& state, const Database& db, std::size_t batch, std::uint32_t max_tile,
+                bool kernel_time) {
   VulkanState& vk = vulkan_state();
   if (!vk.context) {
     state.SkipWithError(("no Vulkan device: " + vk.error).c_str());
     return;
   }
-  const Database& db = database_for(std::uint32_t(state.range(0)), std::uint32_t(state.range(1)));
-  const std::size_t batch = std::size_t(state.range(2));
   vulkan::VulkanSearchOptions options;
   options.max_batch = std::uint32_t(batch);
   options.max_k = 1;
-  options.max_tile = std::uint32_t(state.range(3));
+  options.max_tile = max_tile;
   Result<std::unique_ptr<vulkan::VulkanSearch>> search = vulkan::VulkanSearch::create(*vk.context, db, options);
   if (!search) {
     state.SkipWithError(search.message().c_str());
@@ -201,8 +202,28 @@ void run_vulkan(benchmark::State& state, bool kernel_time) {
   state.counters["rows_fraction"] = (*search)->stats().rows_fraction(db.frame_count());
 }
 
-void BM_VulkanEndToEnd(benchmark::State& state) { run_vulkan(state, false); }
-void BM_VulkanKernel(benchmark::State& state) { run_vulkan(state, true); }
+void run_vulkan_synthetic(benchmark::State& state, bool kernel_time) {
+  const Database& db = database_for(std::uint32_t(state.range(0)), std::uint32_t(state.range(1)));
+  run_vulkan(state, db, std::size_t(state.range(2)), std::uint32_t(state.range(3)), kernel_time);
+}
+
+void BM_VulkanEndToEnd(benchmark::State& state) { run_vulkan_synthetic(state, false); }
+void BM_VulkanKernel(benchmark::State& state) { run_vulkan_synthetic(state, true); }
+
+void BM_RealVulkan(benchmark::State& state) {
+  const Database* db = database(DataSet(state.range(0)));
+  if (db == nullptr) {
+    state.SkipWithError("real data set missing (MMVK_DATA)");
+    return;
+  }
+  run_vulkan(state, *db, std::size_t(state.range(1)), 16, false);
+}
+
+BENCHMARK(BM_RealVulkan)
+    ->ArgNames({"set", "batch"})
+    ->ArgsProduct({{int(DataSet::Locomotion), int(DataSet::Volume), int(DataSet::VolumeMirrored)}, {1, 64, 1024, 8192}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_VulkanEndToEnd)
     ->ArgNames({"frames", "dims", "batch", "tile"})
@@ -216,6 +237,23 @@ BENCHMARK(BM_VulkanKernel)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 #endif
+
+void BM_RealFastBrute(benchmark::State& state) {
+  const Database* db = database(DataSet(state.range(0)));
+  if (db == nullptr) {
+    state.SkipWithError("real data set missing (MMVK_DATA)");
+    return;
+  }
+  ThreadPool pool(2);
+  FastSearch fast(*db, pool, FastSearchOptions{.prune = false});
+  run_cpu(state, fast, std::size_t(state.range(1)));
+}
+
+BENCHMARK(BM_RealFastBrute)
+    ->ArgNames({"set", "batch"})
+    ->ArgsProduct({{int(DataSet::Locomotion), int(DataSet::Volume), int(DataSet::VolumeMirrored)}, {1, 64, 1024}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_FastBrute)
     ->ArgNames({"frames", "dims", "batch"})

@@ -164,10 +164,8 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
         scratch.group_order.emplace_back(bound, group);
       }
     }
-    std::sort(scratch.group_order.begin(), scratch.group_order.end());
     detail::KernelQuery kernel_query{query, weights, 0.0f};
-    for (const auto& [group_bound, group] : scratch.group_order) {
-      if (group_bound > list[k - 1].cost) break;
+    auto visit = [&](std::uint32_t group) {
       l.kernels.box_bounds(tile_boxes, group, query, weights, bounds.data());
       std::size_t tile_count = 0;
       std::uint32_t group_rows = 0;
@@ -178,12 +176,29 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
         scratch.tile_ids[tile_count++] = tile;
         group_rows += tile_rows(tile);
       }
-      if (tile_count == 0) continue;
+      if (tile_count == 0) return;
       kernel_query.threshold = list[k - 1].cost;
       const std::size_t hits =
           l.kernels.evaluate_tiles(tiles, &kernel_query, 1, scratch.tile_ids.data(), tile_count, scratch.hits.data());
       rows += group_rows;
       for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q);
+    };
+    std::vector<std::pair<float, std::uint32_t>>& order = scratch.group_order;
+    if (order.empty()) continue;
+    // Visit the most promising group first: its rows usually set a k-th
+    // best that rules out most groups, so only the rest need sorting.
+    const auto seed = std::min_element(order.begin(), order.end());
+    const std::uint32_t seed_group = seed->second;
+    *seed = order.back();
+    order.pop_back();
+    visit(seed_group);
+    const float worst = list[k - 1].cost;
+    order.erase(std::remove_if(order.begin(), order.end(), [&](const auto& entry) { return entry.first > worst; }),
+                order.end());
+    std::sort(order.begin(), order.end());
+    for (const auto& [group_bound, group] : order) {
+      if (group_bound > list[k - 1].cost) break;
+      visit(group);
     }
   }
   thread_rows_[thread] += rows;

@@ -86,8 +86,7 @@ class BackendDataSuite : public ::testing::Test {
              std::size_t count, std::uint32_t k) {
     Result<std::unique_ptr<SearchBackend>> backend = factory_.make(db);
     ASSERT_TRUE(backend.ok()) << backend.message();
-    ReferenceSearch reference(db);
-    const std::vector<Match> expected = run_search(reference, features, params, count, k);
+    const std::vector<Match> expected = reference_results(db, features, params, count, k);
     const std::vector<Match> actual = run_search(**backend, features, params, count, k);
     expect_identical(expected, actual, k, params, (*backend)->name());
   }

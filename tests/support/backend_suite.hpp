@@ -69,8 +69,7 @@ class BackendSuite : public ::testing::Test {
              std::size_t count, std::uint32_t k) {
     std::unique_ptr<SearchBackend> backend = make(db);
     ASSERT_NE(backend, nullptr);
-    ReferenceSearch reference(db);
-    const std::vector<Match> expected = run_search(reference, features, params, count, k);
+    const std::vector<Match> expected = reference_results(db, features, params, count, k);
     const std::vector<Match> actual = run_search(*backend, features, params, count, k);
     expect_identical(expected, actual, k, params, backend->name());
   }
@@ -81,7 +80,7 @@ class BackendSuite : public ::testing::Test {
 TYPED_TEST_SUITE_P(BackendSuite);
 
 TYPED_TEST_P(BackendSuite, RandomDataMatchesReference) {
-  const Database db = synthetic_database({.frames = 3000, .seed = 11});
+  const Database db = synthetic_database({.frames = 2000, .seed = 11});
   const std::vector<float> queries = synthetic_queries(db, 64, 12);
   this->check(db, queries, {}, 64, 1);
   this->check(db, queries, {}, 64, 5);
@@ -135,8 +134,7 @@ TYPED_TEST_P(BackendSuite, FlagsAreNeverResultsUnlessContinued) {
   params[0].continuing_bias = -1000.0f;
   const std::vector<Match> not_usable = run_search(*backend, queries, params, 3, 4);
   EXPECT_NE(not_usable[0].frame, frames[0]);
-  ReferenceSearch reference(db);
-  expect_identical(run_search(reference, queries, params, 3, 4), not_usable, 4, params, backend->name());
+  expect_identical(reference_results(db, queries, params, 3, 4), not_usable, 4, params, backend->name());
 }
 
 TYPED_TEST_P(BackendSuite, BlockTransitionWithAndWithoutContinuingFrame) {
@@ -160,7 +158,6 @@ TYPED_TEST_P(BackendSuite, TagMasks) {
   const std::vector<float> queries = synthetic_queries(db, 16, 22);
   std::unique_ptr<SearchBackend> backend = this->make(db);
   ASSERT_NE(backend, nullptr);
-  ReferenceSearch reference(db);
   const std::vector<std::pair<TagMask, TagMask>> masks = {
       {kTagWalk, 0}, {kTagRun, 0}, {kTagIdle | kTagRun, 0}, {0, kTagRun}, {0, kTagWalk | kTagIdle}, {kTagWalk, kTagRare}};
   for (const auto& [require, exclude] : masks) {
@@ -176,7 +173,7 @@ TYPED_TEST_P(BackendSuite, TagMasks) {
       EXPECT_EQ(tags & require, require);
       EXPECT_EQ(tags & exclude, 0u);
     }
-    expect_identical(run_search(reference, queries, params, 16, 4), out, 4, params, backend->name());
+    expect_identical(reference_results(db, queries, params, 16, 4), out, 4, params, backend->name());
   }
 }
 
@@ -210,8 +207,7 @@ TYPED_TEST_P(BackendSuite, ExclusionWindowWrapsInLoopingClips) {
   EXPECT_EQ(out[2].frame, wrapped_target);
   EXPECT_NE(out[4].frame, straight_target);
   EXPECT_EQ(out[6].frame, straight_target);
-  ReferenceSearch reference(db);
-  expect_identical(run_search(reference, queries, params, 4, 2), out, 2, params, backend->name());
+  expect_identical(reference_results(db, queries, params, 4, 2), out, 2, params, backend->name());
   // The continuing frame itself stays a candidate inside its window.
   std::vector<float> self(db.row(params[0].continuing_frame).begin(), db.row(params[0].continuing_frame).end());
   QueryParams p = params[0];
@@ -253,9 +249,8 @@ TYPED_TEST_P(BackendSuite, ContinuingBiasNegativeAndPositive) {
     EXPECT_EQ(stayed[q * 2].frame, stay[q].continuing_frame);
     for (std::size_t r = 0; r < 16; ++r) EXPECT_NE(left[q * 16 + r].frame, leave[q].continuing_frame);
   }
-  ReferenceSearch reference(db);
-  expect_identical(run_search(reference, queries, stay, 8, 2), stayed, 2, stay, backend->name());
-  expect_identical(run_search(reference, queries, leave, 8, 16), left, 16, leave, backend->name());
+  expect_identical(reference_results(db, queries, stay, 8, 2), stayed, 2, stay, backend->name());
+  expect_identical(reference_results(db, queries, leave, 8, 16), left, 16, leave, backend->name());
   // Small biases of both signs, where the continuing frame competes.
   std::vector<QueryParams> close(8);
   for (std::size_t q = 0; q < 8; ++q) {
@@ -318,9 +313,8 @@ TYPED_TEST_P(BackendSuite, TiesGoToTheLowerFrameId) {
   }
   // A near copy: ties at a non-zero cost, still by frame id.
   for (float& v : query) v += 0.125f;
-  ReferenceSearch reference(db);
   const std::vector<Match> shifted = run_search(*backend, query, {}, 1, 6);
-  expect_identical(run_search(reference, query, {}, 1, 6), shifted, 6, {}, backend->name());
+  expect_identical(reference_results(db, query, {}, 1, 6), shifted, 6, {}, backend->name());
   EXPECT_EQ(shifted[0].frame, 40u);
   // All weights 0: every frame costs +0; the best k are frames 0..k-1.
   QueryParams flat;
@@ -354,8 +348,7 @@ TYPED_TEST_P(BackendSuite, KGreaterThanOneAndNonePadding) {
       }
     }
   }
-  ReferenceSearch reference(db);
-  expect_identical(run_search(reference, queries, params, 32, 16), out, 16, params, backend->name());
+  expect_identical(reference_results(db, queries, params, 32, 16), out, 16, params, backend->name());
 }
 
 TYPED_TEST_P(BackendSuite, NoCandidateReturnsNone) {
@@ -373,7 +366,7 @@ TYPED_TEST_P(BackendSuite, NoCandidateReturnsNone) {
 }
 
 TYPED_TEST_P(BackendSuite, BatchSizes) {
-  const Database db = synthetic_database({.frames = 4000, .clips = 20, .seed = 37, .constraints = true});
+  const Database db = synthetic_database({.frames = 2500, .clips = 20, .seed = 37, .constraints = true});
   for (std::size_t count : {std::size_t{1}, std::size_t{7}, std::size_t{64}, std::size_t{1024}}) {
     SCOPED_TRACE("batch size " + std::to_string(count));
     const std::vector<float> queries = synthetic_queries(db, count, 38 + count);
@@ -385,11 +378,11 @@ TYPED_TEST_P(BackendSuite, BatchSizes) {
 
 TYPED_TEST_P(BackendSuite, RandomParamsAndKMatchReference) {
   const Database db = synthetic_database({.frames = 3000, .seed = 41, .constraints = true});
-  const std::vector<float> queries = synthetic_queries(db, 128, 42);
-  const std::vector<QueryParams> params = random_params(db, 128, 43);
+  const std::vector<float> queries = synthetic_queries(db, 64, 42);
+  const std::vector<QueryParams> params = random_params(db, 64, 43);
   for (std::uint32_t k : {1u, 2u, 7u, 16u}) {
     SCOPED_TRACE("k = " + std::to_string(k));
-    this->check(db, queries, params, 128, k);
+    this->check(db, queries, params, 64, k);
   }
 }
 

@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "mmvk/reference_search.hpp"
 
 #include "mmvk/database.hpp"
 #include "mmvk/search.hpp"
@@ -193,6 +196,34 @@ inline std::vector<Match> run_search(SearchBackend& backend, std::span<const flo
   const Status status = backend.search(QueryBatch{features, params, count}, k, out);
   EXPECT_TRUE(status.ok()) << backend.name() << ": " << (status.ok() ? "" : status.message());
   return out;
+}
+
+// ReferenceSearch's results, memoized per test program: every backend
+// instantiation of a suite compares against the same reference answers,
+// which then cost one reference search instead of one per backend.
+inline std::vector<Match> reference_results(const Database& db, std::span<const float> features,
+                                            std::span<const QueryParams> params, std::size_t count, std::uint32_t k) {
+  std::string key;
+  auto add = [&key](const void* data, std::size_t size) { key.append(static_cast<const char*>(data), size); };
+  const std::uint64_t hash = db.content_hash();
+  add(&hash, sizeof(hash));
+  add(&count, sizeof(count));
+  add(&k, sizeof(k));
+  add(features.data(), features.size_bytes());
+  for (const QueryParams& p : params) {  // field by field: no padding bytes
+    add(&p.continuing_frame, sizeof(p.continuing_frame));
+    add(&p.continuing_bias, sizeof(p.continuing_bias));
+    add(&p.exclusion_window, sizeof(p.exclusion_window));
+    add(&p.require_all, sizeof(p.require_all));
+    add(&p.exclude_any, sizeof(p.exclude_any));
+    add(p.channel_weights.data(), sizeof(p.channel_weights));
+  }
+  static std::map<std::string, std::vector<Match>> cache;
+  auto found = cache.find(key);
+  if (found != cache.end()) return found->second;
+  ReferenceSearch reference(db);
+  std::vector<Match> out = run_search(reference, features, params, count, k);
+  return cache.emplace(std::move(key), std::move(out)).first->second;
 }
 
 // The same frames and bit-identical costs, slot by slot.

@@ -37,7 +37,7 @@ struct ClusterBound {
 
 struct Scratch {
   std::vector<ClusterBound> order;
-  std::vector<float> total, box;              // [max(clusters, tiles per cluster), padded to 8]
+  std::vector<float> total, box, distance;    // [max(clusters, tiles per cluster), padded to 8]
   std::vector<double> radius_sum, radius_total;  // [clusters]
   std::uint64_t rows = 0;
   ClusterSearchCounters counters;
@@ -115,7 +115,8 @@ struct ClusterSearch::Layout {
   std::uint32_t max_cluster_tiles = 0;
   std::vector<float> cluster_lo;             // [dims x pad8(clusters)] (table.box_min transposed)
   std::vector<float> cluster_hi;             // [dims x pad8(clusters)]
-  std::vector<float> centroid_t;             // [dims x clusters]
+  std::vector<float> centroid_t;             // [dims x pad8(clusters)]
+  std::vector<float> ones;                   // [clusters]: unit multipliers for centroid distances
   std::vector<float> radius_t;               // [channels x clusters]
   std::vector<bool> never_candidate;         // [clusters]: empty or all members excluded by flags
   double radius_margin = 0.0;
@@ -204,13 +205,14 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   const std::size_t k8 = pad8(k);
   l.cluster_lo.assign(k8 * l.dims, 0.0f);
   l.cluster_hi.assign(k8 * l.dims, 0.0f);
-  l.centroid_t.resize(std::size_t{k} * l.dims);
+  l.centroid_t.assign(k8 * l.dims, 0.0f);
+  l.ones.assign(k, 1.0f);
   l.radius_t.resize(std::size_t{k} * l.channels);
   for (std::uint32_t c = 0; c < k; ++c) {
     for (std::uint32_t d = 0; d < l.dims; ++d) {
       l.cluster_lo[d * k8 + c] = table.box_min[std::size_t{c} * l.dims + d];
       l.cluster_hi[d * k8 + c] = table.box_max[std::size_t{c} * l.dims + d];
-      l.centroid_t[std::size_t{d} * k + c] = table.centroids[std::size_t{c} * l.dims + d];
+      l.centroid_t[d * k8 + c] = table.centroids[std::size_t{c} * l.dims + d];
     }
     for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
       l.radius_t[std::size_t{ch} * k + c] = table.channel_radius[std::size_t{c} * l.channels + ch];
@@ -222,6 +224,7 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.order.reserve(k);
     s.total.resize(width);
     s.box.resize(width);
+    s.distance.resize(width);
     s.radius_sum.resize(k);
     s.radius_total.resize(k);
   }
@@ -289,7 +292,7 @@ void radius_bounds(const ClusterSearch::Layout& l, const float* q, const float* 
     std::fill_n(sum, n, 0.0);
     for (std::uint32_t d = l.channel_begin[ch]; d < l.channel_end[ch]; ++d) {
       const double qd = q[d];
-      const float* centroid_d = l.centroid_t.data() + std::size_t{d} * n;
+      const float* centroid_d = l.centroid_t.data() + std::size_t{d} * pad8(n);
       for (std::size_t i = 0; i < n; ++i) {
         const double diff = qd - double(centroid_d[i]);
         sum[i] += diff * diff;
@@ -310,20 +313,6 @@ void radius_bounds(const ClusterSearch::Layout& l, const float* q, const float* 
     if (double(down) > bound) down = std::nextafter(down, 0.0f);
     out[i] = std::max(out[i], down);
   }
-}
-
-float centroid_distance(const ClusterSearch::Layout& l, std::uint32_t c, const float* q, const float* w) {
-  const float* centroid = l.table.centroids.data() + std::size_t{c} * l.dims;
-  float total = 0.0f;
-  for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
-    float sum = 0.0f;
-    for (std::uint32_t d = l.channel_begin[ch]; d < l.channel_end[ch]; ++d) {
-      const float diff = centroid[d] - q[d];
-      sum += diff * diff;
-    }
-    total += w[ch] * sum;
-  }
-  return total;
 }
 
 }  // namespace
@@ -365,7 +354,11 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         s.order.push_back({0.0f, c});
       }
       if (options.nprobe != 0 && options.nprobe < s.order.size()) {
-        for (ClusterBound& b : s.order) b.bound = centroid_distance(l, b.cluster, q, w);
+        // Channel-weighted squared centroid distances: a box bound of the
+        // zero-size boxes [centroid, centroid] with unit multipliers.
+        box_bounds(l, l.centroid_t.data(), l.centroid_t.data(), pad8(t.cluster_count), t.cluster_count, l.ones.data(), q,
+                   w, s, s.distance.data());
+        for (ClusterBound& b : s.order) b.bound = s.distance[b.cluster];
         std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
         s.order.resize(options.nprobe);
       }

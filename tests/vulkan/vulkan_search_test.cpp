@@ -286,7 +286,10 @@ TEST(VulkanContext, ExplicitIndexAndAdoption) {
 TEST(VulkanContext, ValidationCollectsMessages) {
   MMVK_VULKAN_CONTEXT(context, validation_options());
   const Database db = synthetic_database({.frames = 3000, .seed = 119, .constraints = true});
-  std::unique_ptr<VulkanSearch> search = make_search(*context, db, search_options(16, 16, 4));
+  // The staging upload (discrete GPUs' path) under synchronization validation.
+  VulkanSearchOptions options = search_options(16, 16, 4);
+  options.force_staging_upload = true;
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
   ASSERT_NE(search, nullptr);
   const std::vector<float> queries = synthetic_queries(db, 16, 120);
   compare(*search, db, queries, random_params(db, 16, 121), 16, 5);

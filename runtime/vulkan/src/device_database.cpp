@@ -16,7 +16,8 @@ std::span<const std::byte> bytes_of(const std::vector<T>& values) {
 }
 
 Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool, VkFormat format,
-                                      std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what) {
+                                      std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
+                                      bool force_staging) {
   const std::uint64_t texels = data.size() / texel_bytes;
   const VkPhysicalDeviceLimits& limits = context.properties().limits;
   if (texels > limits.maxTexelBufferElements) {
@@ -33,6 +34,10 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
                                         VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                         MemoryUse::DeviceLocal, what);
   if (!buffer) return buffer.error();
+  if (force_staging && buffer->mapped != nullptr) {
+    vkUnmapMemory(context.device(), buffer->memory.get());
+    buffer->mapped = nullptr;
+  }
   MMVK_TRY(upload(context, pool, *buffer, data));
 
   VkBufferViewCreateInfo info{};
@@ -51,7 +56,8 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
 
 }  // namespace
 
-Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database) {
+Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
+                                       bool force_staging) {
   DeviceDatabase device;
   device.frame_count = database.frame_count();
   device.dims = database.dims();
@@ -67,7 +73,7 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
       for (std::size_t d = 0; d < device.dims; ++d) features[f * padded + d] = source[f * device.dims + d];
     }
     Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(features),
-                                                   "the feature matrix");
+                                                   "the feature matrix", force_staging);
     if (!buffer) return buffer.error();
     device.features = std::move(*buffer);
   }
@@ -79,7 +85,8 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
                  database.frame_clip()[f]};
     }
     Result<TexelBuffer> buffer =
-        make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(meta), "the frame metadata");
+        make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(meta), "the frame metadata",
+                          force_staging);
     if (!buffer) return buffer.error();
     device.frame_meta = std::move(*buffer);
   }
@@ -87,7 +94,8 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
     std::vector<std::array<float, 2>> cost(frames);
     for (std::size_t f = 0; f < frames; ++f) cost[f] = {database.frame_multiplier()[f], database.frame_bias()[f]};
     Result<TexelBuffer> buffer =
-        make_texel_buffer(context, pool, VK_FORMAT_R32G32_SFLOAT, 8, bytes_of(cost), "the frame cost terms");
+        make_texel_buffer(context, pool, VK_FORMAT_R32G32_SFLOAT, 8, bytes_of(cost), "the frame cost terms",
+                          force_staging);
     if (!buffer) return buffer.error();
     device.frame_cost = std::move(*buffer);
   }

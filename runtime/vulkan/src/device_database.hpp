@@ -31,6 +31,8 @@ struct DeviceDatabase {
   TexelBuffer frame_cost;
 };
 
-Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database);
+// force_staging: copy through a staging buffer even into mappable memory.
+Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
+                                       bool force_staging);
 
 }  // namespace mmvk::vulkan::detail

@@ -331,7 +331,8 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
   }
 
   MMVK_TRY(impl->create_layouts());
-  Result<DeviceDatabase> device_database = upload_database(context, impl->command_pool.get(), database);
+  Result<DeviceDatabase> device_database =
+      upload_database(context, impl->command_pool.get(), database, options.force_staging_upload);
   if (!device_database) return device_database.error();
   impl->device_database = std::move(*device_database);
   Result<BruteForceKernel> kernel =

@@ -57,6 +57,10 @@ struct VulkanSearchOptions {
   // Runs every kernel variant once at creation: drivers such as lavapipe
   // compile at the first dispatch, which would otherwise land in a search.
   bool warm_up = true;
+  // Uploads the database through a staging buffer and a copy even when the
+  // device-local memory is host-visible (unified memory, lavapipe), so the
+  // path discrete GPUs take can be tested anywhere.
+  bool force_staging_upload = false;
 };
 
 // A submitted batch; valid until wait() consumed it.

@@ -1,5 +1,6 @@
 // mmvk query: batched search from a file of query vectors, one result line
 // per query, so anyone can check the engine against their own brute force.
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cstdio>
@@ -20,6 +21,11 @@
 #include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
 
+#if defined(MMVK_HAS_VULKAN)
+#include "mmvk/vulkan/context.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#endif
+
 namespace mmvk::cli {
 
 namespace {
@@ -36,8 +42,9 @@ constexpr const char* kQueryUsage =
     "\n"
     "backends: reference (the CPU oracle), fast (exact, box-pruned, default),\n"
     "  fast-brute (exact brute force), clusters (exact, k-means cluster-pruned),\n"
-    "  nprobe (approximate: --nprobe N nearest clusters, default 4), vulkan.\n"
-    "  clusters/nprobe load --clusters table.mmkc when given, else train the\n"
+    "  nprobe (approximate: --nprobe N nearest clusters, default 4), and on the\n"
+    "  GPU vulkan (exact brute force), vulkan-clusters, vulkan-nprobe.\n"
+    "  The cluster backends load --clusters table.mmkc when given, else train the\n"
     "  tables with the default k-means parameters.\n"
     "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores.\n"
     "\n"
@@ -106,43 +113,88 @@ Result<std::vector<float>> read_queries(const std::string& path, std::uint32_t d
 struct BackendHolder {
   ThreadPool pool;
   ClusterTable table;
+#if defined(MMVK_HAS_VULKAN)
+  std::unique_ptr<vulkan::Context> context;  // declared before the backend that uses it
+#endif
   std::unique_ptr<SearchBackend> backend;
   explicit BackendHolder(unsigned threads) : pool(threads) {}
 };
 
-Status make_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args) {
+Status load_or_train_clusters(BackendHolder& holder, const Database& db, const ParsedArgs& args) {
+  if (const auto path = args.value("--clusters")) {
+    Result<ClusterTable> table = load_cluster_table(*path);
+    if (!table) return table.status();
+    holder.table = std::move(table.value());
+    return {};
+  }
+  std::fputs("mmvk query: training k-means cluster tables (default parameters; pass --clusters to reuse)\n", stderr);
+  Result<ClusterTable> table = train_cluster_table(db, KMeansParams{});
+  if (!table) return table.status();
+  holder.table = std::move(table.value());
+  return {};
+}
+
+Result<std::uint32_t> nprobe_option(const ParsedArgs& args) {
+  std::uint32_t nprobe = 4;
+  if (const auto text = args.value("--nprobe")) {
+    const auto value = parse_unsigned("--nprobe", *text);
+    if (!value || *value == 0) return make_error("--nprobe must be a positive integer");
+    nprobe = static_cast<std::uint32_t>(*value);
+  }
+  return nprobe;
+}
+
+#if defined(MMVK_HAS_VULKAN)
+Status make_vulkan_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args,
+                           std::size_t batch) {
+  vulkan::VulkanSearchOptions options;
+  options.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
+  const ClusterTable* clusters = nullptr;
+  if (name != "vulkan") {
+    MMVK_TRY(load_or_train_clusters(holder, db, args));
+    clusters = &holder.table;
+    options.mode = name == "vulkan-clusters" ? vulkan::SearchMode::ClustersExact : vulkan::SearchMode::NProbe;
+    Result<std::uint32_t> nprobe = nprobe_option(args);
+    if (!nprobe) return nprobe.status();
+    options.nprobe = *nprobe;
+  }
+  Result<std::unique_ptr<vulkan::Context>> context = vulkan::Context::create();
+  if (!context) return context.status();
+  holder.context = std::move(context.value());
+  Result<std::unique_ptr<vulkan::VulkanSearch>> made = vulkan::VulkanSearch::create(*holder.context, db, options, clusters);
+  if (!made) return made.status();
+  holder.backend = std::move(made.value());
+  return {};
+}
+#endif
+
+Status make_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args,
+                    std::size_t batch) {
   if (name == "reference") {
     holder.backend = std::make_unique<ReferenceSearch>(db);
   } else if (name == "fast" || name == "fast-brute") {
     holder.backend = std::make_unique<FastSearch>(db, holder.pool, FastSearchOptions{.prune = name == "fast"});
   } else if (name == "clusters" || name == "nprobe") {
-    if (const auto path = args.value("--clusters")) {
-      Result<ClusterTable> table = load_cluster_table(*path);
-      if (!table) return table.status();
-      holder.table = std::move(table.value());
-    } else {
-      std::fputs("mmvk query: training k-means cluster tables (default parameters; pass --clusters to reuse)\n",
-                 stderr);
-      Result<ClusterTable> table = train_cluster_table(db, KMeansParams{});
-      if (!table) return table.status();
-      holder.table = std::move(table.value());
-    }
+    MMVK_TRY(load_or_train_clusters(holder, db, args));
     ClusterSearchOptions options;
     if (name == "nprobe") {
-      options.nprobe = 4;
-      if (const auto text = args.value("--nprobe")) {
-        const auto nprobe = parse_unsigned("--nprobe", *text);
-        if (!nprobe || *nprobe == 0) return make_error("--nprobe must be a positive integer");
-        options.nprobe = static_cast<std::uint32_t>(*nprobe);
-      }
+      Result<std::uint32_t> nprobe = nprobe_option(args);
+      if (!nprobe) return nprobe.status();
+      options.nprobe = *nprobe;
     }
     Result<std::unique_ptr<ClusterSearch>> made = ClusterSearch::create(db, holder.table, holder.pool, options);
     if (!made) return made.status();
     holder.backend = std::move(made.value());
-  } else if (name == "vulkan") {
-    return make_error("backend 'vulkan' is not available in this build of mmvk query yet");
+  } else if (name == "vulkan" || name == "vulkan-clusters" || name == "vulkan-nprobe") {
+#if defined(MMVK_HAS_VULKAN)
+    return make_vulkan_backend(holder, db, name, args, batch);
+#else
+    (void)batch;
+    return make_error("backend '" + name + "': this mmvk was built without Vulkan (MMVK_BUILD_VULKAN=OFF)");
+#endif
   } else {
-    return make_error("unknown backend '" + name + "' (reference, fast, fast-brute, clusters, nprobe, vulkan)");
+    return make_error("unknown backend '" + name +
+                      "' (reference, fast, fast-brute, clusters, nprobe, vulkan, vulkan-clusters, vulkan-nprobe)");
   }
   return {};
 }
@@ -255,7 +307,7 @@ int run_query(Args args) {
 
   BackendHolder holder(static_cast<unsigned>(threads));
   const std::string backend_name = parsed->value("--backend").value_or("fast");
-  if (Status made = make_backend(holder, *db, backend_name, *parsed); !made) return fail(made.message());
+  if (Status made = make_backend(holder, *db, backend_name, *parsed, count); !made) return fail(made.message());
   std::vector<Match> results(count * k);
   const auto start = std::chrono::steady_clock::now();
   const Status searched =

@@ -254,19 +254,13 @@ TEST(DatabaseBuild, CustomChannelsComeFromSidecarFiles) {
   EXPECT_NE(broken.message().find("walk.phase.f32: 12 bytes"), std::string::npos) << broken.message();
 }
 
-// The mmvk binary beside this test's build folder (host/mmvk).
-std::filesystem::path mmvk_binary() {
-  std::error_code error;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
-  return self.parent_path().parent_path() / "host" / "mmvk";
-}
-
 int run(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()); }
 
 TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   MMVK_REQUIRE_DATA_DIR(data);
-  const auto mmvk = mmvk_binary();
-  if (!std::filesystem::exists(mmvk)) GTEST_SKIP() << mmvk << " not built (MMVK_BUILD_HOST=OFF)";
+  const auto cli = test::cli_binary();
+  if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
+  const std::filesystem::path mmvk = *cli;
   const auto dir = test::make_temp_dir();
   const std::string walk = bandai(data, "dataset-2_walk_normal_003").string();
   const std::string turn = bandai(data, "dataset-2_walk-turn-left_normal_001").string();

@@ -20,6 +20,14 @@ std::optional<std::filesystem::path> find_data_dir() {
 
 std::filesystem::path test_source_dir() { return MMVK_TEST_SOURCE_DIR; }
 
+std::optional<std::filesystem::path> cli_binary() {
+#if defined(MMVK_CLI_PATH)
+  return std::filesystem::path(MMVK_CLI_PATH);
+#else
+  return std::nullopt;
+#endif
+}
+
 std::filesystem::path make_temp_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = "mmvk-test-" + std::to_string(::getpid());

@@ -17,6 +17,10 @@ std::optional<std::filesystem::path> find_data_dir();
 // tests/ in the source tree (for the malformed-BVH corpus and fixtures).
 std::filesystem::path test_source_dir();
 
+// The built `mmvk` command line, or nullopt when the build has no host
+// programs (MMVK_BUILD_HOST=OFF).
+std::optional<std::filesystem::path> cli_binary();
+
 // A fresh, empty temporary directory unique to the running test.
 std::filesystem::path make_temp_dir();
 

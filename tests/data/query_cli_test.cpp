@@ -1,0 +1,136 @@
+// `mmvk query` end to end on a real database: every exact backend writes the
+// same result lines as the reference, and bad query files get clear errors.
+#include <cstdio>
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "support/test_data.hpp"
+
+namespace mmvk {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = 0;
+  std::string output;  // stdout and stderr together
+};
+
+CommandResult run(const std::string& command) {
+  CommandResult result;
+  std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  char buffer[4096];
+  while (std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, n);
+  result.exit_code = ::pclose(pipe);
+  return result;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The result lines without the '#' comments (which name the backend).
+std::string result_lines(const fs::path& path) {
+  std::istringstream in(read_text(path));
+  std::string line, kept;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line[0] != '#') kept += line + "\n";
+  }
+  return kept;
+}
+
+class QueryCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto data = test::find_data_dir();
+    if (!data) GTEST_SKIP() << "motion data not found (set MMVK_DATA)";
+    const auto cli = test::cli_binary();
+    if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
+    mmvk_ = cli->string();
+    dir_ = test::make_temp_dir();
+    db_ = (dir_ / "walks.mmdb").string();
+    const fs::path walks = *data / "bandai-namco-nc" / "locomotion-normal";
+    std::ofstream(dir_ / "m.json") << R"({"mirror": true, "clips": [)"
+                                   << R"({"file": ")" << (walks / "dataset-2_walk_normal_001.bvh").string() << R"("},)"
+                                   << R"({"file": ")" << (walks / "dataset-2_run_normal_001.bvh").string() << R"("}]})";
+    const CommandResult built = run(mmvk_ + " build " + (dir_ / "m.json").string() + " -o " + db_);
+    ASSERT_EQ(built.exit_code, 0) << built.output;
+    const CommandResult exported = run(mmvk_ + " export " + db_ + " --features " + (dir_ / "features.f32").string());
+    ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  }
+
+  // Queries: exported (normalized) rows plus noise, so minima are unique.
+  fs::path write_queries(std::size_t count, std::uint32_t dims) {
+    const std::string bytes = read_text(dir_ / "features.f32");
+    const std::size_t frames = bytes.size() / (4 * dims);
+    std::vector<float> rows(bytes.size() / 4);
+    std::memcpy(rows.data(), bytes.data(), rows.size() * 4);
+    std::mt19937 random(5);
+    std::vector<float> queries;
+    for (std::size_t q = 0; q < count; ++q) {
+      const std::size_t frame = random() % frames;
+      for (std::uint32_t d = 0; d < dims; ++d) {
+        queries.push_back(rows[frame * dims + d] + float(int(random() % 2001) - 1000) * 1e-4f);
+      }
+    }
+    const fs::path path = dir_ / "queries.f32";
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(queries.data()),
+                                                 std::streamsize(queries.size() * 4));
+    return path;
+  }
+
+  std::string mmvk_;
+  fs::path dir_;
+  std::string db_;
+};
+
+TEST_F(QueryCli, ExactBackendsWriteTheReferenceResults) {
+  const fs::path queries = write_queries(23, 27);
+  const std::string common = mmvk_ + " query " + db_ + " --queries " + queries.string() + " --normalized --k 5";
+  const CommandResult reference = run(common + " --backend reference --out " + (dir_ / "reference.tsv").string());
+  ASSERT_EQ(reference.exit_code, 0) << reference.output;
+  const std::string expected = result_lines(dir_ / "reference.tsv");
+  ASSERT_EQ(std::count(expected.begin(), expected.end(), '\n'), 23);
+  std::vector<std::string> backends = {"fast", "fast-brute", "clusters"};
+  // CI sets MMVK_REQUIRE_VULKAN=1; elsewhere a machine may have no device.
+  const char* require_vulkan = std::getenv("MMVK_REQUIRE_VULKAN");
+  if (require_vulkan && std::string(require_vulkan) == "1") backends.push_back("vulkan");
+  for (const std::string& backend : backends) {
+    const fs::path out = dir_ / (backend + ".tsv");
+    const CommandResult result = run(common + " --backend " + backend + " --out " + out.string());
+    ASSERT_EQ(result.exit_code, 0) << backend << ": " << result.output;
+    EXPECT_EQ(result_lines(out), expected) << backend;
+  }
+}
+
+TEST_F(QueryCli, BadQueryFilesAreNamed) {
+  const fs::path queries = dir_ / "short.f32";
+  std::ofstream(queries, std::ios::binary) << std::string(4 * 27 + 2, '\0');
+  const CommandResult result = run(mmvk_ + " query " + db_ + " --queries " + queries.string() + " --normalized");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("short.f32"), std::string::npos) << result.output;
+
+  const CommandResult bad_k = run(mmvk_ + " query " + db_ + " --queries " + write_queries(1, 27).string() + " --k 17");
+  EXPECT_NE(bad_k.exit_code, 0);
+  EXPECT_NE(bad_k.output.find("k"), std::string::npos) << bad_k.output;
+
+  const CommandResult bad_backend = run(mmvk_ + " query " + db_ + " --queries " + write_queries(1, 27).string() +
+                                        " --backend nonsense");
+  EXPECT_NE(bad_backend.exit_code, 0);
+  EXPECT_NE(bad_backend.output.find("unknown backend 'nonsense'"), std::string::npos) << bad_backend.output;
+}
+
+}  // namespace
+}  // namespace mmvk

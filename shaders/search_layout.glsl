@@ -28,7 +28,9 @@ struct QueryGpu {
   uint pad0;
 };
 
-// gpu_layout.hpp: SearchPush (32 bytes).
+// gpu_layout.hpp: SearchPush (32 bytes). Kernels with their own push
+// constants (the cluster kernels) define MMVK_SEARCH_LAYOUT_OWN_PUSH.
+#ifndef MMVK_SEARCH_LAYOUT_OWN_PUSH
 layout(push_constant) uniform SearchPush {
   uint frame_count;
   uint rows_per_invocation;
@@ -39,6 +41,7 @@ layout(push_constant) uniform SearchPush {
   uint pad1;
   uint pad2;
 } pc;
+#endif
 
 // [frames x dims/4] texels: the feature matrix, dims padded to 4 with zeros.
 layout(set = 0, binding = 0) uniform samplerBuffer features;

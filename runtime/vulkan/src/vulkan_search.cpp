@@ -8,6 +8,7 @@
 
 #include "brute_force_kernel.hpp"
 #include "check.hpp"
+#include "cluster_kernel.hpp"
 #include "device_database.hpp"
 #include "gpu_layout.hpp"
 #include "memory.hpp"
@@ -66,6 +67,7 @@ struct VulkanSearch::Impl {
   DeviceDatabase device_database;
   BruteForceKernel kernel;
   std::vector<Slot> slots;
+  std::optional<ClusterKernel> clusters;  // ClustersExact and NProbe modes
 
   ~Impl() {
     // Nothing may be destroyed while the GPU still uses it.
@@ -277,7 +279,10 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
   }
   if (options.mode != SearchMode::BruteForce) {
     if (clusters == nullptr) return make_error("VulkanSearch: cluster modes need a ClusterTable");
-    return make_error("VulkanSearch: cluster modes are not implemented yet in the Vulkan backend");
+    MMVK_TRY(validate_cluster_table(*clusters, database));
+    if (options.mode == SearchMode::NProbe && options.nprobe == 0) {
+      return make_error("VulkanSearch: nprobe must be >= 1 in NProbe mode");
+    }
   }
 
   auto impl = std::make_unique<Impl>();
@@ -341,11 +346,29 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
   if (!kernel) return kernel.error();
   impl->kernel = std::move(*kernel);
   MMVK_TRY(impl->create_slots());
+  if (options.mode != SearchMode::BruteForce) {
+    ClusterKernelOptions cluster_options;
+    cluster_options.max_batch = options.max_batch;
+    cluster_options.max_k = options.max_k;
+    cluster_options.slots = options.slots;
+    cluster_options.nprobe = options.mode == SearchMode::NProbe ? options.nprobe : 0;
+    cluster_options.scratch_bytes = options.scratch_bytes;
+    cluster_options.force_staging = options.force_staging_upload;
+    Result<ClusterKernel> cluster_kernel = ClusterKernel::create(
+        context, impl->command_pool.get(), impl->set_layout.get(), shape, database, *clusters, cluster_options);
+    if (!cluster_kernel) return cluster_kernel.error();
+    impl->clusters.emplace(std::move(*cluster_kernel));
+  }
 
   if (options.warm_up) {
     // One dispatch of every variant: lavapipe compiles at the first one.
     std::vector<float> queries;
-    for (const auto& [kc, tile] : impl->kernel.variant_keys()) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> variants = impl->kernel.variant_keys();
+    if (impl->clusters) {
+      variants.clear();
+      for (const std::uint32_t kc : impl->clusters->k_classes()) variants.emplace_back(kc, 1);
+    }
+    for (const auto& [kc, tile] : variants) {
       queries.assign(database.features().begin(), database.features().begin() + database.dims());
       std::vector<float> batch_features;
       for (std::uint32_t t = 0; t < tile; ++t) batch_features.insert(batch_features.end(), queries.begin(), queries.end());
@@ -364,7 +387,14 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
 VulkanSearch::VulkanSearch(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 VulkanSearch::~VulkanSearch() = default;
 
-std::string_view VulkanSearch::name() const { return "vulkan-brute-force"; }
+std::string_view VulkanSearch::name() const {
+  switch (impl_->options.mode) {
+    case SearchMode::ClustersExact: return "vulkan-clusters";
+    case SearchMode::NProbe: return "vulkan-nprobe";
+    case SearchMode::BruteForce: break;
+  }
+  return "vulkan-brute-force";
+}
 const Database& VulkanSearch::database() const { return *impl_->database; }
 SearchStats VulkanSearch::stats() const { return impl_->stats; }
 void VulkanSearch::reset_stats() { impl_->stats = {}; }
@@ -448,7 +478,9 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
   }
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.get(), 0, 1, &slot.descriptors, 0,
                           nullptr);
-  const Status recorded = kernel.record(*context, commands, pipeline_layout.get(), count, k, chunk, forced_tile);
+  const Status recorded =
+      clusters ? clusters->record(*context, commands, slot_index, slot.descriptors, count, k)
+               : kernel.record(*context, commands, pipeline_layout.get(), count, k, chunk, forced_tile);
   if (!recorded) {
     vkEndCommandBuffer(commands);
     return recorded.error();
@@ -474,7 +506,8 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
   MMVK_VK_CHECK(vkQueueSubmit(context->queue(), 1, &submit_info, fence));
   slot.in_flight = true;
   stats.queries += count;
-  stats.rows_evaluated += std::uint64_t{count} * shape.frame_count;
+  // Cluster modes count their rows on the GPU (added in wait()).
+  if (!clusters) stats.rows_evaluated += std::uint64_t{count} * shape.frame_count;
   return Ticket{slot_index, slot.serial};
 }
 
@@ -528,6 +561,7 @@ Status VulkanSearch::Impl::wait(const Ticket& ticket, std::span<Match> out) {
     last_kernel_seconds = double(elapsed) * context->properties().limits.timestampPeriod * 1e-9;
   }
 
+  if (clusters) stats.rows_evaluated += clusters->rows_evaluated(ticket.slot, slot.batch);
   const std::uint32_t kc = k_class(slot.k);
   const auto* pairs = static_cast<const std::uint32_t*>(slot.results.mapped);
   for (std::uint32_t q = 0; q < slot.batch; ++q) {

@@ -34,8 +34,11 @@ namespace mmvk::vulkan {
 
 enum class SearchMode {
   BruteForce,     // every row, exact
-  ClustersExact,  // cluster-pruned, exact (needs a ClusterTable; not implemented yet)
-  NProbe,         // the nprobe nearest clusters, approximate (not implemented yet)
+  ClustersExact,  // cluster-pruned, exact (needs a ClusterTable; same answers as BruteForce)
+  // The nprobe clusters with the nearest centroids, searched exactly
+  // (needs a ClusterTable; same answers as ClusterSearch with that nprobe;
+  // nprobe >= cluster_count is exact).
+  NProbe,
 };
 
 struct VulkanSearchOptions {

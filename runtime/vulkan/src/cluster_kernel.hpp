@@ -1,0 +1,100 @@
+// The cluster-pruned kernels (shaders/cluster_*.comp) of VulkanSearch's
+// ClustersExact and NProbe modes: the ClusterTable uploaded once (set 1 of
+// the cluster pipelines), per-slot scratch, and the recording of a batch.
+//
+// Per chunk of queries, six dispatches:
+//   cluster_bounds  (cluster, query): lower bound key per cluster, kSkip for
+//                   clusters without candidates; centroid distance (nprobe)
+//   cluster_select  (query): nprobe selection, the seed cluster (least
+//                   bound), the continuing frame's pair
+//   cluster_scan    round 0 (block, query): the seed cluster's blocks
+//   cluster_merge   round 0 (query): the k-th best so far = upper bound
+//   cluster_scan    round 1: blocks of clusters with bound <= upper bound
+//   cluster_merge   round 1: final best K, rows evaluated
+// Exactness: the seed's k-th best is >= the true k-th best, and a cluster
+// whose bound is strictly above it holds no member that can enter the best
+// k (ClusterSearch's argument, mmvk/cluster_search.hpp); the rows are
+// evaluated with the brute-force arithmetic, so costs are the reference's.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "brute_force_kernel.hpp"
+#include "device_database.hpp"
+#include "handles.hpp"
+#include "memory.hpp"
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/database.hpp"
+#include "mmvk/status.hpp"
+#include "mmvk/vulkan/context.hpp"
+
+namespace mmvk::vulkan::detail {
+
+struct ClusterKernelOptions {
+  std::uint32_t max_batch = 1;
+  std::uint32_t max_k = 1;
+  std::uint32_t slots = 1;
+  std::uint32_t nprobe = 0;               // 0 = exact; >= cluster_count is exact too
+  std::uint64_t scratch_bytes = 32 << 20;  // per slot: bound keys + block pairs
+  bool force_staging = false;
+};
+
+class ClusterKernel {
+ public:
+  // `table` must have been validated against `database`.
+  static Result<ClusterKernel> create(const Context& context, VkCommandPool pool, VkDescriptorSetLayout search_layout,
+                                      const KernelShape& shape, const Database& database, const ClusterTable& table,
+                                      const ClusterKernelOptions& options);
+
+  // K classes (1, 4, 16) the kernel has pipelines for.
+  std::vector<std::uint32_t> k_classes() const;
+  std::uint32_t cluster_count() const { return cluster_count_; }
+  std::uint32_t block_count() const { return block_count_; }
+
+  // Records the search of queries [0, batch) into `commands` with the
+  // slot's scratch; `search_set` is the slot's set 0 (query buffers,
+  // results).
+  Status record(const Context& context, VkCommandBuffer commands, std::uint32_t slot, VkDescriptorSet search_set,
+                std::uint32_t batch, std::uint32_t k) const;
+
+  // Rows evaluated by the last search recorded into `slot` (read after its
+  // fence signalled).
+  std::uint64_t rows_evaluated(std::uint32_t slot, std::uint32_t batch) const;
+
+ private:
+  struct SlotScratch {
+    Buffer bound_keys;   // [chunk x clusters] uvec2
+    Buffer states;       // [max_batch] ClusterQueryState, host-mapped
+    Buffer block_pairs;  // [chunk x blocks x K] uvec2
+    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
+  };
+  struct Variant {
+    std::uint32_t k_class = 1;
+    UniquePipeline scan;
+    UniquePipeline merge;
+  };
+  std::uint32_t chunk_for(std::uint32_t k_class) const;
+
+  KernelShape shape_;
+  std::uint32_t cluster_count_ = 0;
+  std::uint32_t block_count_ = 0;
+  std::uint32_t nprobe_ = 0;
+  std::uint32_t max_batch_ = 1;
+  std::uint64_t bound_capacity_ = 0;  // uvec2 per slot
+  std::uint64_t pair_capacity_ = 0;   // uvec2 per slot
+  // Declaration order = dependency order (destroyed in reverse).
+  UniqueDescriptorSetLayout set_layout_;
+  UniquePipelineLayout pipeline_layout_;
+  UniqueDescriptorPool descriptor_pool_;
+  TexelBuffer members_;
+  TexelBuffer block_info_;
+  TexelBuffer cluster_info_;
+  TexelBuffer cluster_vectors_;
+  std::vector<SlotScratch> slots_;
+  UniquePipeline bounds_;
+  UniquePipeline select_;
+  std::vector<Variant> variants_;
+};
+
+}  // namespace mmvk::vulkan::detail

@@ -1,0 +1,63 @@
+// The data layout of the cluster kernels (cluster_*.comp): set 0 is the
+// search layout (search_layout.glsl: the database texels, the query
+// buffers, the results), set 1 the cluster table and the per-slot cluster
+// scratch, plus their own push constants. The C++ side is
+// runtime/vulkan/src/cluster_kernel.cpp (ClusterPush, ClusterQueryState,
+// the binding numbers); change both together.
+//
+// Every kernel declares the specialization constants before including this:
+// DV (padded dims / 4), DIMS, CHANNELS, END_MASK_0..3 and, where used, K.
+#ifndef MMVK_CLUSTER_LAYOUT_GLSL
+#define MMVK_CLUSTER_LAYOUT_GLSL
+
+#define MMVK_SEARCH_LAYOUT_OWN_PUSH
+#include "search_layout.glsl"
+
+// A bound key that is never visited (ineligible or not probed cluster).
+// Orderable keys of non-NaN floats are at most 0xFF800000 (+inf).
+const uint kSkip = 0xFFFFFFFFu;
+// Flags that make a frame a non-candidate (mmvk::kFrameDoNotUse |
+// kFrameEdgeExcluded | kFrameBlockTransition) when it is not continued.
+const uint kNeverCandidate = 7u;
+
+// cluster_kernel.cpp: ClusterPush (32 bytes).
+layout(push_constant) uniform ClusterPush {
+  uint query_base;     // first query of this chunk in the query buffers
+  uint query_count;    // queries in this chunk
+  uint k;              // the search's k (<= K)
+  uint round;          // 0: the seed cluster, 1: every other cluster that can win
+  uint cluster_count;
+  uint block_count;    // member blocks over all clusters
+  uint nprobe;         // 0: exact; else clusters probed per query (< cluster_count)
+  uint pad0;
+} pc;
+
+// cluster_kernel.cpp: ClusterQueryState (32 bytes, std430).
+struct ClusterQueryState {
+  uint seed;              // cluster evaluated first (least bound), kNone if none
+  uint upper_key;         // orderable key of the k-th best after the seed, kSkip if fewer than k
+  uint rows;              // rows evaluated (statistics)
+  uint pad0;
+  uvec2 continuing_pair;  // (key, frame) of the continuing frame, (kNone, kNone) when not a candidate
+  uvec2 pad1;
+};
+
+// [frames] R32UI: ClusterTable::members (frame ids, cluster by cluster).
+layout(set = 1, binding = 0) uniform usamplerBuffer members;
+// [blocks] RGBA32UI: (cluster, first member, end member, 0); a cluster's
+// members split into blocks of at most rows_per_block.
+layout(set = 1, binding = 1) uniform usamplerBuffer block_info;
+// [clusters x 3] RGBA32UI: (flags_intersection, offsets[c], offsets[c+1],
+// first block), (tag_union lo, hi, tag_intersection lo, hi),
+// (min_multiplier bits, min_bias bits, end block, 0).
+layout(set = 1, binding = 2) uniform usamplerBuffer cluster_info;
+// [clusters x 3 x DV] RGBA32F: box_min, box_max, centroid, padded like rows.
+layout(set = 1, binding = 3) uniform samplerBuffer cluster_vectors;
+// [chunk x clusters]: (bound key, centroid distance key), kSkip when skipped.
+layout(std430, set = 1, binding = 4) buffer BoundKeys { uvec2 bound_keys[]; };
+// [max_batch] per query state, indexed by the query's batch index.
+layout(std430, set = 1, binding = 5) buffer States { ClusterQueryState states[]; };
+// [chunk x blocks x K] per-block best (key, frame) pairs.
+layout(std430, set = 1, binding = 6) buffer BlockPairs { uvec2 block_pairs[]; };
+
+#endif

@@ -1,0 +1,83 @@
+// Cluster search, pass 4 (twice per chunk): one invocation per query merges
+// the continuing frame's pair and the per-block best pairs of the visited
+// blocks into the query's best K, in the strict (cost, frame) order.
+//  round 0: the seed cluster's blocks; writes the k-th best key as the
+//           upper bound of round 1 (kSkip while fewer than k were found).
+//  round 1: every visited block (the seed's, and those whose cluster bound
+//           key is <= the upper bound); writes the results and the number
+//           of rows evaluated. The block loop runs at most block_count
+//           iterations (capped for llvmpipe's loop limit).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
+layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
+layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
+layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
+// Bit d set: dimension d is the last of its channel.
+layout(constant_id = 6) const uint END_MASK_0 = 0u;
+layout(constant_id = 7) const uint END_MASK_1 = 0u;
+layout(constant_id = 8) const uint END_MASK_2 = 0u;
+layout(constant_id = 9) const uint END_MASK_3 = 0u;
+
+#include "cluster_layout.glsl"
+#include "search_cost.glsl"
+
+void insert(inout uvec2 best[K], uvec2 candidate) {
+  if (!pair_less(candidate, best[K - 1u])) return;
+  best[K - 1u] = candidate;
+  [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
+    if (pair_less(best[j], best[j - 1u])) {
+      const uvec2 swap = best[j];
+      best[j] = best[j - 1u];
+      best[j - 1u] = swap;
+    }
+  }
+}
+
+void main() {
+  const uint local_query = gl_GlobalInvocationID.x;
+  if (local_query >= pc.query_count) return;
+  const uint query = pc.query_base + local_query;
+  const ClusterQueryState state = states[query];
+
+  uvec2 best[K];
+  [[unroll]] for (uint j = 0; j < K; ++j) best[j] = uvec2(kNone, kNone);
+  insert(best, state.continuing_pair);
+  const uint pair_base = local_query * pc.block_count;
+
+  if (pc.round == 0u) {
+    if (state.seed != kNone) {
+      const uint first = texelFetch(cluster_info, int(state.seed * 3u)).w;
+      const uint end = texelFetch(cluster_info, int(state.seed * 3u + 2u)).z;
+      for (uint b = first; b < end; ++b) {
+        [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[(pair_base + b) * K + i]);
+      }
+    }
+    uint upper = kSkip;
+    [[unroll]] for (uint j = 0; j < K; ++j) {
+      if (j + 1u == pc.k && best[j].y != kNone) upper = best[j].x;
+    }
+    states[query].upper_key = upper;
+    return;
+  }
+
+  uint rows = state.continuing_pair.y != kNone ? 1u : 0u;
+  const uint key_base = local_query * pc.cluster_count;
+  for (uint b = 0u; b < pc.block_count; ++b) {
+    const uvec4 info = texelFetch(block_info, int(b));
+    bool visited = info.x == state.seed;
+    if (!visited) {
+      const uint key = bound_keys[key_base + info.x].x;
+      visited = key != kSkip && key <= state.upper_key;
+    }
+    if (visited) {
+      rows += info.z - info.y;
+      [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[(pair_base + b) * K + i]);
+    }
+  }
+  [[unroll]] for (uint j = 0; j < K; ++j) results[query * K + j] = best[j];
+  states[query].rows = rows;
+}

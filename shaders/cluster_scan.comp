@@ -1,0 +1,80 @@
+// Cluster search, pass 3 (twice per chunk): one invocation per (member
+// block, query) evaluates the block's rows and writes the query's best K
+// (key, frame) pairs of the block to block_pairs.
+//  round 0: only the blocks of the query's seed cluster;
+//  round 1: the blocks of every other cluster whose bound key is <= the
+//           k-th best key after round 0 (strictly greater cannot win; equal
+//           may still win on a lower frame id). Pruned blocks write nothing:
+//           the merge reads only visited blocks.
+// Rows are evaluated with the brute-force scan's arithmetic
+// (search_cost.glsl); the continuing frame is skipped (cluster_select
+// evaluated it with its bias). The row loop runs at most rows_per_block
+// iterations (llvmpipe's loop limit).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
+layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
+layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
+layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
+// Bit d set: dimension d is the last of its channel.
+layout(constant_id = 6) const uint END_MASK_0 = 0u;
+layout(constant_id = 7) const uint END_MASK_1 = 0u;
+layout(constant_id = 8) const uint END_MASK_2 = 0u;
+layout(constant_id = 9) const uint END_MASK_3 = 0u;
+
+#include "cluster_layout.glsl"
+#include "search_cost.glsl"
+
+void main() {
+  const uint block = gl_GlobalInvocationID.x;
+  if (block >= pc.block_count) return;
+  const uint local_query = gl_WorkGroupID.y;
+  const uint query = pc.query_base + local_query;
+  const uvec4 info = texelFetch(block_info, int(block));
+  const uint cluster = info.x;
+  const uint seed = states[query].seed;
+  if (pc.round == 0u) {
+    if (cluster != seed) return;
+  } else {
+    if (cluster == seed) return;
+    const uint key = bound_keys[local_query * pc.cluster_count + cluster].x;
+    if (key == kSkip || key > states[query].upper_key) return;
+  }
+
+  vec4 q[DV];
+  float w[CHANNELS];
+  [[unroll]] for (uint v = 0; v < DV; ++v) q[v] = query_features[query * DV + v];
+  [[unroll]] for (uint i = 0; i < CHANNELS; ++i) w[i] = query_weights[query * CHANNELS + i];
+  const QueryGpu p = query_params[query];
+  uvec2 best[K];
+  [[unroll]] for (uint j = 0; j < K; ++j) best[j] = uvec2(kNone, kNone);
+  float worst = uintBitsToFloat(0x7F800000u);  // cost of best[K - 1], +inf while empty
+
+  for (uint m = info.y; m < info.z; ++m) {
+    const uint r = texelFetch(members, int(m)).x;
+    const uvec4 meta = texelFetch(frame_meta, int(r));
+    vec4 x[DV];
+    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(r * DV + v));
+    const float cost = row_cost(x, q, w, texelFetch(frame_cost, int(r)).xy);
+    // One float compare first (NaN and ties pass it), as the brute force.
+    if (!(cost > worst) && r != p.continuing_frame) {
+      const uvec2 candidate = uvec2(orderable_bits(cost), r);
+      if (pair_less(candidate, best[K - 1u]) && !isnan(cost) && frame_is_candidate(r, meta, false, p)) {
+        best[K - 1u] = candidate;
+        [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
+          if (pair_less(best[j], best[j - 1u])) {
+            const uvec2 swap = best[j];
+            best[j] = best[j - 1u];
+            best[j - 1u] = swap;
+          }
+        }
+        worst = best[K - 1u].y == kNone ? uintBitsToFloat(0x7F800000u) : cost_of_key(best[K - 1u].x);
+      }
+    }
+  }
+  const uint out_base = (local_query * pc.block_count + block) * K;
+  [[unroll]] for (uint j = 0; j < K; ++j) block_pairs[out_base + j] = best[j];
+}

@@ -1,0 +1,99 @@
+// Cluster search, pass 2: one invocation per query.
+//  - nprobe mode: keeps the bound keys of the nprobe eligible clusters with
+//    the least (centroid distance, cluster id) and sets the others to kSkip
+//    (the threshold is found by a binary search over the 32-bit distance
+//    keys: 32 counting loops over the clusters, so cluster_count is capped
+//    for llvmpipe's loop limit).
+//  - picks the seed: the cluster of least (bound, id), which ClusterSearch
+//    visits first;
+//  - evaluates the continuing frame (cost with continuing_bias), which the
+//    cluster scans skip, as ClusterSearch seeds it.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
+layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
+layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
+layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
+// Bit d set: dimension d is the last of its channel.
+layout(constant_id = 6) const uint END_MASK_0 = 0u;
+layout(constant_id = 7) const uint END_MASK_1 = 0u;
+layout(constant_id = 8) const uint END_MASK_2 = 0u;
+layout(constant_id = 9) const uint END_MASK_3 = 0u;
+
+#include "cluster_layout.glsl"
+#include "search_cost.glsl"
+
+void main() {
+  const uint local_query = gl_GlobalInvocationID.x;
+  if (local_query >= pc.query_count) return;
+  const uint query = pc.query_base + local_query;
+  const uint base = local_query * pc.cluster_count;
+  const uint clusters = pc.cluster_count;
+
+  if (pc.nprobe != 0u) {
+    uint eligible = 0u;
+    for (uint c = 0u; c < clusters; ++c) eligible += bound_keys[base + c].y != kSkip ? 1u : 0u;
+    if (eligible > pc.nprobe) {
+      // The least T with count(distance key <= T) >= nprobe.
+      uint lo = 0u;
+      uint hi = kSkip - 1u;
+      for (uint step = 0u; step < 32u && lo < hi; ++step) {
+        const uint mid = lo + ((hi - lo) >> 1u);
+        uint n = 0u;
+        for (uint c = 0u; c < clusters; ++c) n += bound_keys[base + c].y <= mid ? 1u : 0u;
+        if (n >= pc.nprobe) {
+          hi = mid;
+        } else {
+          lo = mid + 1u;
+        }
+      }
+      uint below = 0u;
+      for (uint c = 0u; c < clusters; ++c) below += bound_keys[base + c].y < lo ? 1u : 0u;
+      uint take = pc.nprobe - below;  // clusters at exactly the threshold, by ascending id
+      for (uint c = 0u; c < clusters; ++c) {
+        const uint distance = bound_keys[base + c].y;
+        bool keep = distance < lo;
+        if (distance == lo && take > 0u) {
+          keep = true;
+          --take;
+        }
+        if (!keep) bound_keys[base + c].x = kSkip;
+      }
+    }
+  }
+
+  uint seed = kNone;
+  uint seed_key = kSkip;
+  for (uint c = 0u; c < clusters; ++c) {
+    const uint key = bound_keys[base + c].x;
+    if (key < seed_key) {
+      seed_key = key;
+      seed = c;
+    }
+  }
+
+  uvec2 continuing_pair = uvec2(kNone, kNone);
+  const QueryGpu p = query_params[query];
+  const uint r = p.continuing_frame;
+  if (r != kNone) {
+    const uvec4 meta = texelFetch(frame_meta, int(r));
+    if (frame_is_candidate(r, meta, true, p)) {
+      vec4 q[DV];
+      vec4 x[DV];
+      float w[CHANNELS];
+      [[unroll]] for (uint v = 0; v < DV; ++v) {
+        q[v] = query_features[query * DV + v];
+        x[v] = texelFetch(features, int(r * DV + v));
+      }
+      [[unroll]] for (uint i = 0; i < CHANNELS; ++i) w[i] = query_weights[query * CHANNELS + i];
+      precise float cost = row_cost(x, q, w, texelFetch(frame_cost, int(r)).xy);
+      cost = cost + p.continuing_bias;
+      if (!isnan(cost)) continuing_pair = uvec2(orderable_bits(cost), r);
+    }
+  }
+  states[query].seed = seed;
+  states[query].continuing_pair = continuing_pair;
+}

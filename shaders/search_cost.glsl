@@ -1,0 +1,50 @@
+// The cost and candidate rules of the search semantics (docs/search.md,
+// runtime/src/search.cpp), as the cluster kernels evaluate them; the same
+// arithmetic as brute_force_scan.comp, so both give the reference's bits.
+// The including kernel declares DV, DIMS, CHANNELS and END_MASK_0..3.
+#ifndef MMVK_SEARCH_COST_GLSL
+#define MMVK_SEARCH_COST_GLSL
+
+// Constant-folds once d is a constant (all callers are unrolled loops).
+bool ends_channel(uint d) {
+  uint word = d < 32u ? END_MASK_0 : d < 64u ? END_MASK_1 : d < 96u ? END_MASK_2 : END_MASK_3;
+  return ((word >> (d & 31u)) & 1u) != 0u;
+}
+
+// mmvk::is_candidate. meta: (flags, tags low, tags high, clip) of row r.
+bool frame_is_candidate(uint r, uvec4 meta, bool continuing, QueryGpu p) {
+  if ((meta.x & (kFrameDoNotUse | kFrameEdgeExcluded)) != 0u) return false;
+  if ((meta.x & kFrameBlockTransition) != 0u && !continuing) return false;
+  if ((meta.y & p.require_lo) != p.require_lo || (meta.z & p.require_hi) != p.require_hi) return false;
+  if ((meta.y & p.exclude_lo) != 0u || (meta.z & p.exclude_hi) != 0u) return false;
+  if (meta.w == p.window_clip && !continuing) {
+    const uint a = r - p.clip_first;
+    const uint b = p.continuing_frame - p.clip_first;
+    uint distance = a > b ? a - b : b - a;
+    if (p.clip_loop != 0u) distance = min(distance, p.clip_count - distance);
+    if (distance <= p.exclusion_window) return false;
+  }
+  return true;
+}
+
+// mmvk::frame_cost without the continuing bias: per channel a sum of
+// squared differences in dim order from 0, total += w_c * sum in channel
+// order, multiplier * total + bias; `precise` forbids fusing.
+float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
+  precise float total = 0.0;
+  precise float channel_sum = 0.0;
+  uint c = 0u;
+  [[unroll]] for (uint d = 0; d < DIMS; ++d) {
+    precise float diff = x[d >> 2u][d & 3u] - q[d >> 2u][d & 3u];
+    channel_sum = channel_sum + diff * diff;
+    if (ends_channel(d)) {
+      total = total + w[c] * channel_sum;
+      channel_sum = 0.0;
+      ++c;
+    }
+  }
+  precise float cost = scale_bias.x * total + scale_bias.y;
+  return cost;
+}
+
+#endif

@@ -1,0 +1,165 @@
+// The shared backend suites (backend_suite.hpp on random data,
+// backend_data_suite.hpp on the Bandai locomotion features) for the Vulkan
+// cluster modes: ClustersExact and NProbe with nprobe = all clusters, both
+// of which must give the reference's frames and cost bits. Plus: NProbe
+// with few clusters equals the CPU ClusterSearch with the same nprobe and
+// table, a run under the validation layer, and the creation errors.
+#include <map>
+#include <memory>
+
+#include "mmvk/cluster_search.hpp"
+#include "mmvk/thread_pool.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#include "support/backend_data_suite.hpp"
+#include "support/backend_suite.hpp"
+#include "vulkan_test_env.hpp"
+
+namespace mmvk::test {
+namespace {
+
+// Trains one table per database (10 Lloyd iterations: exactness does not
+// depend on the clustering's quality) and keeps it alive with the context.
+struct TableCache {
+  ThreadPool pool{2};
+  std::map<std::uint64_t, std::unique_ptr<ClusterTable>> tables;
+
+  Result<const ClusterTable*> table_for(const Database& db) {
+    std::unique_ptr<ClusterTable>& table = tables[db.content_hash()];
+    if (!table) {
+      KMeansParams params;
+      params.iterations = 10;
+      Result<ClusterTable> trained = train_cluster_table(db, params, pool);
+      if (!trained.ok()) return trained.error();
+      table = std::make_unique<ClusterTable>(std::move(trained).value());
+    }
+    return table.get();
+  }
+};
+
+template <vulkan::SearchMode Mode, std::uint32_t NProbe>
+struct VulkanClusterFactory {
+  TableCache tables;
+  std::unique_ptr<vulkan::Context> context;
+  std::string error;
+
+  VulkanClusterFactory() { context = make_test_context(error); }
+
+  std::string skip_reason() {
+    if (context) return {};
+    if (vulkan_required()) {
+      ADD_FAILURE() << error;
+      return {};
+    }
+    return error;
+  }
+
+  Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
+    if (!context) return make_error(error);
+    Result<const ClusterTable*> table = tables.table_for(db);
+    if (!table) return table.error();
+    vulkan::VulkanSearchOptions options;
+    options.warm_up = false;  // compile only the variants a test uses
+    options.mode = Mode;
+    options.nprobe = NProbe;
+    Result<std::unique_ptr<vulkan::VulkanSearch>> search = vulkan::VulkanSearch::create(*context, db, options, *table);
+    if (!search) return search.error();
+    return std::unique_ptr<SearchBackend>(std::move(search).value());
+  }
+};
+
+using VulkanClustersExact = VulkanClusterFactory<vulkan::SearchMode::ClustersExact, 0>;
+using VulkanProbeAll = VulkanClusterFactory<vulkan::SearchMode::NProbe, 0xFFFFFFFFu>;
+using VulkanClusterBackends = ::testing::Types<VulkanClustersExact, VulkanProbeAll>;
+INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendSuite, VulkanClusterBackends);
+INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendDataSuite, VulkanClusterBackends);
+
+// Approximate mode: the same clusters as the CPU nprobe (nearest centroids
+// by channel-weighted squared distance, ties by cluster id), searched
+// exactly, so the same answers; also with constraints and k > 1.
+TEST(VulkanClusterSearch, NProbeEqualsCpuNProbe) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const Database db = synthetic_database({.frames = 3000, .seed = 51, .constraints = true});
+  TableCache tables;
+  Result<const ClusterTable*> table = tables.table_for(db);
+  ASSERT_TRUE(table.ok()) << table.message();
+  const std::vector<float> queries = synthetic_queries(db, 64, 52);
+  const std::vector<QueryParams> params = random_params(db, 64, 53);
+  for (const std::uint32_t nprobe : {1u, 3u, 10u}) {
+    SCOPED_TRACE("nprobe " + std::to_string(nprobe));
+    vulkan::VulkanSearchOptions options;
+    options.warm_up = false;
+    options.mode = vulkan::SearchMode::NProbe;
+    options.nprobe = nprobe;
+    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
+    ASSERT_TRUE(gpu.ok()) << gpu.message();
+    ClusterSearchOptions cpu_options;
+    cpu_options.nprobe = nprobe;
+    auto cpu = ClusterSearch::create(db, **table, tables.pool, cpu_options);
+    ASSERT_TRUE(cpu.ok()) << cpu.message();
+    for (const std::uint32_t k : {1u, 4u}) {
+      const std::vector<Match> expected = run_search(**cpu, queries, params, 64, k);
+      const std::vector<Match> actual = run_search(**gpu, queries, params, 64, k);
+      expect_identical(expected, actual, k, params, (*gpu)->name());
+      const std::vector<Match> expected_plain = run_search(**cpu, queries, {}, 64, k);
+      const std::vector<Match> actual_plain = run_search(**gpu, queries, {}, 64, k);
+      expect_identical(expected_plain, actual_plain, k, {}, (*gpu)->name());
+    }
+    // Fewer rows than exhaustive.
+    EXPECT_LT((*gpu)->stats().rows_fraction(db.frame_count()), 1.0);
+  }
+}
+
+// Pruning visits fewer rows than brute force, and warm-up plus small
+// scratch (several chunks per submit) keep the results exact.
+TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
+  vulkan::ContextOptions context_options;
+  context_options.validation = true;
+  MMVK_VULKAN_CONTEXT(context, context_options);
+  const Database db = synthetic_database({.frames = 4000, .seed = 55, .constraints = true});
+  TableCache tables;
+  Result<const ClusterTable*> table = tables.table_for(db);
+  ASSERT_TRUE(table.ok()) << table.message();
+  vulkan::VulkanSearchOptions options;
+  options.mode = vulkan::SearchMode::ClustersExact;
+  options.max_batch = 100;
+  options.max_k = 4;
+  options.scratch_bytes = 16 << 10;  // a few queries per chunk
+  auto created = vulkan::VulkanSearch::create(*context, db, options, *table);
+  ASSERT_TRUE(created.ok()) << created.message();
+  std::unique_ptr<vulkan::VulkanSearch> gpu = std::move(created).value();
+  const std::vector<float> queries = synthetic_queries(db, 100, 56, 0.05f);
+  std::vector<QueryParams> params = random_params(db, 100, 57);
+  const std::vector<Match> expected = reference_results(db, queries, params, 100, 4);
+  const std::vector<Match> actual = run_search(*gpu, queries, params, 100, 4);
+  expect_identical(expected, actual, 4, params, gpu->name());
+  EXPECT_LT(gpu->stats().rows_fraction(db.frame_count()), 0.9);
+  gpu.reset();
+  const std::vector<std::string> messages = context->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, the first: " << messages.front();
+}
+
+TEST(VulkanClusterSearch, CreationErrors) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const Database db = synthetic_database({.frames = 1000, .seed = 59});
+  const Database other = synthetic_database({.frames = 1000, .seed = 60});
+  TableCache tables;
+  Result<const ClusterTable*> table = tables.table_for(db);
+  ASSERT_TRUE(table.ok()) << table.message();
+  vulkan::VulkanSearchOptions options;
+  options.warm_up = false;
+  options.mode = vulkan::SearchMode::ClustersExact;
+  auto no_table = vulkan::VulkanSearch::create(*context, db, options);
+  ASSERT_FALSE(no_table.ok());
+  EXPECT_NE(no_table.message().find("ClusterTable"), std::string::npos) << no_table.message();
+  auto mismatched = vulkan::VulkanSearch::create(*context, other, options, *table);
+  ASSERT_FALSE(mismatched.ok());
+  EXPECT_NE(mismatched.message().find("cluster table"), std::string::npos) << mismatched.message();
+  options.mode = vulkan::SearchMode::NProbe;
+  options.nprobe = 0;
+  auto zero = vulkan::VulkanSearch::create(*context, db, options, *table);
+  ASSERT_FALSE(zero.ok());
+  EXPECT_NE(zero.message().find("nprobe"), std::string::npos) << zero.message();
+}
+
+}  // namespace
+}  // namespace mmvk::test

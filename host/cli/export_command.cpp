@@ -25,28 +25,6 @@ constexpr const char* kExportUsage =
     "names, clip ranges and the per-frame flags (1 = do_not_use,\n"
     "2 = block_transition, 4 = edge_excluded).\n";
 
-const char* kind_name(ChannelKind kind) {
-  switch (kind) {
-    case ChannelKind::TrajectoryPosition: return "trajectory_position";
-    case ChannelKind::TrajectoryDirection: return "trajectory_direction";
-    case ChannelKind::BonePosition: return "bone_position";
-    case ChannelKind::BoneVelocity: return "bone_velocity";
-    case ChannelKind::RootVelocity: return "root_velocity";
-    case ChannelKind::Custom: return "custom";
-  }
-  return "?";
-}
-
-const char* mode_name(Normalization mode) {
-  switch (mode) {
-    case Normalization::GroupStd: return "group_std";
-    case Normalization::PerDimStd: return "per_dim_std";
-    case Normalization::MeanAbsDev: return "mean_abs_dev";
-    case Normalization::MinMax: return "min_max";
-  }
-  return "?";
-}
-
 std::string little_endian_floats(std::span<const float> values) {
   std::string bytes(values.size() * 4, '\0');
   for (std::size_t i = 0; i < values.size(); ++i) {
@@ -71,8 +49,8 @@ nlohmann::json sidecar(const Database& db, const std::string& source, const std:
   std::vector<float> weights;
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
-    nlohmann::json ch = {{"name", channel.name},       {"kind", kind_name(channel.kind)},
-                         {"normalization", mode_name(channel.normalization)},
+    nlohmann::json ch = {{"name", channel.name},       {"kind", channel_kind_name(channel.kind)},
+                         {"normalization", normalization_name(channel.normalization)},
                          {"weight", channel.weight},   {"offset", schema.offset(c)},
                          {"dims", channel.dims()}};
     if (!channel.bone.empty()) ch["bone"] = channel.bone;

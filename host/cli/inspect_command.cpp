@@ -22,28 +22,6 @@ constexpr const char* kInspectUsage =
     "(unnormalized) mean, std, min and max.\n"
     "  --json   the same as one JSON object on stdout\n";
 
-const char* kind_name(ChannelKind kind) {
-  switch (kind) {
-    case ChannelKind::TrajectoryPosition: return "trajectory_position";
-    case ChannelKind::TrajectoryDirection: return "trajectory_direction";
-    case ChannelKind::BonePosition: return "bone_position";
-    case ChannelKind::BoneVelocity: return "bone_velocity";
-    case ChannelKind::RootVelocity: return "root_velocity";
-    case ChannelKind::Custom: return "custom";
-  }
-  return "?";
-}
-
-const char* mode_name(Normalization mode) {
-  switch (mode) {
-    case Normalization::GroupStd: return "group_std";
-    case Normalization::PerDimStd: return "per_dim_std";
-    case Normalization::MeanAbsDev: return "mean_abs_dev";
-    case Normalization::MinMax: return "min_max";
-  }
-  return "?";
-}
-
 std::string tag_list(const Database& db, TagMask mask) {
   std::string out;
   for (std::size_t t = 0; t < db.tag_names().size(); ++t) {
@@ -125,8 +103,8 @@ int run_inspect(Args args) {
     out["channels"] = nlohmann::json::array();
     for (std::size_t c = 0; c < schema.channels.size(); ++c) {
       const FeatureChannel& channel = schema.channels[c];
-      nlohmann::json ch = {{"name", channel.name}, {"kind", kind_name(channel.kind)},
-                           {"normalization", mode_name(channel.normalization)}, {"weight", channel.weight},
+      nlohmann::json ch = {{"name", channel.name}, {"kind", channel_kind_name(channel.kind)},
+                           {"normalization", normalization_name(channel.normalization)}, {"weight", channel.weight},
                            {"offset", schema.offset(c)}, {"dims", channel.dims()}};
       ch["dimensions"] = nlohmann::json::array();
       for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
@@ -169,8 +147,8 @@ int run_inspect(Args args) {
       detail = "offsets (s):";
       for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);
     }
-    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", channel.name.c_str(), kind_name(channel.kind),
-                mode_name(channel.normalization), double(channel.weight), detail.c_str());
+    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", channel.name.c_str(), channel_kind_name(channel.kind).data(),
+                normalization_name(channel.normalization).data(), double(channel.weight), detail.c_str());
     std::printf("    %-32s %10s %10s %10s %10s %10s %10s\n", "dimension", "offset", "scale", "mean", "std", "min", "max");
     for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
       std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", schema.dim_name(d).c_str(),

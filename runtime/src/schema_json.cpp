@@ -131,6 +131,20 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
 
 }  // namespace
 
+std::string_view channel_kind_name(ChannelKind kind) {
+  for (const KindName& k : kKinds) {
+    if (k.kind == kind) return k.name;
+  }
+  return "?";
+}
+
+std::string_view normalization_name(Normalization mode) {
+  for (const NormalizationName& m : kModes) {
+    if (m.mode == mode) return m.name;
+  }
+  return "?";
+}
+
 Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source) {
   const std::string name(source.empty() ? std::string_view("schema") : source);
   Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);

@@ -57,6 +57,10 @@ struct FeatureSchema {
   Status validate() const;
 };
 
+// The names used in the JSON form ("trajectory_position", "group_std", ...).
+std::string_view channel_kind_name(ChannelKind kind);
+std::string_view normalization_name(Normalization mode);
+
 // The widely used 27-d set: left/right foot positions and velocities, hip
 // velocity, trajectory positions (x, z) and directions (x, z) at 0.33, 0.67
 // and 1.0 s.

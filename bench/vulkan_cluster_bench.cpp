@@ -1,0 +1,176 @@
+// The Vulkan cluster modes (ClustersExact, NProbe 4/16) beside the Vulkan
+// brute force, the CPU ClusterSearch and the fast CPU brute force, on the
+// real databases of bench_data.hpp, with the cluster table trained by
+// train_cluster_table(db, KMeansParams{}) (round(sqrt(N)) clusters).
+//
+// Counters: queries/s (kIsRate, end to end: submit to results in host
+// memory), kernel_ms (GPU time of the last batch from timestamps), rows
+// (fraction of the frames evaluated per query), recall@1 (the frame found
+// equals FastSearch brute force's exact frame; 1 for exact backends).
+//
+//   build/bench/mmvk_bench --benchmark_filter='vclusters/locomotion/'
+#include <benchmark/benchmark.h>
+
+#if defined(MMVK_HAS_VULKAN)
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_data.hpp"
+#include "mmvk/cluster_search.hpp"
+#include "mmvk/fast_search.hpp"
+#include "mmvk/thread_pool.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#include "query_streams.hpp"
+
+namespace mmvk::bench {
+namespace {
+
+constexpr std::size_t kQueries = 1024;
+constexpr QueryStream kStreams[] = {QueryStream::Continue, QueryStream::Transition, QueryStream::Uniform};
+constexpr DataSet kSets[] = {DataSet::Locomotion, DataSet::Volume, DataSet::VolumeMirrored};
+constexpr std::uint32_t kBatches[] = {1, 64, 1024};
+const char* const kBackends[] = {"fast-brute",      "cpu-clusters",   "vulkan-brute",
+                                 "vulkan-clusters", "vulkan-nprobe4", "vulkan-nprobe16"};
+
+vulkan::Context* shared_context() {
+  static std::unique_ptr<vulkan::Context> context;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    Result<std::unique_ptr<vulkan::Context>> created = vulkan::Context::create();
+    if (created.ok()) {
+      context = std::move(created).value();
+    } else {
+      std::fprintf(stderr, "vulkan_cluster_bench: %s\n", created.message().c_str());
+    }
+  }
+  return context.get();
+}
+
+// One database's table, backends, query streams and exact answers; the
+// backends are created on first use (lavapipe compiles at creation).
+struct Setup {
+  const Database* db = nullptr;
+  ThreadPool pool;
+  ClusterTable table;
+  std::map<std::string, std::unique_ptr<SearchBackend>> backends;
+  std::map<QueryStream, std::vector<float>> queries;
+  std::map<QueryStream, std::vector<std::uint32_t>> truth;
+};
+
+Setup* setup_for(DataSet set) {
+  static std::map<DataSet, std::unique_ptr<Setup>> cache;
+  std::unique_ptr<Setup>& slot = cache[set];
+  if (slot) return slot->db ? slot.get() : nullptr;
+  slot = std::make_unique<Setup>();
+  Setup& s = *slot;
+  const Database* db = database(set);
+  if (db == nullptr) return nullptr;
+  Result<ClusterTable> table = train_cluster_table(*db, KMeansParams{}, s.pool);
+  if (!table.ok()) {
+    std::fprintf(stderr, "vulkan_cluster_bench: %s\n", table.message().c_str());
+    return nullptr;
+  }
+  s.table = std::move(table).value();
+  FastSearch exact(*db, s.pool, FastSearchOptions{.prune = false});
+  for (const QueryStream stream : kStreams) {
+    s.queries[stream] = make_queries(*db, stream, kQueries);
+    std::vector<Match> out(kQueries);
+    if (!exact.search({s.queries[stream], {}, kQueries}, 1, out).ok()) return nullptr;
+    for (const Match& m : out) s.truth[stream].push_back(m.frame);
+  }
+  s.db = db;
+  return &s;
+}
+
+Result<std::unique_ptr<SearchBackend>> make_backend(Setup& s, const std::string& name) {
+  if (name == "fast-brute") {
+    return std::unique_ptr<SearchBackend>(std::make_unique<FastSearch>(*s.db, s.pool, FastSearchOptions{.prune = false}));
+  }
+  if (name == "cpu-clusters") {
+    Result<std::unique_ptr<ClusterSearch>> backend = ClusterSearch::create(*s.db, s.table, s.pool);
+    if (!backend.ok()) return backend.error();
+    return std::unique_ptr<SearchBackend>(std::move(backend).value());
+  }
+  vulkan::Context* context = shared_context();
+  if (context == nullptr) return make_error("no Vulkan device");
+  vulkan::VulkanSearchOptions options;
+  options.max_batch = kQueries;
+  options.max_k = 1;
+  if (name == "vulkan-clusters") options.mode = vulkan::SearchMode::ClustersExact;
+  if (name == "vulkan-nprobe4" || name == "vulkan-nprobe16") {
+    options.mode = vulkan::SearchMode::NProbe;
+    options.nprobe = name == "vulkan-nprobe4" ? 4 : 16;
+  }
+  Result<std::unique_ptr<vulkan::VulkanSearch>> backend = vulkan::VulkanSearch::create(*context, *s.db, options, &s.table);
+  if (!backend.ok()) return backend.error();
+  return std::unique_ptr<SearchBackend>(std::move(backend).value());
+}
+
+void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& name, std::uint32_t batch) {
+  Setup* s = setup_for(set);
+  if (s == nullptr) {
+    state.SkipWithError("database unavailable");
+    return;
+  }
+  std::unique_ptr<SearchBackend>& backend = s->backends[name];
+  if (!backend) {
+    Result<std::unique_ptr<SearchBackend>> made = make_backend(*s, name);
+    if (!made.ok()) {
+      state.SkipWithError(made.message().c_str());
+      return;
+    }
+    backend = std::move(made).value();
+  }
+  const std::vector<float>& all = s->queries.at(stream);
+  const std::vector<std::uint32_t>& truth = s->truth.at(stream);
+  const std::uint32_t dims = s->db->dims();
+  std::vector<Match> out(batch);
+  backend->reset_stats();
+  std::size_t offset = 0;
+  std::uint64_t hits = 0;
+  std::uint64_t total = 0;
+  for (auto _ : state) {
+    const QueryBatch q{std::span<const float>(all).subspan(offset * dims, std::size_t{batch} * dims), {}, batch};
+    if (!backend->search(q, 1, out).ok()) {
+      state.SkipWithError("search failed");
+      return;
+    }
+    for (std::uint32_t i = 0; i < batch; ++i) hits += out[i].frame == truth[offset + i] ? 1 : 0;
+    total += batch;
+    offset = (offset + batch) % kQueries;
+  }
+  state.counters["queries/s"] = benchmark::Counter(double(total), benchmark::Counter::kIsRate);
+  state.counters["rows"] = backend->stats().rows_fraction(s->db->frame_count());
+  state.counters["recall@1"] = total == 0 ? 0.0 : double(hits) / double(total);
+  if (auto* gpu = dynamic_cast<vulkan::VulkanSearch*>(backend.get()); gpu != nullptr) {
+    state.counters["kernel_ms"] = gpu->last_kernel_seconds().value_or(0.0) * 1e3;
+  }
+}
+
+const bool registered = [] {
+  for (const DataSet set : kSets) {
+    for (const QueryStream stream : kStreams) {
+      for (const char* backend : kBackends) {
+        for (const std::uint32_t batch : kBatches) {
+          const std::string name = "vclusters/" + std::string(data_set_name(set)) + "/" +
+                                   std::string(query_stream_name(stream)) + "/" + backend + "/B:" +
+                                   std::to_string(batch);
+          benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& state) {
+            run(state, set, stream, backend, batch);
+          })->UseRealTime()->MinTime(0.3);
+        }
+      }
+    }
+  }
+  return true;
+}();
+
+}  // namespace
+}  // namespace mmvk::bench
+
+#endif  // MMVK_HAS_VULKAN

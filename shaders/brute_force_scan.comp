@@ -1,19 +1,32 @@
 // Exact brute-force search, pass 1 of 2: every invocation scans one block of
 // rows for a tile of T queries held in registers, and writes each query's
 // best K (cost, frame) pairs of that block to the scratch buffer; pass 2
-// (topk_merge.comp) merges the blocks.
+// (topk_merge.comp) merges the blocks and adds each query's continuing
+// frame, which this pass skips.
 //
 // Why this shape (shared/LAVAPIPE.md): query tiles in registers beat shared
 // memory 3-5x on lavapipe; rows are read as RGBA32F texels (vectorized
 // gathers); the row loop runs at most rows_per_invocation (<= 32k)
 // iterations and every inner loop is unrolled, because llvmpipe silently
-// stops loops after 65,535 iterations. The candidate rules are checked only
-// for pairs that would enter the best K, which is rare after the first rows.
+// stops loops after 65,535 iterations. The cost arithmetic is
+// search_cost.glsl's (the reference's order, `precise`).
 //
-// Costs follow the reference order exactly (runtime/src/search.cpp):
-// per channel a sum of squared differences in dim order from 0.0, then
-// total += w_c * sum in channel order, cost = multiplier * total + bias,
-// + continuing_bias last; `precise` keeps real GPUs from fusing.
+// The hot path is branch-free: llvmpipe runs both sides of every `if` under
+// a lane mask, so a rarely taken branch costs as much as an always taken
+// one. Per (row, query) it evaluates the cost, a few integer operations for
+// the candidate rules (tags, exclusion window) and, for K = 1, two selects.
+// What makes that possible:
+// - The continuing frame is the only row whose cost has an extra term
+//   (continuing_bias) and the only one exempt from block transitions and
+//   the exclusion window; it is excluded here and evaluated once per query
+//   by the merge pass.
+// - Per-row flags exclude a row for every query alike: its bias becomes NaN,
+//   which no comparison accepts.
+// - The exclusion window is at most two row ranges per query (a looping
+//   clip wraps), computed once per invocation.
+// - Rows are scanned in descending order, so `cost <= best` keeps the
+//   lowest frame among equal costs (the reference's order), accepts an
+//   infinite cost into an empty slot and rejects NaN, in one comparison.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -23,40 +36,54 @@
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
 layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
-layout(constant_id = 3) const uint T = 1;         // queries per tile
-layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
 layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
 // Bit d set: dimension d is the last of its channel.
 layout(constant_id = 6) const uint END_MASK_0 = 0u;
 layout(constant_id = 7) const uint END_MASK_1 = 0u;
 layout(constant_id = 8) const uint END_MASK_2 = 0u;
 layout(constant_id = 9) const uint END_MASK_3 = 0u;
+layout(constant_id = 3) const uint T = 1;         // queries per tile
+layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
 
-// Constant-folds once d is a constant (all callers are unrolled loops).
-bool ends_channel(uint d) {
-  uint word = d < 32u ? END_MASK_0 : d < 64u ? END_MASK_1 : d < 96u ? END_MASK_2 : END_MASK_3;
-  return ((word >> (d & 31u)) & 1u) != 0u;
-}
+#include "search_cost.glsl"
+
+#define kInfinity uintBitsToFloat(0x7F800000u)
+#define kNaN uintBitsToFloat(0x7FC00000u)
 
 // The query of tile slot `local`; slots past the chunk's end repeat its
 // last query (their results are not written).
 uint query_index(uint local) { return pc.query_base + min(local, pc.query_count - 1u); }
 
-// The search semantics' candidate rule (mmvk::is_candidate).
-// meta: (flags, tags low, tags high, clip) of row r.
-bool is_candidate(uint r, uvec4 meta, bool continuing, QueryGpu p) {
-  if ((meta.x & (kFrameDoNotUse | kFrameEdgeExcluded)) != 0u) return false;
-  if ((meta.x & kFrameBlockTransition) != 0u && !continuing) return false;
-  if ((meta.y & p.require_lo) != p.require_lo || (meta.z & p.require_hi) != p.require_hi) return false;
-  if ((meta.y & p.exclude_lo) != 0u || (meta.z & p.exclude_hi) != 0u) return false;
-  if (meta.w == p.window_clip && !continuing) {
-    const uint a = r - p.clip_first;
-    const uint b = p.continuing_frame - p.clip_first;
-    uint distance = a > b ? a - b : b - a;
-    if (p.clip_loop != 0u) distance = min(distance, p.clip_count - distance);
-    if (distance <= p.exclusion_window) return false;
+// The rows this pass skips for query p, as two ranges (first, last - first):
+// row r is skipped when r - first <= last - first (unsigned). They hold the
+// continuing frame and, when an exclusion window applies, every frame of its
+// clip within the window (mmvk::is_candidate); an empty range is
+// (kNone, 0), which no row reaches.
+uvec4 skipped_ranges(QueryGpu p) {
+  uvec4 ranges = uvec4(kNone, 0u, kNone, 0u);
+  if (p.continuing_frame == kNone) return ranges;
+  ranges.xy = uvec2(p.continuing_frame, 0u);
+  if (p.window_clip == kNone) return ranges;
+  // Offsets inside the clip: b is the continuing frame, w the window; a row
+  // at offset a is excluded when |a - b| <= w, or, in a looping clip, when
+  // count - |a - b| <= w (the distance through the wrap).
+  const uint count = p.clip_count;
+  const uint b = p.continuing_frame - p.clip_first;
+  const uint w = p.exclusion_window;
+  const uint first = w >= b ? 0u : b - w;
+  const uint last = w >= count - 1u - b ? count - 1u : b + w;
+  ranges.xy = uvec2(p.clip_first + first, last - first);
+  if (p.clip_loop != 0u) {
+    if (w > b) {
+      // a > b: a >= b + count - w, a suffix of the clip.
+      const uint suffix = w - b >= count ? 0u : count - (w - b);
+      ranges.zw = uvec2(p.clip_first + suffix, count - 1u - suffix);
+    } else if (w >= count - b) {
+      // a < b: a <= b + w - count, a prefix of the clip.
+      ranges.zw = uvec2(p.clip_first, min(w - (count - b), count - 1u));
+    }
   }
-  return true;
+  return ranges;
 }
 
 void main() {
@@ -66,51 +93,56 @@ void main() {
 
   vec4 q[T][DV];
   float w[T][CHANNELS];
-  QueryGpu p[T];
+  // In registers: reading a storage buffer inside the row loop made the
+  // kernel 2x slower on lavapipe.
+  uvec4 tags[T];     // (require lo, require hi, exclude lo, exclude hi)
+  uvec4 skipped[T];  // skipped_ranges()
+  // K = 1: the running best; a frame of kNone is an empty slot.
+  float best_cost[T];
+  uint best_frame[T];
+  // K > 1: the best K as (orderable cost bits, frame), sorted, and the cost
+  // of the last one (+inf while it is empty).
   uvec2 best[T][K];
-  float worst[T];  // cost of best[t][K - 1], +inf while that slot is empty
+  float worst[T];
   [[unroll]] for (uint t = 0; t < T; ++t) {
     const uint query = query_index(tile_first + t);
     [[unroll]] for (uint v = 0; v < DV; ++v) q[t][v] = query_features[query * DV + v];
     [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[t][c] = query_weights[query * CHANNELS + c];
-    // In registers: reading a storage buffer inside the row loop, even in a
-    // rarely taken branch, made the kernel 2x slower on lavapipe.
-    p[t] = query_params[query];
+    const QueryGpu p = query_params[query];
+    tags[t] = uvec4(p.require_lo, p.require_hi, p.exclude_lo, p.exclude_hi);
+    skipped[t] = skipped_ranges(p);
+    best_cost[t] = kInfinity;
+    best_frame[t] = kNone;
     [[unroll]] for (uint j = 0; j < K; ++j) best[t][j] = uvec2(kNone, kNone);
-    worst[t] = uintBitsToFloat(0x7F800000u);
+    worst[t] = kInfinity;
   }
 
   const uint row_begin = block * pc.rows_per_invocation;
   const uint row_end = min(row_begin + pc.rows_per_invocation, pc.frame_count);
-  for (uint r = row_begin; r < row_end; ++r) {
+  for (uint r = row_end; r > row_begin;) {
+    --r;
     const uvec4 meta = texelFetch(frame_meta, int(r));
-    const vec2 scale_bias = texelFetch(frame_cost, int(r)).xy;
+    vec2 scale_bias = texelFetch(frame_cost, int(r)).xy;
+    // Do-not-use, edge-excluded and block-transition rows are candidates only
+    // as a continuing frame, which the merge pass evaluates.
+    if ((meta.x & (kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition)) != 0u) scale_bias.y = kNaN;
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(r * DV + v));
 
     [[unroll]] for (uint t = 0; t < T; ++t) {
-      precise float total = 0.0;
-      precise float channel_sum = 0.0;
-      uint c = 0u;
-      [[unroll]] for (uint d = 0; d < DIMS; ++d) {
-        precise float diff = x[d >> 2u][d & 3u] - q[t][d >> 2u][d & 3u];
-        channel_sum = channel_sum + diff * diff;
-        if (ends_channel(d)) {
-          total = total + w[t][c] * channel_sum;
-          channel_sum = 0.0;
-          ++c;
-        }
-      }
-      precise float cost = scale_bias.x * total + scale_bias.y;
-      const bool continuing = r == p[t].continuing_frame;
-      if (continuing) cost = cost + p[t].continuing_bias;
-
-      // One float compare on the hot path (NaN and ties pass it); the exact
-      // (cost, frame) order and the candidate rules run only for a pair that
-      // may enter the best K, which is rare once good rows were seen.
-      if (!(cost > worst[t])) {
+      const float cost = row_cost(x, q[t], w[t], scale_bias);
+      // The candidate rules as integer operations, no short-circuit branch.
+      const uint rejected = ((meta.y & tags[t].x) ^ tags[t].x) | ((meta.z & tags[t].y) ^ tags[t].y) |
+                            (meta.y & tags[t].z) | (meta.z & tags[t].w) |
+                            uint(r - skipped[t].x <= skipped[t].y) | uint(r - skipped[t].z <= skipped[t].w);
+      if (K == 1u) {
+        const bool better = rejected == 0u && cost <= best_cost[t];
+        best_cost[t] = better ? cost : best_cost[t];
+        best_frame[t] = better ? r : best_frame[t];
+      } else if (rejected == 0u && !(cost > worst[t])) {
+        // Rare once good rows were seen (but lavapipe masks, not skips, it).
         const uvec2 candidate = uvec2(orderable_bits(cost), r);
-        if (pair_less(candidate, best[t][K - 1u]) && !isnan(cost) && is_candidate(r, meta, continuing, p[t])) {
+        if (pair_less(candidate, best[t][K - 1u]) && !isnan(cost)) {
           best[t][K - 1u] = candidate;
           [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
             if (pair_less(best[t][j], best[t][j - 1u])) {
@@ -119,7 +151,7 @@ void main() {
               best[t][j - 1u] = swap;
             }
           }
-          worst[t] = best[t][K - 1u].y == kNone ? uintBitsToFloat(0x7F800000u) : cost_of_key(best[t][K - 1u].x);
+          worst[t] = best[t][K - 1u].y == kNone ? kInfinity : cost_of_key(best[t][K - 1u].x);
         }
       }
     }
@@ -129,6 +161,10 @@ void main() {
     const uint local_query = tile_first + t;
     if (local_query >= pc.query_count) break;
     const uint base = (local_query * pc.block_count + block) * K;
-    [[unroll]] for (uint j = 0; j < K; ++j) scratch[base + j] = best[t][j];
+    if (K == 1u) {
+      scratch[base] = best_frame[t] == kNone ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost[t]), best_frame[t]);
+    } else {
+      [[unroll]] for (uint j = 0; j < K; ++j) scratch[base + j] = best[t][j];
+    }
   }
 }

@@ -56,7 +56,19 @@ Result<BruteForceKernel> BruteForceKernel::create(const Context& context, VkPipe
       if (!scan) return scan.error();
       kernel.variants_.push_back(Variant{k, tile, std::move(*scan)});
     }
-    const std::array<SpecValue, 2> merge_spec = {{{kSpecWorkgroupSize, shape.workgroup_size}, {kSpecK, k}}};
+    // The scan skips each query's continuing frame; the merge evaluates it.
+    const std::array<SpecValue, 10> merge_spec = {{
+        {kSpecWorkgroupSize, shape.workgroup_size},
+        {kSpecDimVec4s, shape.dim_vec4s},
+        {kSpecDims, shape.dims},
+        {kSpecK, k},
+        {kSpecChannels, shape.channels},
+        {kSpecEndMask0 + 0, shape.end_mask[0]},
+        {kSpecEndMask0 + 1, shape.end_mask[1]},
+        {kSpecEndMask0 + 2, shape.end_mask[2]},
+        {kSpecEndMask0 + 3, shape.end_mask[3]},
+        {kSpecMergeContinuing, 1},  // a VkBool32
+    }};
     Result<UniquePipeline> merge = create_compute_pipeline(context, layout, "topk_merge", merge_spec);
     if (!merge) return merge.error();
     kernel.merges_.emplace_back(k, std::move(*merge));

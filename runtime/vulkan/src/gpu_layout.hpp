@@ -66,6 +66,7 @@ enum SpecId : std::uint32_t {
   kSpecK = 4,
   kSpecChannels = 5,
   kSpecEndMask0 = 6,  // .. kSpecEndMask0 + 3
+  kSpecMergeContinuing = 10,  // topk_merge: evaluate the continuing frame
 };
 inline constexpr std::uint32_t kMaxKernelDims = 128;  // four 32-bit end masks
 

@@ -19,6 +19,10 @@ const uint kSkip = 0xFFFFFFFFu;
 // Flags that make a frame a non-candidate (mmvk::kFrameDoNotUse |
 // kFrameEdgeExcluded | kFrameBlockTransition) when it is not continued.
 const uint kNeverCandidate = 7u;
+// Invocations per member block (cluster_kernel.cpp: kRowLanes): lane i
+// evaluates the block's rows i, i + kRowLanes, ..., so the lanes of a SIMD
+// group share one block and one visit decision.
+const uint kRowLanes = 8u;
 
 // cluster_kernel.cpp: ClusterPush (32 bytes).
 layout(push_constant) uniform ClusterPush {
@@ -57,7 +61,23 @@ layout(set = 1, binding = 3) uniform samplerBuffer cluster_vectors;
 layout(std430, set = 1, binding = 4) buffer BoundKeys { uvec2 bound_keys[]; };
 // [max_batch] per query state, indexed by the query's batch index.
 layout(std430, set = 1, binding = 5) buffer States { ClusterQueryState states[]; };
-// [chunk x blocks x K] per-block best (key, frame) pairs.
+// [chunk x blocks x kRowLanes x K] per-lane best (key, frame) pairs of each block.
 layout(std430, set = 1, binding = 6) buffer BlockPairs { uvec2 block_pairs[]; };
+// Per scan round: (workgroups x, 1, 1, work items), the indirect dispatch
+// of cluster_scan; the host zeroes x and the count before each chunk.
+layout(std430, set = 1, binding = 7) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
+// [chunk x blocks] (local query, block) pairs the current scan round visits.
+layout(std430, set = 1, binding = 8) buffer WorkItems { uvec2 work_items[]; };
+
+// Appends a block to evaluate for a query in scan round `round`: only the
+// visited blocks are dispatched (a grid over every (block, query) spent
+// most of its time on pruned invocations: 435 of 500 ms on 22k frames).
+// The group count is ceil(items / items per workgroup), raised by the
+// appender of each workgroup's first item.
+void append_work(uint round, uint local_query, uint block) {
+  const uint index = atomicAdd(scan_dispatch[round].w, 1u);
+  work_items[index] = uvec2(local_query, block);
+  if (index % (gl_WorkGroupSize.x / kRowLanes) == 0u) atomicAdd(scan_dispatch[round].x, 1u);
+}
 
 #endif

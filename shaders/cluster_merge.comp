@@ -1,12 +1,15 @@
 // Cluster search, pass 4 (twice per chunk): one invocation per query merges
-// the continuing frame's pair and the per-block best pairs of the visited
+// the continuing frame's pair and the per-lane best pairs of the visited
 // blocks into the query's best K, in the strict (cost, frame) order.
 //  round 0: the seed cluster's blocks; writes the k-th best key as the
-//           upper bound of round 1 (kSkip while fewer than k were found).
+//           upper bound of round 1 (kSkip while fewer than k were found)
+//           and lists the blocks of the other clusters whose bound key is
+//           <= it for scan round 1.
 //  round 1: every visited block (the seed's, and those whose cluster bound
 //           key is <= the upper bound); writes the results and the number
-//           of rows evaluated. The block loop runs at most block_count
-//           iterations (capped for llvmpipe's loop limit).
+//           of rows evaluated. The loops run at most block_count x
+//           (kRowLanes + 1) + cluster_count iterations (capped for
+//           llvmpipe's loop limit).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -52,8 +55,8 @@ void main() {
     if (state.seed != kNone) {
       const uint first = texelFetch(cluster_info, int(state.seed * 3u)).w;
       const uint end = texelFetch(cluster_info, int(state.seed * 3u + 2u)).z;
-      for (uint b = first; b < end; ++b) {
-        [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[(pair_base + b) * K + i]);
+      for (uint lane_list = first * kRowLanes; lane_list < end * kRowLanes; ++lane_list) {
+        [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[(pair_base * kRowLanes + lane_list) * K + i]);
       }
     }
     uint upper = kSkip;
@@ -61,6 +64,14 @@ void main() {
       if (j + 1u == pc.k && best[j].y != kNone) upper = best[j].x;
     }
     states[query].upper_key = upper;
+    const uint key_base = local_query * pc.cluster_count;
+    for (uint c = 0u; c < pc.cluster_count; ++c) {
+      const uint key = bound_keys[key_base + c].x;
+      if (c == state.seed || key == kSkip || key > upper) continue;
+      const uint first = texelFetch(cluster_info, int(c * 3u)).w;
+      const uint end = texelFetch(cluster_info, int(c * 3u + 2u)).z;
+      for (uint b = first; b < end; ++b) append_work(1u, local_query, b);
+    }
     return;
   }
 
@@ -75,7 +86,10 @@ void main() {
     }
     if (visited) {
       rows += info.z - info.y;
-      [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[(pair_base + b) * K + i]);
+      for (uint lane = 0u; lane < kRowLanes; ++lane) {
+        const uint at = ((pair_base + b) * kRowLanes + lane) * K;
+        [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[at + i]);
+      }
     }
   }
   [[unroll]] for (uint j = 0; j < K; ++j) results[query * K + j] = best[j];

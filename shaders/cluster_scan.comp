@@ -1,15 +1,20 @@
-// Cluster search, pass 3 (twice per chunk): one invocation per (member
-// block, query) evaluates the block's rows and writes the query's best K
-// (key, frame) pairs of the block to block_pairs.
-//  round 0: only the blocks of the query's seed cluster;
+// Cluster search, pass 3 (twice per chunk, indirect): kRowLanes invocations
+// per work item (member block, query) evaluate the block's rows (lane i: rows i, i +
+// kRowLanes, ...) and write the query's best K (key, frame) pairs of their
+// rows to block_pairs. The lanes of a SIMD group share one block, so they
+// are all active or all pruned (one invocation per block left 7 of 8 lanes
+// idle on lavapipe: 1 visited block in 8 is typical).
+//  round 0: the blocks of the query's seed cluster (listed by
+//           cluster_select);
 //  round 1: the blocks of every other cluster whose bound key is <= the
-//           k-th best key after round 0 (strictly greater cannot win; equal
-//           may still win on a lower frame id). Pruned blocks write nothing:
-//           the merge reads only visited blocks.
+//           k-th best key after round 0 (listed by cluster_merge round 0;
+//           strictly greater cannot win, equal may still win on a lower
+//           frame id). Pruned blocks write nothing: the merge reads only
+//           visited blocks.
 // Rows are evaluated with the brute-force scan's arithmetic
 // (search_cost.glsl); the continuing frame is skipped (cluster_select
 // evaluated it with its bias). The row loop runs at most rows_per_block
-// iterations (llvmpipe's loop limit).
+// / kRowLanes iterations (llvmpipe's loop limit).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -29,20 +34,14 @@ layout(constant_id = 9) const uint END_MASK_3 = 0u;
 #include "search_cost.glsl"
 
 void main() {
-  const uint block = gl_GlobalInvocationID.x;
-  if (block >= pc.block_count) return;
-  const uint local_query = gl_WorkGroupID.y;
+  const uint item = gl_GlobalInvocationID.x / kRowLanes;
+  const uint lane = gl_GlobalInvocationID.x % kRowLanes;
+  if (item >= scan_dispatch[pc.round].w) return;
+  const uvec2 work = work_items[item];
+  const uint local_query = work.x;
+  const uint block = work.y;
   const uint query = pc.query_base + local_query;
   const uvec4 info = texelFetch(block_info, int(block));
-  const uint cluster = info.x;
-  const uint seed = states[query].seed;
-  if (pc.round == 0u) {
-    if (cluster != seed) return;
-  } else {
-    if (cluster == seed) return;
-    const uint key = bound_keys[local_query * pc.cluster_count + cluster].x;
-    if (key == kSkip || key > states[query].upper_key) return;
-  }
 
   vec4 q[DV];
   float w[CHANNELS];
@@ -53,7 +52,7 @@ void main() {
   [[unroll]] for (uint j = 0; j < K; ++j) best[j] = uvec2(kNone, kNone);
   float worst = uintBitsToFloat(0x7F800000u);  // cost of best[K - 1], +inf while empty
 
-  for (uint m = info.y; m < info.z; ++m) {
+  for (uint m = info.y + lane; m < info.z; m += kRowLanes) {
     const uint r = texelFetch(members, int(m)).x;
     const uvec4 meta = texelFetch(frame_meta, int(r));
     vec4 x[DV];
@@ -75,6 +74,6 @@ void main() {
       }
     }
   }
-  const uint out_base = (local_query * pc.block_count + block) * K;
+  const uint out_base = ((local_query * pc.block_count + block) * kRowLanes + lane) * K;
   [[unroll]] for (uint j = 0; j < K; ++j) block_pairs[out_base + j] = best[j];
 }

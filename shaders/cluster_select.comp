@@ -5,7 +5,7 @@
 //    keys: 32 counting loops over the clusters, so cluster_count is capped
 //    for llvmpipe's loop limit).
 //  - picks the seed: the cluster of least (bound, id), which ClusterSearch
-//    visits first;
+//    visits first, and lists its blocks for scan round 0;
 //  - evaluates the continuing frame (cost with continuing_bias), which the
 //    cluster scans skip, as ClusterSearch seeds it.
 #version 460
@@ -73,6 +73,12 @@ void main() {
       seed_key = key;
       seed = c;
     }
+  }
+
+  if (seed != kNone) {
+    const uint first = texelFetch(cluster_info, int(seed * 3u)).w;
+    const uint end = texelFetch(cluster_info, int(seed * 3u + 2u)).z;
+    for (uint b = first; b < end; ++b) append_work(0u, local_query, b);
   }
 
   uvec2 continuing_pair = uvec2(kNone, kNone);

@@ -47,27 +47,36 @@ enum ClusterBinding : std::uint32_t {
   kBindingBoundKeys = 4,       // storage
   kBindingStates = 5,          // storage
   kBindingBlockPairs = 6,      // storage
+  kBindingScanDispatch = 7,    // storage + indirect
+  kBindingWorkItems = 8,       // storage
 };
-constexpr std::uint32_t kClusterBindingCount = 7;
+constexpr std::uint32_t kClusterBindingCount = 9;
 constexpr std::uint32_t kClusterTexelBindings = 4;
-constexpr std::uint32_t kClusterStorageBindings = 3;
+constexpr std::uint32_t kClusterStorageBindings = 5;
+// The reset value of ScanDispatch: per round (groups x, 1, 1, items).
+constexpr std::array<std::uint32_t, 8> kScanDispatchReset = {0, 1, 1, 0, 0, 1, 1, 0};
 
-// Rows per scan invocation: a few hundred keeps llvmpipe's loop limit far
-// away and splits big clusters over several invocations (B = 1 latency).
-constexpr std::uint32_t kRowsPerBlock = 256;
+// Rows per member block, evaluated by kRowLanes invocations (64 rows each
+// at most): big clusters split over several workgroups (B = 1 latency).
+constexpr std::uint32_t kRowsPerBlock = 512;
+constexpr std::uint32_t kRowLanes = 8;  // cluster_layout.glsl
 // Loop limits of one invocation (llvmpipe stops loops at 65,535 iterations
-// in total): the final merge walks every block, the nprobe selection walks
-// the clusters 35 times.
-constexpr std::uint32_t kMaxBlocks = 16384;
+// in total): the final merge walks every block and the lanes of the visited
+// ones, the nprobe selection walks the clusters 35 times.
+constexpr std::uint32_t kMaxBlocks = 7000;
 constexpr std::uint32_t kMaxProbeClusters = 1800;
 
-void compute_barrier(VkCommandBuffer commands) {
+// Between any two steps of a chunk: shader writes, the dispatch-argument
+// reset (a transfer) and indirect reads are all ordered.
+void full_barrier(VkCommandBuffer commands) {
+  constexpr VkPipelineStageFlags stages =
+      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
   VkMemoryBarrier barrier{};
   barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                       &barrier, 0, nullptr, 0, nullptr);
+  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                          VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+  vkCmdPipelineBarrier(commands, stages, stages, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
 
 template <class T>
@@ -132,6 +141,11 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   }
   ClusterKernel kernel;
   kernel.shape_ = shape;
+  // 64 invocations per workgroup, also on CPU drivers: most cluster
+  // invocations exit at once (pruned blocks), and lavapipe's cost per
+  // workgroup added up with 8.
+  kernel.shape_.workgroup_size =
+      std::min({64u, limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
   kernel.max_batch_ = options.max_batch;
   const std::uint32_t clusters = table.cluster_count;
   kernel.cluster_count_ = clusters;
@@ -240,11 +254,15 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   // Per-slot scratch: at least one query, at most max_batch, within the
   // budget and maxStorageBufferRange.
   const std::uint64_t range = limits.maxStorageBufferRange;
-  const std::uint64_t pairs_per_query = std::uint64_t{kernel.block_count_} * k_class(options.max_k);
+  const std::uint64_t pairs_per_query = std::uint64_t{kernel.block_count_} * kRowLanes * k_class(options.max_k);
   const std::uint64_t per_query_bytes = (pairs_per_query + clusters) * 8;
   std::uint64_t chunk = std::clamp<std::uint64_t>(options.scratch_bytes / per_query_bytes, 1, options.max_batch);
+  // The indirect scans: every block of the chunk visited must stay within
+  // maxComputeWorkGroupCount[0] workgroups.
+  const std::uint64_t items_per_group = kernel.shape_.workgroup_size / kRowLanes;
   chunk = std::min({chunk, range / (pairs_per_query * 8), range / (std::uint64_t{clusters} * 8),
-                    std::uint64_t{limits.maxComputeWorkGroupCount[1]}});
+                    std::uint64_t{limits.maxComputeWorkGroupCount[1]},
+                    std::uint64_t{limits.maxComputeWorkGroupCount[0]} * items_per_group / kernel.block_count_});
   if (chunk == 0) return make_error("Vulkan: one query's cluster scratch exceeds maxStorageBufferRange");
   kernel.bound_capacity_ = chunk * clusters;
   kernel.pair_capacity_ = chunk * pairs_per_query;
@@ -273,13 +291,23 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
         create_buffer(context, kernel.pair_capacity_ * 8, storage, MemoryUse::DeviceLocal, "the cluster block pairs");
     if (!pairs) return pairs.error();
     slot.block_pairs = std::move(*pairs);
+    Result<Buffer> scan_dispatch =
+        create_buffer(context, sizeof(kScanDispatchReset),
+                      storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                      MemoryUse::DeviceLocal, "the cluster scan dispatch arguments");
+    if (!scan_dispatch) return scan_dispatch.error();
+    slot.scan_dispatch = std::move(*scan_dispatch);
+    Result<Buffer> work_items = create_buffer(context, chunk * kernel.block_count_ * 8, storage, MemoryUse::DeviceLocal,
+                                              "the cluster work items");
+    if (!work_items) return work_items.error();
+    slot.work_items = std::move(*work_items);
     slot.set = sets[s];
 
     const std::array<VkBufferView, kClusterTexelBindings> views = {
         kernel.members_.view.get(), kernel.block_info_.view.get(), kernel.cluster_info_.view.get(),
         kernel.cluster_vectors_.view.get()};
-    const std::array<const Buffer*, kClusterStorageBindings> buffers = {&slot.bound_keys, &slot.states,
-                                                                        &slot.block_pairs};
+    const std::array<const Buffer*, kClusterStorageBindings> buffers = {
+        &slot.bound_keys, &slot.states, &slot.block_pairs, &slot.scan_dispatch, &slot.work_items};
     std::array<VkDescriptorBufferInfo, kClusterStorageBindings> buffer_infos{};
     std::array<VkWriteDescriptorSet, kClusterBindingCount> writes{};
     for (std::uint32_t b = 0; b < kClusterBindingCount; ++b) {
@@ -303,7 +331,7 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   // Pipelines: bounds and select once, scan and merge per K class.
   const auto spec_for = [&](std::uint32_t k) {
     return std::array<SpecValue, 9>{{
-        {kSpecWorkgroupSize, shape.workgroup_size},
+        {kSpecWorkgroupSize, kernel.shape_.workgroup_size},
         {kSpecDimVec4s, shape.dim_vec4s},
         {kSpecDims, shape.dims},
         {kSpecK, k},
@@ -340,7 +368,8 @@ std::vector<std::uint32_t> ClusterKernel::k_classes() const {
 }
 
 std::uint32_t ClusterKernel::chunk_for(std::uint32_t kc) const {
-  const std::uint64_t chunk = std::min(bound_capacity_ / cluster_count_, pair_capacity_ / (std::uint64_t{block_count_} * kc));
+  const std::uint64_t chunk =
+      std::min(bound_capacity_ / cluster_count_, pair_capacity_ / (std::uint64_t{block_count_} * kRowLanes * kc));
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(chunk, max_batch_));
 }
 
@@ -360,6 +389,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
   const std::array<VkDescriptorSet, 2> sets = {search_set, slots_[slot].set};
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 2, sets.data(), 0,
                           nullptr);
+  const VkBuffer scan_dispatch = slots_[slot].scan_dispatch.buffer.get();
   const auto dispatch = [&](VkPipeline pipeline, const ClusterPush& push, std::uint32_t groups_x,
                             std::uint32_t groups_y, const char* name) -> Status {
     if (groups_x == 0 || groups_y == 0 || groups_x > limits.maxComputeWorkGroupCount[0] ||
@@ -376,17 +406,21 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
     const std::uint32_t count = std::min(chunk, batch - base);
     ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, 0};
     const std::uint32_t query_groups = (count + wg - 1) / wg;
-    const std::uint32_t block_groups = (block_count_ + wg - 1) / wg;
     // The previous chunk's last merge read the scratch this chunk rewrites.
-    if (base != 0) compute_barrier(commands);
+    if (base != 0) full_barrier(commands);
+    vkCmdUpdateBuffer(commands, scan_dispatch, 0, sizeof(kScanDispatchReset), kScanDispatchReset.data());
     MMVK_TRY(dispatch(bounds_.get(), push, (cluster_count_ + wg - 1) / wg, count, "cluster_bounds"));
-    compute_barrier(commands);
+    full_barrier(commands);
     MMVK_TRY(dispatch(select_.get(), push, query_groups, 1, "cluster_select"));
     for (std::uint32_t round = 0; round < 2; ++round) {
       push.round = round;
-      compute_barrier(commands);
-      MMVK_TRY(dispatch(variant->scan.get(), push, block_groups, count, "cluster_scan"));
-      compute_barrier(commands);
+      full_barrier(commands);
+      // The work items (and so the group count) were listed on the GPU;
+      // the chunk cap above keeps the count within the device's limit.
+      vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, variant->scan.get());
+      vkCmdPushConstants(commands, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(ClusterPush), &push);
+      vkCmdDispatchIndirect(commands, scan_dispatch, std::uint64_t{round} * 16);
+      full_barrier(commands);
       MMVK_TRY(dispatch(variant->merge.get(), push, query_groups, 1, "cluster_merge"));
     }
   }

@@ -2,14 +2,16 @@
 // ClustersExact and NProbe modes: the ClusterTable uploaded once (set 1 of
 // the cluster pipelines), per-slot scratch, and the recording of a batch.
 //
-// Per chunk of queries, six dispatches:
+// Per chunk of queries, six dispatches (two indirect):
 //   cluster_bounds  (cluster, query): lower bound key per cluster, kSkip for
 //                   clusters without candidates; centroid distance (nprobe)
 //   cluster_select  (query): nprobe selection, the seed cluster (least
 //                   bound), the continuing frame's pair
-//   cluster_scan    round 0 (block, query): the seed cluster's blocks
-//   cluster_merge   round 0 (query): the k-th best so far = upper bound
-//   cluster_scan    round 1: blocks of clusters with bound <= upper bound
+//   cluster_scan    round 0 (8 lanes per listed block, indirect): the seed
+//                   cluster's blocks (listed by cluster_select)
+//   cluster_merge   round 0 (query): the k-th best so far = upper bound;
+//                   lists the blocks of clusters with bound <= upper bound
+//   cluster_scan    round 1: the listed blocks
 //   cluster_merge   round 1: final best K, rows evaluated
 // Exactness: the seed's k-th best is >= the true k-th best, and a cluster
 // whose bound is strictly above it holds no member that can enter the best
@@ -66,7 +68,9 @@ class ClusterKernel {
   struct SlotScratch {
     Buffer bound_keys;   // [chunk x clusters] uvec2
     Buffer states;       // [max_batch] ClusterQueryState, host-mapped
-    Buffer block_pairs;  // [chunk x blocks x K] uvec2
+    Buffer block_pairs;  // [chunk x blocks x kRowLanes x K] uvec2
+    Buffer scan_dispatch;  // 2 x (groups x, 1, 1, items): indirect args of the scans
+    Buffer work_items;     // [chunk x blocks] (local query, block)
     VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
   };
   struct Variant {

@@ -54,7 +54,7 @@ void main() {
       q[v] = query_features[query * DV + v];
       lo[v] = texelFetch(cluster_vectors, int((c * 3u) * DV + v));
       hi[v] = texelFetch(cluster_vectors, int((c * 3u + 1u) * DV + v));
-      center[v] = texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v));
+      center[v] = pc.nprobe != 0u ? texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v)) : vec4(0.0);
     }
     [[unroll]] for (uint i = 0; i < CHANNELS; ++i) w[i] = query_weights[query * CHANNELS + i];
     precise float total = 0.0;
@@ -70,12 +70,15 @@ void main() {
       const float outside = below > above ? below : above;
       const float gap = outside > 0.0 ? outside : 0.0;
       sum = sum + gap * gap;
-      // The centroid as a zero-size box (ClusterSearch's nprobe distance).
-      precise float c_below = center[d >> 2u][d & 3u] - qd;
-      precise float c_above = qd - center[d >> 2u][d & 3u];
-      const float c_outside = c_below > c_above ? c_below : c_above;
-      const float c_gap = c_outside > 0.0 ? c_outside : 0.0;
-      distance_sum = distance_sum + c_gap * c_gap;
+      // The centroid as a zero-size box (ClusterSearch's nprobe distance);
+      // skipped in exact mode (a uniform branch).
+      if (pc.nprobe != 0u) {
+        precise float c_below = center[d >> 2u][d & 3u] - qd;
+        precise float c_above = qd - center[d >> 2u][d & 3u];
+        const float c_outside = c_below > c_above ? c_below : c_above;
+        const float c_gap = c_outside > 0.0 ? c_outside : 0.0;
+        distance_sum = distance_sum + c_gap * c_gap;
+      }
       if (ends_channel(d)) {
         if (w[ch] != 0.0) {
           total = total + w[ch] * sum;

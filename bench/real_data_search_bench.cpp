@@ -10,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -28,7 +29,7 @@
 namespace mmvk::bench {
 namespace {
 
-enum class Backend { Reference, FastBrute, FastPruned, ClustersExact, Nprobe1, Nprobe4, Nprobe16 };
+enum class Backend { Reference, FastBrute, FastPruned, ClustersExact, Nprobe1, Nprobe4, Nprobe8, Nprobe16, Nprobe32, Nprobe64 };
 
 const char* backend_name(Backend backend) {
   switch (backend) {
@@ -38,7 +39,10 @@ const char* backend_name(Backend backend) {
     case Backend::ClustersExact: return "clusters";
     case Backend::Nprobe1: return "nprobe1";
     case Backend::Nprobe4: return "nprobe4";
+    case Backend::Nprobe8: return "nprobe8";
     case Backend::Nprobe16: return "nprobe16";
+    case Backend::Nprobe32: return "nprobe32";
+    case Backend::Nprobe64: return "nprobe64";
   }
   return "?";
 }
@@ -60,11 +64,17 @@ Fixture* fixture(DataSet set) {
   auto f = std::make_unique<Fixture>();
   f->db = database(set);
   if (f->db) {
+    // MMVK_BENCH_CLUSTERS=n trains n clusters instead of the default (for
+    // tuning); each count has its own cache file.
+    KMeansParams params;
+    const char* clusters = std::getenv("MMVK_BENCH_CLUSTERS");
+    if (clusters != nullptr) params.clusters = static_cast<std::uint32_t>(std::strtoul(clusters, nullptr, 10));
+    const std::string suffix = params.clusters == 0 ? "" : "-c" + std::to_string(params.clusters);
     const std::filesystem::path cache =
-        std::filesystem::path(MMVK_BENCH_WORK_DIR) / (std::string(data_set_name(set)) + ".mmkc");
+        std::filesystem::path(MMVK_BENCH_WORK_DIR) / (std::string(data_set_name(set)) + suffix + ".mmkc");
     Result<ClusterTable> table = load_cluster_table(cache);
     if (!table || !validate_cluster_table(*table, *f->db).ok()) {
-      table = train_cluster_table(*f->db, KMeansParams{});
+      table = train_cluster_table(*f->db, params, f->pool);
       if (table) (void)save_cluster_table(*table, cache);
     }
     if (!table) {
@@ -75,9 +85,15 @@ Fixture* fixture(DataSet set) {
       f->backends[Backend::Reference] = std::make_unique<ReferenceSearch>(*f->db);
       f->backends[Backend::FastBrute] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = false});
       f->backends[Backend::FastPruned] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = true});
-      for (auto [backend, nprobe] : {std::pair{Backend::ClustersExact, 0u}, std::pair{Backend::Nprobe1, 1u},
-                                     std::pair{Backend::Nprobe4, 4u}, std::pair{Backend::Nprobe16, 16u}}) {
-        auto made = ClusterSearch::create(*f->db, f->table, f->pool, {.nprobe = nprobe});
+      for (auto [backend, nprobe] :
+           {std::pair{Backend::ClustersExact, 0u}, std::pair{Backend::Nprobe1, 1u}, std::pair{Backend::Nprobe4, 4u},
+            std::pair{Backend::Nprobe8, 8u}, std::pair{Backend::Nprobe16, 16u}, std::pair{Backend::Nprobe32, 32u},
+            std::pair{Backend::Nprobe64, 64u}}) {
+        ClusterSearchOptions options{.nprobe = nprobe};
+        // Tuning switches (MMVK_BENCH_PROBE_BY_BOUND=1, MMVK_BENCH_NO_SEED=1).
+        options.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
+        options.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
+        auto made = ClusterSearch::create(*f->db, f->table, f->pool, options);
         if (made) f->backends[backend] = std::move(made.value());
       }
     }
@@ -118,13 +134,20 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, Backend which
   state.counters["rows_fraction"] = backend.stats().rows_fraction(f->db->frame_count());
   state.counters["recall@1"] = double(hits) / double(batch);
   state.counters["frames"] = f->db->frame_count();
+  if (const auto* clusters = dynamic_cast<const ClusterSearch*>(&backend)) {
+    const double queries = double(backend.stats().queries);
+    state.counters["clusters"] = clusters->cluster_count();
+    state.counters["visited/q"] = double(clusters->counters().clusters_visited) / queries;
+    state.counters["tiles_checked/q"] = double(clusters->counters().tiles_checked) / queries;
+  }
 }
 
 const bool registered = [] {
   for (DataSet set : {DataSet::Locomotion, DataSet::Volume, DataSet::VolumeMirrored}) {
     for (QueryStream stream : {QueryStream::Transition, QueryStream::Continue, QueryStream::Uniform}) {
       for (Backend which : {Backend::Reference, Backend::FastBrute, Backend::FastPruned, Backend::ClustersExact,
-                            Backend::Nprobe1, Backend::Nprobe4, Backend::Nprobe16}) {
+                            Backend::Nprobe1, Backend::Nprobe4, Backend::Nprobe8, Backend::Nprobe16, Backend::Nprobe32,
+                            Backend::Nprobe64}) {
         const std::string name = std::string("real/") + std::string(data_set_name(set)) + "/" +
                                  std::string(query_stream_name(stream)) + "/" + backend_name(which);
         auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, which);

@@ -27,9 +27,14 @@ std::size_t pad8(std::size_t n) { return (n + 7) / 8 * 8; }
 
 constexpr std::uint32_t kNeverCandidate = kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition;
 
+constexpr std::uint32_t kNoCluster = 0xffffffffu;
+
+// Ordered by (bound, cluster); in nprobe mode `bound` is the centroid
+// distance and `lower` the lower bound.
 struct ClusterBound {
   float bound;
   std::uint32_t cluster;
+  float lower = 0.0f;
   friend bool operator<(const ClusterBound& a, const ClusterBound& b) {
     return a.bound < b.bound || (a.bound == b.bound && a.cluster < b.cluster);
   }
@@ -351,19 +356,20 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         if (l.never_candidate[c]) continue;
         if ((t.tag_union[c] & params.require_all) != params.require_all) continue;
         if ((t.tag_intersection[c] & params.exclude_any) != 0) continue;
-        s.order.push_back({0.0f, c});
+        s.order.push_back({0.0f, c, 0.0f});
       }
-      if (options.nprobe != 0 && options.nprobe < s.order.size()) {
-        // Channel-weighted squared centroid distances: a box bound of the
-        // zero-size boxes [centroid, centroid] with unit multipliers.
+      const bool probing = options.nprobe != 0 && options.nprobe < s.order.size();
+      // Nearest-centroid seed (exact mode) or probe order (nprobe mode):
+      // channel-weighted squared centroid distances, a box bound of the
+      // zero-size boxes [centroid, centroid] with unit multipliers.
+      const bool by_centroid = probing && !options.probe_by_bound;
+      const bool seeding = !by_centroid && options.seed_nearest && s.order.size() > 1;
+      if (by_centroid || seeding) {
         box_bounds(l, l.centroid_t.data(), l.centroid_t.data(), pad8(t.cluster_count), t.cluster_count, l.ones.data(), q,
                    w, s, s.distance.data());
-        for (ClusterBound& b : s.order) b.bound = s.distance[b.cluster];
-        std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
-        s.order.resize(options.nprobe);
       }
+      float* bound = s.box.data();
       if (!s.order.empty()) {
-        float* bound = s.box.data();
         if (options.box_bound) {
           box_bounds(l, l.cluster_lo.data(), l.cluster_hi.data(), pad8(t.cluster_count), t.cluster_count,
                      t.min_multiplier.data(), q, w, s, bound);
@@ -373,25 +379,19 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
         if (options.radius_bound) radius_bounds(l, q, w, s, bound);
         for (ClusterBound& b : s.order) b.bound = bound[b.cluster] + t.min_bias[b.cluster];
       }
-      // A min-heap: usually only a few clusters are visited, so popping them
-      // in order beats sorting all of them.
-      const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
-      std::make_heap(s.order.begin(), s.order.end(), heap_order);
 
-      for (auto heap_end = s.order.end(); heap_end != s.order.begin(); --heap_end) {
-        std::pop_heap(s.order.begin(), heap_end, heap_order);
-        const ClusterBound& b = *(heap_end - 1);
-        // Strictly greater: a member costing exactly the k-th best could still
-        // win on a lower frame id.
-        if (b.bound > best[k - 1].cost) break;
+      // Evaluates the tiles of cluster c whose own bound is at most the k-th
+      // best (strictly greater is skipped: a member costing exactly the k-th
+      // best could still win on a lower frame id). Uses s.box as scratch.
+      const auto visit = [&](std::uint32_t c) {
         ++s.counters.clusters_visited;
-        const std::uint32_t first_tile = l.tile_offsets[b.cluster];
-        const std::uint32_t tiles = l.tile_offsets[b.cluster + 1] - first_tile;
+        const std::uint32_t first_tile = l.tile_offsets[c];
+        const std::uint32_t tiles = l.tile_offsets[c + 1] - first_tile;
         float* tile_bound = s.box.data();
         if (options.tile_bound) {
           // Members are in frame order, so a tile mostly holds neighbouring
           // frames of a clip and its box is tight.
-          const std::size_t at = l.tile_box_offset[b.cluster];
+          const std::size_t at = l.tile_box_offset[c];
           box_bounds(l, l.tile_lo.data() + at, l.tile_hi.data() + at, pad8(tiles), tiles,
                      l.tile_min_multiplier.data() + first_tile, q, w, s, tile_bound);
           s.counters.tiles_checked += tiles;
@@ -413,6 +413,54 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
             insert(best, candidate);
           }
         }
+      };
+
+      if (by_centroid) {
+        // The nprobe nearest centroids, nearest first (the most likely home
+        // of the answer, so the k-th best tightens early); a probed cluster
+        // whose lower bound is above the k-th best is skipped, which never
+        // changes the result.
+        for (ClusterBound& b : s.order) {
+          b.lower = b.bound;
+          b.bound = s.distance[b.cluster];
+        }
+        std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
+        s.order.resize(options.nprobe);
+        std::sort(s.order.begin(), s.order.end());
+        for (const ClusterBound& b : s.order) {
+          if (b.lower > best[k - 1].cost) continue;
+          visit(b.cluster);
+        }
+        continue;
+      }
+
+      // Exact: first the cluster of the nearest centroid (when seeding), to
+      // tighten the k-th best early, then every cluster in lower-bound order
+      // until the next bound is above the k-th best.
+      std::uint32_t seeded = kNoCluster;
+      std::uint32_t budget = probing ? options.nprobe : t.cluster_count;
+      if (seeding) {
+        const ClusterBound* nearest = &s.order.front();
+        for (const ClusterBound& b : s.order) {
+          if (s.distance[b.cluster] < s.distance[nearest->cluster]) nearest = &b;
+        }
+        seeded = nearest->cluster;
+        if (nearest->bound <= best[k - 1].cost) {
+          visit(seeded);
+          --budget;
+        }
+      }
+      // A min-heap: usually only a few clusters are visited, so popping them
+      // in order beats sorting all of them.
+      const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
+      std::make_heap(s.order.begin(), s.order.end(), heap_order);
+      for (auto heap_end = s.order.end(); heap_end != s.order.begin() && budget > 0; --heap_end) {
+        std::pop_heap(s.order.begin(), heap_end, heap_order);
+        const ClusterBound& b = *(heap_end - 1);
+        if (b.bound > best[k - 1].cost) break;
+        if (b.cluster == seeded) continue;
+        visit(b.cluster);
+        --budget;
       }
     }
   });

@@ -106,6 +106,8 @@ const Variant kExactVariants[] = {
     {"radius only", {.nprobe = 0, .box_bound = false, .radius_bound = true}},
     {"no tile bound", {.nprobe = 0, .box_bound = true, .radius_bound = true, .tile_bound = false}},
     {"no bounds", {.nprobe = 0, .box_bound = false, .radius_bound = false, .tile_bound = false}},
+    {"no nearest seed", {.nprobe = 0, .seed_nearest = false}},
+    {"nprobe=all by bound", {.nprobe = 1000000, .probe_by_bound = true}},
 };
 
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
@@ -209,22 +211,25 @@ TEST(ClusterSearch, NprobeResultsAreRealCandidatesWithTrueCosts) {
   ReferenceSearch reference(db);
   std::vector<Match> exact(count);
   ASSERT_TRUE(reference.search({features, params, count}, 1, exact).ok());
-  std::size_t previous_hits = 0;
-  for (std::uint32_t nprobe : {1u, 4u, 16u}) {
-    auto backend = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
-    ASSERT_TRUE(backend.ok());
-    std::vector<Match> out(count);
-    ASSERT_TRUE((*backend)->search({features, params, count}, 1, out).ok());
-    std::size_t hits = 0;
-    for (std::size_t i = 0; i < count; ++i) {
-      hits += out[i].frame == exact[i].frame;
-      if (out[i].frame == kNoFrame) continue;
-      EXPECT_TRUE(is_candidate(db, out[i].frame, params[i]));
-      EXPECT_EQ(out[i].cost, frame_cost(db, out[i].frame, {features.data() + i * db.dims(), db.dims()}, params[i]));
-      EXPECT_FALSE(match_less(out[i], exact[i])) << "nprobe cannot beat exact";
+  for (bool by_bound : {false, true}) {
+    std::size_t previous_hits = 0;
+    for (std::uint32_t nprobe : {1u, 4u, 16u}) {
+      auto backend = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .probe_by_bound = by_bound});
+      ASSERT_TRUE(backend.ok());
+      std::vector<Match> out(count);
+      ASSERT_TRUE((*backend)->search({features, params, count}, 1, out).ok());
+      std::size_t hits = 0;
+      for (std::size_t i = 0; i < count; ++i) {
+        hits += out[i].frame == exact[i].frame;
+        if (out[i].frame == kNoFrame) continue;
+        EXPECT_TRUE(is_candidate(db, out[i].frame, params[i]));
+        EXPECT_EQ(out[i].cost, frame_cost(db, out[i].frame, {features.data() + i * db.dims(), db.dims()}, params[i]));
+        EXPECT_FALSE(match_less(out[i], exact[i])) << "nprobe cannot beat exact";
+      }
+      EXPECT_GE(hits, previous_hits) << "more probes, no fewer exact hits (nprobe " << nprobe << ", by bound "
+                                     << by_bound << ")";
+      previous_hits = hits;
     }
-    EXPECT_GE(hits, previous_hits) << "more probes, no fewer exact hits (nprobe " << nprobe << ")";
-    previous_hits = hits;
   }
 }
 

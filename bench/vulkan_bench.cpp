@@ -229,6 +229,7 @@ BENCHMARK(BM_VulkanEndToEnd)
     ->ArgNames({"frames", "dims", "batch", "tile"})
     ->ArgsProduct({{22000, 417000}, {27}, {1, 64, 1024}, {16}})
     ->Args({417000, 27, 1024, 4})
+    ->Args({417000, 27, 1024, 32})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VulkanKernel)

@@ -126,6 +126,20 @@ TEST(VulkanSearch, ChunkedBatchesMatchReference) {
   compare(*search, db, std::span<const float>(queries).first(37 * db.dims()), std::span(params).first(37), 37, 16);
 }
 
+// The 32-query tile (k = 1, batches of 512 or more), with a partial last
+// tile and every constraint.
+TEST(VulkanSearch, LargestTileMatchesReference) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 3000, .seed = 109, .constraints = true});
+  // No warm-up: only the 32-query variant compiles (seconds on lavapipe).
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, search_options(600, 1, 32, false));
+  ASSERT_NE(search, nullptr);
+  const std::vector<float> queries = synthetic_queries(db, 600, 110);
+  const std::vector<QueryParams> params = random_params(db, 600, 111);
+  compare(*search, db, queries, params, 600, 1);
+  compare(*search, db, queries, {}, 600, 1);
+}
+
 TEST(VulkanSearch, AsyncSubmitPollWait) {
   MMVK_VULKAN_CONTEXT(context, ContextOptions{});
   const Database db = synthetic_database({.frames = 4000, .seed = 109, .constraints = true});

@@ -259,8 +259,8 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
                       std::to_string(kMaxK) + "]");
   }
   if (options.slots == 0) return make_error("VulkanSearch: slots must be >= 1");
-  if (options.max_tile != 1 && options.max_tile != 4 && options.max_tile != 16) {
-    return make_error("VulkanSearch: max_tile must be 1, 4 or 16, got " + std::to_string(options.max_tile));
+  if (options.max_tile != 1 && options.max_tile != 4 && options.max_tile != 16 && options.max_tile != 32) {
+    return make_error("VulkanSearch: max_tile must be 1, 4, 16 or 32, got " + std::to_string(options.max_tile));
   }
   if (options.rows_per_invocation > kMaxRowsPerInvocation) {
     return make_error("VulkanSearch: rows_per_invocation " + std::to_string(options.rows_per_invocation) +

@@ -50,9 +50,10 @@ struct VulkanSearchOptions {
   // Rows each scan invocation covers; 0 picks one from the frame count.
   // At most 32768, as llvmpipe stops loops at 65,535 iterations.
   std::uint32_t rows_per_invocation = 0;
-  // Largest query tile held in registers (1, 4 or 16; 16 only for k = 1).
-  // Bigger tiles are faster on large batches and slower to compile
-  // (lavapipe compiles the 16-query kernel for seconds at the first use).
+  // Largest query tile held in registers (1, 4, 16 or 32; 16 and 32 only
+  // for k = 1, 32 for batches of 512 or more). Bigger tiles are faster on
+  // large batches and slower to compile (lavapipe compiles the 16-query
+  // kernel for seconds at the first use).
   std::uint32_t max_tile = 16;
   // Per-slot scratch budget for the per-block best pairs, bytes; batches
   // whose scratch would not fit are processed in chunks inside one submit.

@@ -146,9 +146,13 @@ Result<std::uint32_t> nprobe_option(const ParsedArgs& args) {
 
 #if defined(MMVK_HAS_VULKAN)
 Status make_vulkan_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args,
-                           std::size_t batch) {
+                           std::size_t batch, std::uint32_t k) {
   vulkan::VulkanSearchOptions options;
   options.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
+  options.max_k = k;
+  // One search per run: warming up every kernel variant would compile (on
+  // lavapipe, for seconds) kernels this run never uses.
+  options.warm_up = false;
   const ClusterTable* clusters = nullptr;
   if (name != "vulkan") {
     MMVK_TRY(load_or_train_clusters(holder, db, args));
@@ -169,7 +173,7 @@ Status make_vulkan_backend(BackendHolder& holder, const Database& db, const std:
 #endif
 
 Status make_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args,
-                    std::size_t batch) {
+                    std::size_t batch, std::uint32_t k) {
   if (name == "reference") {
     holder.backend = std::make_unique<ReferenceSearch>(db);
   } else if (name == "fast" || name == "fast-brute") {
@@ -187,9 +191,10 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
     holder.backend = std::move(made.value());
   } else if (name == "vulkan" || name == "vulkan-clusters" || name == "vulkan-nprobe") {
 #if defined(MMVK_HAS_VULKAN)
-    return make_vulkan_backend(holder, db, name, args, batch);
+    return make_vulkan_backend(holder, db, name, args, batch, k);
 #else
     (void)batch;
+    (void)k;
     return make_error("backend '" + name + "': this mmvk was built without Vulkan (MMVK_BUILD_VULKAN=OFF)");
 #endif
   } else {
@@ -307,7 +312,8 @@ int run_query(Args args) {
 
   BackendHolder holder(static_cast<unsigned>(threads));
   const std::string backend_name = parsed->value("--backend").value_or("fast");
-  if (Status made = make_backend(holder, *db, backend_name, *parsed, count); !made) return fail(made.message());
+  const Status made = make_backend(holder, *db, backend_name, *parsed, count, static_cast<std::uint32_t>(k));
+  if (!made) return fail(made.message());
   std::vector<Match> results(count * k);
   const auto start = std::chrono::steady_clock::now();
   const Status searched =

@@ -63,6 +63,10 @@ struct Setup {
 };
 
 Setup* setup_for(DataSet set) {
+  // Statics are destroyed in reverse order of construction: creating the
+  // context first makes it outlive the Vulkan backends in the cache (the
+  // other order aborted at exit).
+  (void)shared_context();
   static std::map<DataSet, std::unique_ptr<Setup>> cache;
   std::unique_ptr<Setup>& slot = cache[set];
   if (slot) return slot->db ? slot.get() : nullptr;

@@ -79,46 +79,6 @@ void full_barrier(VkCommandBuffer commands) {
   vkCmdPipelineBarrier(commands, stages, stages, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
 
-template <class T>
-std::span<const std::byte> bytes_of(const std::vector<T>& values) {
-  return std::as_bytes(std::span<const T>(values));
-}
-
-Result<TexelBuffer> texel_buffer(const Context& context, VkCommandPool pool, VkFormat format, std::uint32_t texel_bytes,
-                                 std::span<const std::byte> data, const char* what, bool force_staging) {
-  const std::uint64_t texels = data.size() / texel_bytes;
-  if (texels > context.properties().limits.maxTexelBufferElements) {
-    return make_error(std::string("Vulkan: the cluster table is too large for this device: ") + what + " needs " +
-                      std::to_string(texels) + " texels, maxTexelBufferElements is " +
-                      std::to_string(context.properties().limits.maxTexelBufferElements));
-  }
-  VkFormatProperties format_props;
-  vkGetPhysicalDeviceFormatProperties(context.physical_device(), format, &format_props);
-  if ((format_props.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT) == 0) {
-    return make_error(std::string("Vulkan: the device cannot read ") + what + " as a uniform texel buffer");
-  }
-  Result<Buffer> buffer = create_buffer(context, data.size(),
-                                        VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                        MemoryUse::DeviceLocal, what);
-  if (!buffer) return buffer.error();
-  if (force_staging && buffer->mapped != nullptr) {
-    vkUnmapMemory(context.device(), buffer->memory.get());
-    buffer->mapped = nullptr;
-  }
-  MMVK_TRY(upload(context, pool, *buffer, data));
-  VkBufferViewCreateInfo info{};
-  info.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
-  info.buffer = buffer->buffer.get();
-  info.format = format;
-  info.range = data.size();
-  VkBufferView view = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateBufferView(context.device(), &info, nullptr, &view));
-  TexelBuffer result;
-  result.buffer = std::move(*buffer);
-  result.view = UniqueBufferView(context.device(), view);
-  return result;
-}
-
 }  // namespace
 
 Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPool pool,
@@ -193,19 +153,19 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   kernel.block_count_ = static_cast<std::uint32_t>(block_info.size());
   if (database.frame_count() != table.members.size()) return make_error("Vulkan: cluster table size mismatch");
 
-  Result<TexelBuffer> members = texel_buffer(context, pool, VK_FORMAT_R32_UINT, 4, bytes_of(table.members),
+  Result<TexelBuffer> members = make_texel_buffer(context, pool, VK_FORMAT_R32_UINT, 4, bytes_of(table.members),
                                              "the cluster members", options.force_staging);
   if (!members) return members.error();
   kernel.members_ = std::move(*members);
-  Result<TexelBuffer> blocks = texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(block_info),
+  Result<TexelBuffer> blocks = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(block_info),
                                             "the member blocks", options.force_staging);
   if (!blocks) return blocks.error();
   kernel.block_info_ = std::move(*blocks);
-  Result<TexelBuffer> info = texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(cluster_info),
+  Result<TexelBuffer> info = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(cluster_info),
                                           "the cluster info", options.force_staging);
   if (!info) return info.error();
   kernel.cluster_info_ = std::move(*info);
-  Result<TexelBuffer> boxes = texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(vectors),
+  Result<TexelBuffer> boxes = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(vectors),
                                            "the cluster boxes and centroids", options.force_staging);
   if (!boxes) return boxes.error();
   kernel.cluster_vectors_ = std::move(*boxes);

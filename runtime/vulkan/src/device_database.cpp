@@ -8,20 +8,13 @@
 
 namespace mmvk::vulkan::detail {
 
-namespace {
-
-template <class T>
-std::span<const std::byte> bytes_of(const std::vector<T>& values) {
-  return std::as_bytes(std::span<const T>(values));
-}
-
 Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool, VkFormat format,
                                       std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
                                       bool force_staging) {
   const std::uint64_t texels = data.size() / texel_bytes;
   const VkPhysicalDeviceLimits& limits = context.properties().limits;
   if (texels > limits.maxTexelBufferElements) {
-    return make_error(std::string("Vulkan: the database is too large for this device: ") + what + " needs " +
+    return make_error(std::string("Vulkan: too large for this device: ") + what + " needs " +
                       std::to_string(texels) + " texels, maxTexelBufferElements is " +
                       std::to_string(limits.maxTexelBufferElements));
   }
@@ -54,7 +47,7 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
   return result;
 }
 
-}  // namespace
+
 
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
                                        bool force_staging) {

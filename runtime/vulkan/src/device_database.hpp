@@ -7,7 +7,10 @@
 // maxStorageBufferRange (128 MiB).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "handles.hpp"
 #include "memory.hpp"
@@ -32,6 +35,18 @@ struct DeviceDatabase {
 };
 
 // force_staging: copy through a staging buffer even into mappable memory.
+template <class T>
+std::span<const std::byte> bytes_of(const std::vector<T>& values) {
+  return std::as_bytes(std::span<const T>(values));
+}
+
+// A device-local texel buffer of `format` holding `data` (uploaded through
+// staging when the memory is not host-visible, or when force_staging), and
+// its view. `what` names the data in errors, e.g. over maxTexelBufferElements.
+Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool, VkFormat format,
+                                      std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
+                                      bool force_staging);
+
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
                                        bool force_staging);
 

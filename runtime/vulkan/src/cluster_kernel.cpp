@@ -171,22 +171,11 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   kernel.cluster_vectors_ = std::move(*boxes);
 
   // Set 1 layout and the pipeline layout (set 0 = the search layout).
-  std::array<VkDescriptorSetLayoutBinding, kClusterBindingCount> bindings{};
-  for (std::uint32_t b = 0; b < kClusterBindingCount; ++b) {
-    bindings[b].binding = b;
-    bindings[b].descriptorType =
-        b < kClusterTexelBindings ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[b].descriptorCount = 1;
-    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  }
-  VkDescriptorSetLayoutCreateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_info.bindingCount = kClusterBindingCount;
-  set_info.pBindings = bindings.data();
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &set_layout));
-  kernel.set_layout_ = UniqueDescriptorSetLayout(device, set_layout);
-  const std::array<VkDescriptorSetLayout, 2> set_layouts = {search_layout, set_layout};
+  Result<UniqueDescriptorSetLayout> set_layout =
+      create_set_layout(context, kClusterBindingCount, kClusterTexelBindings);
+  if (!set_layout) return set_layout.error();
+  kernel.set_layout_ = std::move(*set_layout);
+  const std::array<VkDescriptorSetLayout, 2> set_layouts = {search_layout, kernel.set_layout_.get()};
   VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(ClusterPush)};
   VkPipelineLayoutCreateInfo layout_info{};
   layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
@@ -227,7 +216,7 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   kernel.bound_capacity_ = chunk * clusters;
   kernel.pair_capacity_ = chunk * pairs_per_query;
 
-  std::vector<VkDescriptorSetLayout> layouts(options.slots, set_layout);
+  std::vector<VkDescriptorSetLayout> layouts(options.slots, kernel.set_layout_.get());
   std::vector<VkDescriptorSet> sets(options.slots);
   VkDescriptorSetAllocateInfo allocate{};
   allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;

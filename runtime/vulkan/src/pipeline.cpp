@@ -85,4 +85,23 @@ Status dispatch(const Context& context, VkCommandBuffer commands, VkPipeline pip
   return {};
 }
 
+Result<UniqueDescriptorSetLayout> create_set_layout(const Context& context, std::uint32_t binding_count,
+                                                    std::uint32_t texel_bindings) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings(binding_count);
+  for (std::uint32_t b = 0; b < binding_count; ++b) {
+    bindings[b].binding = b;
+    bindings[b].descriptorType =
+        b < texel_bindings ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[b].descriptorCount = 1;
+    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  info.bindingCount = binding_count;
+  info.pBindings = bindings.data();
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  MMVK_VK_CHECK(vkCreateDescriptorSetLayout(context.device(), &info, nullptr, &layout));
+  return UniqueDescriptorSetLayout(context.device(), layout);
+}
+
 }  // namespace mmvk::vulkan::detail

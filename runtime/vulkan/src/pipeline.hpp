@@ -30,6 +30,11 @@ Result<UniquePipeline> create_compute_pipeline(const Context& context, VkPipelin
 // per-stage limits.
 Status check_binding_limits(const Context& context);
 
+// A compute descriptor set layout of `binding_count` single bindings: the
+// first `texel_bindings` uniform texel buffers, the rest storage buffers.
+Result<UniqueDescriptorSetLayout> create_set_layout(const Context& context, std::uint32_t binding_count,
+                                                    std::uint32_t texel_bindings);
+
 // Records push constants + vkCmdDispatch after checking the group counts
 // against maxComputeWorkGroupCount and the push constants against
 // maxPushConstantsSize; the error names the kernel.

@@ -96,26 +96,15 @@ struct VulkanSearch::Impl {
 Status VulkanSearch::Impl::create_layouts() {
   MMVK_TRY(check_binding_limits(*context));
   const VkDevice device = context->device();
-  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
-  for (std::uint32_t b = 0; b < kBindingCount; ++b) {
-    bindings[b].binding = b;
-    bindings[b].descriptorType =
-        b < kTexelBindings ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[b].descriptorCount = 1;
-    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  }
-  VkDescriptorSetLayoutCreateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_info.bindingCount = kBindingCount;
-  set_info.pBindings = bindings.data();
-  VkDescriptorSetLayout set_layout_handle = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &set_layout_handle));
-  set_layout = UniqueDescriptorSetLayout(device, set_layout_handle);
+  Result<UniqueDescriptorSetLayout> created = create_set_layout(*context, kBindingCount, kTexelBindings);
+  if (!created) return created.error();
+  set_layout = std::move(*created);
 
   VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(SearchPush)};
   VkPipelineLayoutCreateInfo layout_info{};
   layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   layout_info.setLayoutCount = 1;
+  const VkDescriptorSetLayout set_layout_handle = set_layout.get();
   layout_info.pSetLayouts = &set_layout_handle;
   layout_info.pushConstantRangeCount = 1;
   layout_info.pPushConstantRanges = &push;

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "../../runtime/src/file_io.hpp"
+#include "../../runtime/src/common/file_io.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"

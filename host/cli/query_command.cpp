@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "../../runtime/src/file_io.hpp"
+#include "../../runtime/src/common/file_io.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "mmvk/cluster_search.hpp"

@@ -9,7 +9,7 @@
 
 #include <unistd.h>
 
-#include "../../runtime/src/hash.hpp"
+#include "../../runtime/src/common/hash.hpp"
 #include "mmvk/database_io.hpp"
 #include "support/test_data.hpp"
 

@@ -71,3 +71,15 @@ inline Error make_error(std::string message) { return Error{std::move(message)};
     ::mmvk::Status mmvk_try_status_ = (expr);   \
     if (!mmvk_try_status_.ok()) return mmvk_try_status_.error(); \
   } while (false)
+
+// Evaluates a Result-returning expression; on failure returns its error from
+// the enclosing function, otherwise moves the value into `lhs`, which may be
+// a declaration:  MMVK_ASSIGN_OR_RETURN(auto database, load_database(path));
+#define MMVK_ASSIGN_OR_RETURN(lhs, expr) \
+  MMVK_ASSIGN_OR_RETURN_IMPL_(MMVK_CONCAT_(mmvk_result_, __LINE__), lhs, expr)
+#define MMVK_ASSIGN_OR_RETURN_IMPL_(result, lhs, expr) \
+  auto result = (expr);                                \
+  if (!result.ok()) return result.error();             \
+  lhs = std::move(result).value()
+#define MMVK_CONCAT_(a, b) MMVK_CONCAT_INNER_(a, b)
+#define MMVK_CONCAT_INNER_(a, b) a##b

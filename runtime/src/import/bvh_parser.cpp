@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "bvh_lexer.hpp"
-#include "file_io.hpp"
+#include "import/bvh_lexer.hpp"
+#include "common/file_io.hpp"
 #include "mmvk/bvh.hpp"
 
 namespace mmvk {

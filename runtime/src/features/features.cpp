@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "file_io.hpp"
+#include "common/file_io.hpp"
 
 namespace mmvk {
 

@@ -7,7 +7,7 @@
 #include <new>
 #include <vector>
 
-#include "fast_search_kernels.hpp"
+#include "search/fast_search_kernels.hpp"
 #include "mmvk/fast_search.hpp"
 
 namespace mmvk {

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <span>
 
-#include "file_io.hpp"
-#include "hash.hpp"
+#include "common/file_io.hpp"
+#include "common/hash.hpp"
 
 namespace mmvk {
 

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "file_io.hpp"
+#include "common/file_io.hpp"
 #include "mmvk/feature_schema.hpp"
 
 namespace mmvk {

@@ -3,7 +3,7 @@
 // sequence (diff, square, channel sum in dim order, weighted total in
 // channel order, multiplier, bias) and the costs are bit-identical. Built
 // like the rest of the library with -ffp-contract=off (no fused multiply-add).
-#include "fast_search_kernels.hpp"
+#include "search/fast_search_kernels.hpp"
 
 #include <cstring>
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <set>
 
-#include "hash.hpp"
+#include "common/hash.hpp"
 
 namespace mmvk {
 

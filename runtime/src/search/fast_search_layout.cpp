@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "fast_search_layout.hpp"
+#include "search/fast_search_layout.hpp"
 
 namespace mmvk {
 

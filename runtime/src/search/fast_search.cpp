@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "fast_search_layout.hpp"
+#include "search/fast_search_layout.hpp"
 
 namespace mmvk {
 

@@ -10,7 +10,7 @@
 #include <random>
 #include <string>
 
-#include "cluster_table_build.hpp"
+#include "clusters/cluster_table_build.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/thread_pool.hpp"
 

@@ -6,7 +6,7 @@
 #include <limits>
 #include <string>
 
-#include "cluster_table_build.hpp"
+#include "clusters/cluster_table_build.hpp"
 
 namespace mmvk::detail {
 

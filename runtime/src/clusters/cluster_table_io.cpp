@@ -20,8 +20,8 @@
 #include <cstring>
 #include <string>
 
-#include "file_io.hpp"
-#include "hash.hpp"
+#include "common/file_io.hpp"
+#include "common/hash.hpp"
 #include "mmvk/cluster_table.hpp"
 
 namespace mmvk {

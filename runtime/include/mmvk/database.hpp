@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "mmvk/animation_data.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/status.hpp"
 
@@ -52,6 +54,9 @@ struct DatabaseParts {
   std::vector<Clip> clips;                      // contiguous, in frame order, covering all frames
   std::vector<std::uint32_t> frame_flags;       // [frames], FrameFlag bits
   std::vector<float> features;                  // [frames x dims], normalized, row-major
+  // The skeleton and per-frame poses (animation_data.hpp); absent in a
+  // database built with --no-animation or loaded from a format 1 file.
+  std::optional<AnimationData> animation;
 };
 
 class Database {
@@ -71,6 +76,8 @@ class Database {
   std::span<const DimNormalization> normalization() const { return parts_.normalization; }
   std::span<const std::string> tag_names() const { return parts_.tag_names; }
   std::span<const Clip> clips() const { return parts_.clips; }
+  // The animation section, or null when the database has none.
+  const AnimationData* animation() const { return parts_.animation ? &*parts_.animation : nullptr; }
 
   // Per-frame metadata, [frame_count] each (the clip's values repeated, so
   // backends index them by frame without a lookup).
@@ -86,8 +93,9 @@ class Database {
   // as the database rows). Precondition: raw.size() == out.size() == dims().
   void normalize(std::span<const float> raw, std::span<float> out) const;
 
-  // A 64-bit digest of the whole content; cluster tables and backends record
-  // it to detect being used with another database.
+  // A 64-bit digest of the search content (everything but the animation
+  // section, so adding or dropping poses keeps cluster tables valid); cluster
+  // tables and backends record it to detect being used with another database.
   std::uint64_t content_hash() const { return content_hash_; }
 
   const DatabaseParts& parts() const { return parts_; }

@@ -1,0 +1,116 @@
+// The animation section of a Database: the skeleton and, per database frame,
+// the pose (local joint rotations and the translations that vary), the
+// character root (position and facing on the ground) and foot contacts.
+// Optional: a database built with --no-animation, or loaded from a format 1
+// file, has features only (Database::animation() is null).
+//
+// Spaces. The pose is stored in character space: every top-level joint
+// (parent -1) has its local rotation and translation expressed relative to
+// the frame's character root (origin = root position, +Z = root facing,
+// +Y up), the other joints relative to their parents as imported. Forward
+// kinematics of a stored pose therefore gives joint positions relative to
+// the character, and placing them at a root position p and yaw a gives
+// world = p + R_y(a) * q. The import's model-space positions are recovered
+// with the frame's own root_positions and root_yaws.
+//
+// Yaw: radians about +Y; yaw 0 faces +Z, and facing = (sin yaw, 0, cos yaw).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "mmvk/motion.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk {
+
+// Contact bits of AnimationData::contacts.
+enum FootContact : std::uint8_t {
+  kContactLeft = 1u << 0,
+  kContactRight = 1u << 1,
+};
+
+// How foot contacts are detected at build time. A foot is in contact on a
+// frame when its contact bone is both low and slow:
+//   height (model-space y, metres above the ground plane y = 0) < max_height
+//   and speed (length of the central-difference velocity, m/s) < max_speed.
+// The defaults were set on Bandai locomotion and CMU walks (docs/animation.md
+// gives the measurement).
+struct FootContactParams {
+  // Bone references (see find_bone); when the toe role does not resolve
+  // (DAZ skeletons have no toe) the ankle ("@left_foot"/"@right_foot") is
+  // used with max_height + ankle_height_extra.
+  std::string left_bone = "@left_toe";
+  std::string right_bone = "@right_toe";
+  float max_height = 0.06f;          // metres
+  float max_speed = 0.6f;            // m/s
+  float ankle_height_extra = 0.06f;  // metres, added when falling back to the ankle
+};
+
+// How rotations are kept in the .mmdb file (always float in memory).
+enum class RotationEncoding : std::uint8_t {
+  Float32,      // 16 bytes per joint, exact
+  Quantized16,  // 4 x int16 per joint (8 bytes); worst-case error measured < 0.1 degree
+};
+
+struct AnimationData {
+  Skeleton skeleton;                 // names, parents (parents[i] < i), rest offsets (metres)
+  std::vector<int> mirror_pairs;     // [joints] each joint's mirror partner (itself when none)
+  // Joints whose local translation varies between frames (the hips, and any
+  // top-level joint, which is stored in character space), ascending. Every
+  // other joint uses skeleton.rest_offsets.
+  std::vector<std::uint32_t> translated_joints;
+  std::array<int, 2> contact_joints{-1, -1};  // left, right bone used for contacts
+  FootContactParams contact_params;           // the thresholds the contacts were detected with
+  RotationEncoding encoding = RotationEncoding::Float32;
+
+  std::uint32_t frame_count = 0;                 // = Database::frame_count()
+  std::vector<glm::quat> local_rotations;        // [frames x joints], unit, character space for top-level joints
+  std::vector<glm::vec3> local_translations;     // [frames x translated_joints.size()], metres
+  std::vector<glm::vec3> root_positions;         // [frames], the clip's world space, y = 0, metres
+  std::vector<float> root_yaws;                  // [frames], radians
+  std::vector<std::uint8_t> contacts;            // [frames], FootContact bits
+
+  std::size_t joint_count() const { return skeleton.size(); }
+  // Bytes one frame takes in memory (rotations, translations, root, contacts).
+  std::size_t bytes_per_frame_in_memory() const;
+  // Bytes one frame takes in the .mmdb file with `encoding`.
+  std::size_t bytes_per_frame_in_file() const;
+  // Checks sizes, parents, pairs, unit quaternions, finite values, and that
+  // the frame count equals `frames`. Errors name the field.
+  Status validate(std::uint32_t frames) const;
+};
+
+// The clear error for a database without animation, naming `mmvk build`
+// (without --no-animation) as the fix. `what` names the caller ("crowd controller").
+Error missing_animation_error(std::string_view what);
+
+// The pose of one database frame in character space: local rotations [joints]
+// and local translations [joints] (rest offsets, or the frame's translation
+// for translated joints). Preconditions: frame < frame_count, spans sized
+// joint_count().
+void sample_pose(const AnimationData& animation, std::uint32_t frame, std::span<glm::quat> local_rotations,
+                 std::span<glm::vec3> local_translations);
+
+// Root motion from database frame `from` to frame `to`, expressed in `from`'s
+// character space: the displacement (x, z in metres, y = 0) and the yaw change
+// (radians, wrapped to [-pi, pi]).
+struct RootDelta {
+  glm::vec3 translation{0.0f};
+  float yaw = 0.0f;
+};
+RootDelta root_delta(const AnimationData& animation, std::uint32_t from, std::uint32_t to);
+
+// The motion of one database clip (frames [first, first + count)) back in the
+// import's model space: what the build imported after resampling and
+// mirroring, up to float rounding. Used by export, tests and tools.
+Result<Motion> clip_motion(const AnimationData& animation, float fps, std::uint32_t first_frame,
+                           std::uint32_t frame_count);
+
+}  // namespace mmvk

@@ -1,0 +1,229 @@
+// CrowdController: motion matching for B characters at once. It owns every
+// character's state in arrays (playback frame, search timer, spring
+// simulation, inertialization offsets, animated root) and runs the standard
+// controller loop once per tick, batched: one search per tick for all the
+// characters that are due. docs/animation.md describes the loop in prose.
+//
+// One tick (dt seconds), synchronous form tick(dt, input, backend, pool):
+//   1. simulate: each simulated root moves toward its desired velocity and
+//      facing (critically damped springs, trajectory.hpp);
+//   2. play: each character advances by dt * fps frames (a looping clip wraps
+//      to its first frame; a non-looping clip holds its last frame); its
+//      animated root moves by the frames' root motion plus the
+//      inertialization's root offset;
+//   3. decide: a character is due when its search timer runs out (timers
+//      are staggered over the interval so the load per tick is flat), or a
+//      search is forced: first tick, the end of a non-looping clip, a
+//      do_not_use frame, entering a block_transition range, or a desired
+//      velocity or facing that changed sharply since its last search;
+//   4. assemble: one normalized query per due character into a [due x dims]
+//      batch (query_assembly.hpp): pose channels from its current frame,
+//      trajectory channels from its predicted trajectory;
+//   5. search: the batch on the backend, split into chunks of at most
+//      params.max_batch queries;
+//   6. apply: a character jumps only when its match is not the continuing
+//      frame (the frame it plays now); a jump starts an inertialization
+//      (pose_batch.hpp);
+//   7. blend and correct: the played pose plus decaying offsets is the
+//      output pose; the animated root is pulled toward the simulated root
+//      with a bounded correction (ControllerParams).
+// Deferred form tick(dt, input, async, pool): steps 5-6 split: the batch is
+// submitted in step 5 and its results are applied at the start of the next
+// tick (one tick of latency), so a GPU search overlaps the caller's work.
+//
+// No global state, no threads of its own (it uses the caller's ThreadPool),
+// no allocation per tick. Not thread-safe. The Database must outlive it.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "mmvk/animation_data.hpp"
+#include "mmvk/database.hpp"
+#include "mmvk/pose_batch.hpp"
+#include "mmvk/query_assembly.hpp"
+#include "mmvk/search.hpp"
+#include "mmvk/status.hpp"
+#include "mmvk/thread_pool.hpp"
+#include "mmvk/trajectory.hpp"
+
+namespace mmvk {
+
+struct ControllerParams {
+  float search_interval = 0.1f;            // seconds between a character's regular searches
+  float inertialization_half_life = 0.1f;  // seconds
+  SpringParams spring;                     // simulated root (and prediction) half-lives
+  // Forced search when the desired velocity changed by more than this since
+  // the character's last search (m/s), or the desired yaw by more than
+  // force_search_yaw_change (radians).
+  float force_search_velocity_change = 1.0f;
+  float force_search_yaw_change = 0.6f;
+  // Root correction: each tick the animated root moves toward the simulated
+  // one by the fraction 1 - 2^(-dt / correction_half_life) of the gap, at
+  // most max_correction_speed * dt metres (and max_correction_yaw_rate * dt
+  // radians); a gap still larger than max_correction_distance (or
+  // max_correction_yaw) is then clamped to it, so a character never drifts
+  // further than that from its simulated position.
+  float correction_half_life = 0.2f;      // seconds
+  float max_correction_speed = 1.0f;      // m/s
+  float max_correction_distance = 0.5f;   // metres
+  float max_correction_yaw_rate = 3.0f;   // rad/s
+  float max_correction_yaw = 0.6f;        // radians
+  // Search options applied to every query (per-character tags: query_params()).
+  float continuing_bias = 0.0f;
+  std::uint32_t exclusion_window = 0;
+  std::uint32_t max_batch = 1024;  // queries per backend call (VulkanSearchOptions::max_batch)
+};
+
+// Per-tick input, [B] each.
+struct CrowdInput {
+  std::span<const glm::vec3> desired_velocity;  // world m/s, y ignored
+  // Desired facing yaw (radians), or empty: face the desired velocity (and
+  // keep the current facing while it is below 1e-3 m/s).
+  std::span<const float> desired_yaw;
+};
+
+struct TickStats {
+  std::uint32_t searches = 0;      // queries assembled this tick
+  std::uint32_t forced = 0;        // of which forced
+  std::uint32_t batches = 0;       // backend calls
+  std::uint32_t applied = 0;       // results applied this tick
+  std::uint32_t jumps = 0;         // results that were not the continuing frame
+  std::uint32_t no_candidate = 0;  // results with no frame (kept playing)
+};
+
+// A search the controller starts in one tick and collects in the next.
+class AsyncSearch {
+ public:
+  virtual ~AsyncSearch() = default;
+  virtual const Database& database() const = 0;
+  // Starts searching `batch` (k = 1), any size: the implementation splits
+  // it. The spans stay valid until collect(). At most one search in flight.
+  virtual Status submit(const QueryBatch& batch) = 0;
+  // Waits for the submitted search and writes its matches [batch.size].
+  virtual Status collect(std::span<Match> out) = 0;
+};
+
+// The deferred path on any SearchBackend: searches at submit (chunks of
+// max_batch), hands the matches out at collect. Gives the same chosen frames
+// as an asynchronous GPU search of the same backend semantics.
+class DeferredSearch final : public AsyncSearch {
+ public:
+  DeferredSearch(SearchBackend& backend, std::uint32_t max_batch, std::uint32_t capacity);
+  const Database& database() const override { return backend_.database(); }
+  Status submit(const QueryBatch& batch) override;
+  Status collect(std::span<Match> out) override;
+
+ private:
+  SearchBackend& backend_;
+  std::uint32_t max_batch_;
+  std::vector<Match> matches_;
+  std::size_t pending_ = 0;
+  bool in_flight_ = false;
+};
+
+class CrowdController {
+ public:
+  // Errors: the database has no animation (missing_animation_error), its
+  // schema has no trajectory_position channel, characters == 0, parameters
+  // out of range (each names the field).
+  static Result<CrowdController> create(const Database& database, std::uint32_t characters,
+                                        const ControllerParams& params = {});
+
+  // Places character b (before or between ticks): root and simulated root at
+  // `position` (y set to 0) facing `yaw`, playing database frame `frame`;
+  // its next tick forces a search. Characters start at the origin, yaw 0,
+  // frame 0. Errors: b or frame out of range.
+  Status place(std::uint32_t b, const glm::vec3& position, float yaw, std::uint32_t frame = 0);
+
+  // Synchronous tick: search and apply within the tick.
+  Status tick(float dt, const CrowdInput& input, SearchBackend& backend, ThreadPool& pool);
+  // Deferred tick: apply the previous tick's results, then submit this one's.
+  Status tick(float dt, const CrowdInput& input, AsyncSearch& search, ThreadPool& pool);
+
+  // World joint positions of every character into out [B x joints].
+  void world_positions(std::span<glm::vec3> out, ThreadPool& pool) const;
+
+  std::uint32_t size() const { return characters_; }
+  const Database& database() const { return *database_; }
+  const AnimationData& animation() const { return *animation_; }
+  const ControllerParams& params() const { return params_; }
+  const TickStats& last_tick() const { return last_; }
+  const TickStats& totals() const { return totals_; }
+  std::uint64_t ticks() const { return ticks_; }
+
+  // Per-character query options (tags, weights); the controller overwrites
+  // continuing_frame, continuing_bias and exclusion_window.
+  std::span<QueryParams> query_params() { return query_params_; }
+
+  // Per-character output, [B] unless noted.
+  std::span<const std::uint32_t> frames() const { return frames_; }          // database frame played
+  std::span<const glm::vec3> root_positions() const { return root_pos_; }   // animated root, world, y = 0
+  std::span<const float> root_yaws() const { return root_yaw_; }
+  std::span<const SimulationState> simulation() const { return sim_; }      // simulated root
+  std::span<const std::uint8_t> searched() const { return searched_; }      // 1: searched this tick
+  std::span<const std::uint8_t> jumped() const { return jumped_; }          // 1: jumped this tick
+  std::span<const float> match_costs() const { return match_cost_; }        // last applied match (inf: none)
+  std::span<const std::uint8_t> contacts() const { return contacts_; }      // FootContact bits of the frame
+  // The trajectory of each character's last search: [B x T] world positions
+  // and yaws, T = trajectory_offsets().size().
+  std::span<const float> trajectory_offsets() const { return assembler_.trajectory_offsets(); }
+  std::span<const glm::vec3> predicted_positions() const { return pred_pos_; }
+  std::span<const float> predicted_yaws() const { return pred_yaw_; }
+  // The output pose, character space: [B x joints] each.
+  std::span<const glm::quat> local_rotations() const { return rotations_; }
+  std::span<const glm::vec3> local_translations() const { return translations_; }
+
+ private:
+  CrowdController() = default;
+  struct Scratch;
+  Status begin(float dt, const CrowdInput& input, ThreadPool& pool);
+  void apply(std::span<const Match> matches, ThreadPool& pool);
+  void finish(float dt, ThreadPool& pool);
+
+  const Database* database_ = nullptr;
+  const AnimationData* animation_ = nullptr;
+  ControllerParams params_;
+  QueryAssembler assembler_;
+  Inertializer inertializer_;
+  std::uint32_t characters_ = 0;
+  std::uint32_t joints_ = 0;
+  std::uint64_t ticks_ = 0;
+  TickStats last_, totals_;
+
+  // Per character, [B].
+  std::vector<std::uint32_t> frames_;
+  std::vector<float> frame_time_;        // fraction of a frame played past frames_
+  std::vector<float> search_timer_;      // seconds to the next regular search
+  std::vector<std::uint8_t> force_;      // forced search pending
+  std::vector<std::uint8_t> searched_, jumped_, contacts_;
+  std::vector<float> match_cost_;
+  std::vector<glm::vec3> root_pos_;
+  std::vector<float> root_yaw_;
+  std::vector<SimulationState> sim_;
+  std::vector<glm::vec3> desired_velocity_, searched_velocity_;
+  std::vector<float> desired_yaw_, searched_yaw_;
+  std::vector<QueryParams> query_params_;
+  std::vector<glm::vec3> pred_pos_;      // [B x T]
+  std::vector<float> pred_yaw_;          // [B x T]
+  std::vector<glm::quat> rotations_;     // [B x joints]
+  std::vector<glm::vec3> translations_;  // [B x joints]
+
+  // The batch, [B] capacity.
+  std::vector<std::uint32_t> due_;       // characters in the batch, ascending
+  std::vector<std::uint32_t> due_frames_;
+  std::vector<QueryFrame> due_refs_;
+  std::vector<float> queries_;           // [B x dims]
+  std::vector<QueryParams> batch_params_;
+  std::vector<Match> matches_;
+  std::uint32_t due_count_ = 0;
+  std::uint32_t pending_count_ = 0;      // deferred: queries in flight
+  std::vector<std::uint32_t> pending_;   // deferred: their characters
+  std::vector<std::uint32_t> pending_continuing_;
+};
+
+}  // namespace mmvk

@@ -74,6 +74,9 @@ struct ClusterSearchOptions {
   // the tile bounds make exact mode's proof of the answer cheap, and most
   // of its work is finding the answer (see the bench results in git log).
   bool probe_by_bound = false;
+  // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
+  // AVX-512F (as FastSearchOptions::baseline_kernels; the same kernels).
+  bool baseline_kernels = false;
 };
 
 // Work counters beyond SearchStats (benchmarks report them).
@@ -104,6 +107,8 @@ class ClusterSearch final : public SearchBackend {
   const ClusterSearchOptions& options() const { return options_; }
   void set_nprobe(std::uint32_t nprobe) { options_.nprobe = nprobe; }
   std::uint32_t cluster_count() const;
+  // The instruction set the kernels use: "avx512f", "avx2" or "generic".
+  std::string_view kernel_name() const;
 
   struct Layout;  // the cluster-ordered tiles (cluster_search.cpp)
 

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "search/fast_search_layout.hpp"
+#include "search/top_k.hpp"
 
 namespace mmvk {
 
@@ -18,17 +19,6 @@ constexpr std::uint32_t kGroupRows = kFastTileRows * kFastGroupTiles;
 // Queries that share one pass over a tile in brute force (loads are shared,
 // and the independent sums hide the add latency).
 constexpr std::uint32_t kBruteQueries = 2;
-
-// Inserts `candidate` into the sorted best-k list when it beats the k-th.
-void insert(std::span<Match> best, const Match& candidate) {
-  std::size_t slot = best.size() - 1;
-  if (!match_less(candidate, best[slot])) return;
-  while (slot > 0 && match_less(candidate, best[slot - 1])) {
-    best[slot] = best[slot - 1];
-    --slot;
-  }
-  best[slot] = candidate;
-}
 
 }  // namespace
 
@@ -74,15 +64,9 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
   };
   auto best_of = [&](std::size_t q) { return best.subspan((q - first_query) * k, k); };
   auto query_of = [&](std::size_t q) { return batch.features.subspan(q * dims, dims); };
+  // Tiles hold the frames in order: a hit's slot is its frame.
   auto offer = [&](const detail::LaneHit& hit, std::size_t q) {
-    const std::span<Match> list = best_of(q);
-    const Match candidate{hit.frame, hit.cost};
-    if (!match_less(candidate, list[k - 1])) return;
-    const QueryParams& params = params_of(q);
-    // Tiles never mark block-transition rows valid; the continuing frame
-    // was evaluated with its bias before them.
-    if (hit.frame == params.continuing_frame || !is_candidate(db, hit.frame, params)) return;
-    insert(list, candidate);
+    detail::offer_tile_row(db, params_of(q), best_of(q), Match{hit.slot, hit.cost});
   };
   std::uint64_t rows = 0;
 
@@ -94,7 +78,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
     const QueryParams& params = params_of(q);
     const std::uint32_t cont = params.continuing_frame;
     if (cont != kNoFrame && cont >= first_row && cont < end_row && is_candidate(db, cont, params)) {
-      insert(list, Match{cont, frame_cost(db, cont, query_of(q), params)});
+      detail::insert_sorted(list, Match{cont, frame_cost(db, cont, query_of(q), params)});
       ++rows;
     }
   }
@@ -155,7 +139,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
     const std::span<Match> list = best_of(q);
     scratch.group_order.clear();
     for (std::uint32_t pack = first_group / detail::kLanes; pack * detail::kLanes < end_group; ++pack) {
-      l.kernels.box_bounds(group_boxes, pack, query, weights, bounds.data());
+      l.kernels.box_bounds(group_boxes, pack, 1, query, weights, bounds.data());
       for (std::uint32_t lane = 0; lane < detail::kLanes; ++lane) {
         const std::uint32_t group = pack * detail::kLanes + lane;
         if (group < first_group || group >= end_group || !detail::block_may_match(l.group_summary[group], params)) continue;
@@ -166,7 +150,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
     }
     detail::KernelQuery kernel_query{query, weights, 0.0f};
     auto visit = [&](std::uint32_t group) {
-      l.kernels.box_bounds(tile_boxes, group, query, weights, bounds.data());
+      l.kernels.box_bounds(tile_boxes, group, 1, query, weights, bounds.data());
       std::size_t tile_count = 0;
       std::uint32_t group_rows = 0;
       const std::uint32_t first_tile = group * kFastGroupTiles;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "search/top_k.hpp"
+
 namespace mmvk {
 
 Status ReferenceSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) {
@@ -13,19 +15,12 @@ Status ReferenceSearch::search(const QueryBatch& batch, std::uint32_t k, std::sp
     const std::span<const float> query = batch.features.subspan(q * db.dims(), db.dims());
     const std::span<Match> best = out.subspan(q * k, k);
     std::fill(best.begin(), best.end(), Match{});
-    // Insertion into a sorted list of k: ascending frames plus a strict
-    // (cost, frame) order make ties go to the lower frame id.
+    // Ties go to the lower frame id (insert_sorted's strict order).
     for (std::uint32_t frame = 0; frame < db.frame_count(); ++frame) {
       if (!is_candidate(db, frame, params)) continue;
       const Match candidate{frame, frame_cost(db, frame, query, params)};
       ++stats_.rows_evaluated;
-      if (!match_less(candidate, best[k - 1])) continue;
-      std::size_t slot = k - 1;
-      while (slot > 0 && match_less(candidate, best[slot - 1])) {
-        best[slot] = best[slot - 1];
-        --slot;
-      }
-      best[slot] = candidate;
+      detail::insert_sorted(best, candidate);
     }
   }
   stats_.queries += batch.size;

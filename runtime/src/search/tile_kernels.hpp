@@ -1,7 +1,8 @@
-// The vectorized inner loops of FastSearch (fast_search_kernels.cpp). They
-// are compiled once per instruction set (function multiversioning: the
-// loader picks the widest the CPU has), never with -march=native, so the
-// library stays portable for the applications that embed it.
+// The vectorized inner loops of the CPU tile module, shared by FastSearch and
+// ClusterSearch (tile_kernels.cpp): the costs of 16-row tiles and the lower
+// bounds of 16-box packs. They are compiled once per instruction set and one
+// set is picked at run time (select_kernels), never with -march=native, so
+// the library stays portable for the applications that embed it.
 #pragma once
 
 #include <cstddef>
@@ -14,7 +15,7 @@ inline constexpr std::uint32_t kLanes = 16;
 // A lane whose cost passed the query's threshold (not yet checked against
 // tags, the exclusion window or the exact (cost, frame) order).
 struct LaneHit {
-  std::uint32_t frame;
+  std::uint32_t slot;   // tile * 16 + lane (the frame itself when tiles hold the frames in order)
   float cost;
   std::uint32_t query;  // index into the kernel's query array
 };
@@ -37,8 +38,8 @@ struct TileArrays {
   std::uint32_t dims;
 };
 
-// Boxes of 16 blocks per pack: [pack][dims][16] lo and hi, [pack][16]
-// minimum multiplier and bias.
+// Boxes of 16 per pack: [pack][dims][16] lo and hi, [pack][16] minimum
+// multiplier and bias.
 struct BoxArrays {
   const float* lo;
   const float* hi;
@@ -51,18 +52,25 @@ struct BoxArrays {
 
 // The kernels for one instruction set, chosen once at run time.
 struct Kernels {
-// Evaluates the tiles tile_ids[0..count) for `query_count` queries (1, 2 or
-// 4), with the reference's per-row accumulation order, and writes the hits
-// to `hits` (capacity count * 16 * query_count). Returns the number of hits.
+  // Evaluates the tiles tile_ids[0..count) for `query_count` queries (1, 2 or
+  // 4), with the reference's per-row accumulation order (bit-identical
+  // costs), and writes the lanes that pass to `hits` (capacity count * 16 *
+  // query_count). Returns the number of hits.
   std::size_t (*evaluate_tiles)(const TileArrays& tiles, const KernelQuery* queries, std::uint32_t query_count,
                                 const std::uint32_t* tile_ids, std::size_t count, LaneHit* hits);
 
-// Lower bounds of the 16 boxes of pack `pack` for one query, into out[16].
-  void (*box_bounds)(const BoxArrays& boxes, std::size_t pack, const float* query, const float* weights, float* out);
+  // Lower bounds of the boxes of packs [first_pack, first_pack + pack_count)
+  // for one query, into out[pack_count * 16]: min_multiplier * sum_ch w_ch *
+  // sum_d gap_d^2 + min_bias, gap_d the distance of q_d to [lo_d, hi_d]. No
+  // bound exceeds the cost of a row inside its box; channels of weight 0 are
+  // skipped.
+  void (*box_bounds)(const BoxArrays& boxes, std::size_t first_pack, std::size_t pack_count, const float* query,
+                     const float* weights, float* out);
   const char* name;  // "avx512f", "avx2" or "generic"
 };
 
-// The widest kernels this CPU runs, or the baseline ones.
+// The widest kernels this CPU runs, or the x86-64 baseline ones (tests use
+// them to hold every kernel to the reference).
 Kernels select_kernels(bool baseline);
 
 }  // namespace mmvk::detail

@@ -3,7 +3,7 @@
 // sequence (diff, square, channel sum in dim order, weighted total in
 // channel order, multiplier, bias) and the costs are bit-identical. Built
 // like the rest of the library with -ffp-contract=off (no fused multiply-add).
-#include "search/fast_search_kernels.hpp"
+#include "search/tile_kernels.hpp"
 
 #include <cstring>
 
@@ -114,36 +114,45 @@ MMVK_INLINE std::size_t evaluate_tiles_v(const TileArrays& tiles, const KernelQu
 // The bound mirrors the cost's operation order with each |x - q| replaced by
 // the distance from q to the box (0 inside it). Rounding is monotonic, so
 // every step stays <= the matching step of any row in the box, and the
-// bound never exceeds a member's computed cost.
+// bound never exceeds a member's computed cost. A channel of weight 0 adds
+// +0 to a member's total, so skipping it changes no bound (and avoids
+// 0 x inf when a far box overflows).
 template <class V>
-MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t pack, const float* query, const float* weights,
-                              float* out) {
+MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t first_pack, std::size_t pack_count, const float* query,
+                              const float* weights, float* out) {
   constexpr int W = sizeof(V) / sizeof(float);
   constexpr int P = kLanes / W;
-  const float* lo = b.lo + pack * b.dims * kLanes;
-  const float* hi = b.hi + pack * b.dims * kLanes;
-  V total[P];
-  for (int p = 0; p < P; ++p) total[p] = V{} + 0.0f;
-  std::uint32_t d = 0;
-  for (std::uint32_t c = 0; c < b.channels; ++c) {
-    const std::uint32_t end = b.channel_end[c];
-    V sum[P];
-    for (int p = 0; p < P; ++p) sum[p] = V{} + 0.0f;
-    for (; d < end; ++d) {
-      for (int p = 0; p < P; ++p) {
-        const V below = load<V>(lo + std::size_t{d} * kLanes + p * W) - query[d];
-        const V above = query[d] - load<V>(hi + std::size_t{d} * kLanes + p * W);
-        V diff = below > above ? below : above;
-        diff = diff > 0.0f ? diff : V{} + 0.0f;
-        sum[p] += diff * diff;
+  for (std::size_t pack = first_pack; pack < first_pack + pack_count; ++pack, out += kLanes) {
+    const float* lo = b.lo + pack * b.dims * kLanes;
+    const float* hi = b.hi + pack * b.dims * kLanes;
+    V total[P];
+    for (int p = 0; p < P; ++p) total[p] = V{} + 0.0f;
+    std::uint32_t d = 0;
+    for (std::uint32_t c = 0; c < b.channels; ++c) {
+      const std::uint32_t end = b.channel_end[c];
+      if (weights[c] == 0.0f) {
+        d = end;
+        continue;
       }
+      V sum[P];
+      for (int p = 0; p < P; ++p) sum[p] = V{} + 0.0f;
+      for (; d < end; ++d) {
+        for (int p = 0; p < P; ++p) {
+          // At most one of below and above is > 0 (lo <= hi).
+          const V below = load<V>(lo + std::size_t{d} * kLanes + p * W) - query[d];
+          const V above = query[d] - load<V>(hi + std::size_t{d} * kLanes + p * W);
+          V diff = below > above ? below : above;
+          diff = diff > 0.0f ? diff : V{} + 0.0f;
+          sum[p] += diff * diff;
+        }
+      }
+      for (int p = 0; p < P; ++p) total[p] += weights[c] * sum[p];
     }
-    for (int p = 0; p < P; ++p) total[p] += weights[c] * sum[p];
-  }
-  for (int p = 0; p < P; ++p) {
-    const V bound = load<V>(b.min_multiplier + pack * kLanes + p * W) * total[p] +
-                    load<V>(b.min_bias + pack * kLanes + p * W);
-    std::memcpy(out + p * W, &bound, sizeof(bound));
+    for (int p = 0; p < P; ++p) {
+      const V bound = load<V>(b.min_multiplier + pack * kLanes + p * W) * total[p] +
+                      load<V>(b.min_bias + pack * kLanes + p * W);
+      std::memcpy(out + p * W, &bound, sizeof(bound));
+    }
   }
 }
 
@@ -153,9 +162,9 @@ MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t pack, const float*
                                       std::size_t count, LaneHit* hits) {                                      \
     return evaluate_tiles_v<V>(tiles, queries, query_count, tile_ids, count, hits);                            \
   }                                                                                                            \
-  void box_bounds_##suffix(const BoxArrays& boxes, std::size_t pack, const float* query, const float* weights, \
-                           float* out) {                                                                       \
-    box_bounds_v<V>(boxes, pack, query, weights, out);                                                         \
+  void box_bounds_##suffix(const BoxArrays& boxes, std::size_t first_pack, std::size_t pack_count,            \
+                           const float* query, const float* weights, float* out) {                             \
+    box_bounds_v<V>(boxes, first_pack, pack_count, query, weights, out);                                       \
   }
 
 MMVK_DEFINE_KERNELS(generic, V4)

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mmvk/cluster_search.hpp"
+#include "mmvk/fast_search.hpp"
 #include "mmvk/reference_search.hpp"
 #include "support/clustered_data.hpp"
 
@@ -108,6 +109,11 @@ const Variant kExactVariants[] = {
     {"no bounds", {.nprobe = 0, .box_bound = false, .radius_bound = false, .tile_bound = false}},
     {"no nearest seed", {.nprobe = 0, .seed_nearest = false}},
     {"nprobe=all by bound", {.nprobe = 1000000, .probe_by_bound = true}},
+    // The SSE2 kernels the tile module falls back to (the same ones FastSearch
+    // forces with baseline_kernels).
+    {"baseline kernels", {.baseline_kernels = true}},
+    {"baseline kernels, box + radius",
+     {.nprobe = 0, .box_bound = true, .radius_bound = true, .seed_nearest = false, .baseline_kernels = true}},
 };
 
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
@@ -249,6 +255,30 @@ TEST(ClusterSearch, CountsRowsAndPrunes) {
   EXPECT_LT(stats.rows_fraction(db.frame_count()), 0.5);
   (*backend)->reset_stats();
   EXPECT_EQ((*backend)->stats().rows_evaluated, 0u);
+}
+
+// One tile module serves both CPU backends: they pick the same kernels, the
+// widest this CPU runs, and the baseline when asked.
+TEST(ClusterSearch, PicksTheSameKernelsAsFastSearch) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 10);
+  ThreadPool pool(1);
+  for (bool baseline : {false, true}) {
+    auto clusters = ClusterSearch::create(db, table, pool, {.baseline_kernels = baseline});
+    ASSERT_TRUE(clusters.ok());
+    FastSearch fast(db, pool, {.baseline_kernels = baseline});
+    EXPECT_EQ((*clusters)->kernel_name(), fast.kernel_name());
+    std::string expected = "generic";
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    __builtin_cpu_init();
+    if (!baseline && __builtin_cpu_supports("avx512f")) {
+      expected = "avx512f";
+    } else if (!baseline && __builtin_cpu_supports("avx2")) {
+      expected = "avx2";
+    }
+#endif
+    EXPECT_EQ((*clusters)->kernel_name(), expected) << "baseline " << baseline;
+  }
 }
 
 TEST(ClusterSearch, BadInputIsAnError) {

@@ -3,6 +3,13 @@
 // sequence (diff, square, channel sum in dim order, weighted total in
 // channel order, multiplier, bias) and the costs are bit-identical. Built
 // like the rest of the library with -ffp-contract=off (no fused multiply-add).
+//
+// Each instruction set gets its own copy (#pragma GCC target) and
+// select_kernels() picks one set of function pointers per backend, rather
+// than target_clones resolving each function on its own: the choice can be
+// forced to the baseline (tests hold every copy to the reference), AVX-512
+// is covered, and callers can see which set runs (kernel_name()). Measured
+// against ClusterSearch's former AVX2 target_clones, it was no slower.
 #include "search/tile_kernels.hpp"
 
 #include <cstring>

@@ -1,26 +1,22 @@
 #include "brute_force_kernel.hpp"
 
 #include <algorithm>
-#include <array>
+#include <vector>
 
+#include "commands.hpp"
 #include "pipeline.hpp"
+#include "search_layout.hpp"
 
 namespace mmvk::vulkan::detail {
 
 namespace {
 
 void compute_barrier(VkCommandBuffer commands) {
-  VkMemoryBarrier barrier{};
-  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                       &barrier, 0, nullptr, 0, nullptr);
+  memory_barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 }  // namespace
-
-std::uint32_t k_class(std::uint32_t k) { return k <= 1 ? 1 : k <= 4 ? 4 : 16; }
 
 // Query tiles held in registers (shared/LAVAPIPE.md: 1/4/16 by batch size;
 // 16 and 32 only for k = 1, where the kept pairs are few). Every row's
@@ -43,35 +39,15 @@ Result<BruteForceKernel> BruteForceKernel::create(const Context& context, VkPipe
     if (k > largest_class) break;
     for (const std::uint32_t tile : {1u, 4u, 16u, 32u}) {
       if (tile > max_batch || tile > max_tile || (tile >= 16 && k != 1)) continue;
-      const std::array<SpecValue, 10> spec = {{
-          {kSpecWorkgroupSize, shape.workgroup_size},
-          {kSpecDimVec4s, shape.dim_vec4s},
-          {kSpecDims, shape.dims},
-          {kSpecTile, tile},
-          {kSpecK, k},
-          {kSpecChannels, shape.channels},
-          {kSpecEndMask0 + 0, shape.end_mask[0]},
-          {kSpecEndMask0 + 1, shape.end_mask[1]},
-          {kSpecEndMask0 + 2, shape.end_mask[2]},
-          {kSpecEndMask0 + 3, shape.end_mask[3]},
-      }};
+      std::vector<SpecValue> spec = shape_spec(shape, k);
+      spec.push_back({kSpecTile, tile});
       Result<UniquePipeline> scan = create_compute_pipeline(context, layout, "brute_force_scan", spec);
       if (!scan) return scan.error();
       kernel.variants_.push_back(Variant{k, tile, std::move(*scan)});
     }
     // The scan skips each query's continuing frame; the merge evaluates it.
-    const std::array<SpecValue, 10> merge_spec = {{
-        {kSpecWorkgroupSize, shape.workgroup_size},
-        {kSpecDimVec4s, shape.dim_vec4s},
-        {kSpecDims, shape.dims},
-        {kSpecK, k},
-        {kSpecChannels, shape.channels},
-        {kSpecEndMask0 + 0, shape.end_mask[0]},
-        {kSpecEndMask0 + 1, shape.end_mask[1]},
-        {kSpecEndMask0 + 2, shape.end_mask[2]},
-        {kSpecEndMask0 + 3, shape.end_mask[3]},
-        {kSpecMergeContinuing, 1},  // a VkBool32
-    }};
+    std::vector<SpecValue> merge_spec = shape_spec(shape, k);
+    merge_spec.push_back({kSpecMergeContinuing, 1});  // a VkBool32
     Result<UniquePipeline> merge = create_compute_pipeline(context, layout, "topk_merge", merge_spec);
     if (!merge) return merge.error();
     kernel.merges_.emplace_back(k, std::move(*merge));

@@ -6,28 +6,12 @@
 #include <cstdint>
 #include <vector>
 
-#include "gpu_layout.hpp"
 #include "handles.hpp"
-#include "mmvk/feature_schema.hpp"
+#include "kernel_shape.hpp"
 #include "mmvk/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {
-
-// What the kernels are specialized for.
-struct KernelShape {
-  std::uint32_t frame_count = 0;
-  std::uint32_t dims = 0;
-  std::uint32_t dim_vec4s = 0;
-  std::uint32_t channels = 0;        // non-empty schema channels
-  std::uint32_t end_mask[4] = {};    // bit d: dim d ends a channel
-  std::uint32_t workgroup_size = 1;
-  std::uint32_t rows_per_invocation = 1;
-  std::uint32_t block_count = 1;     // ceil(frame_count / rows_per_invocation)
-};
-
-// Kept pairs per query: 1, 4 or 16 (the smallest class >= k).
-std::uint32_t k_class(std::uint32_t k);
 
 class BruteForceKernel {
  public:

@@ -22,12 +22,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "brute_force_kernel.hpp"
 #include "device_database.hpp"
 #include "handles.hpp"
+#include "kernel_shape.hpp"
 #include "memory.hpp"
 #include "mmvk/cluster_table.hpp"
-#include "mmvk/database.hpp"
 #include "mmvk/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
@@ -44,9 +43,10 @@ struct ClusterKernelOptions {
 
 class ClusterKernel {
  public:
-  // `table` must have been validated against `database`.
+  // `table` must have been validated against the database of `shape`
+  // (validate_cluster_table; VulkanSearch::create does it once).
   static Result<ClusterKernel> create(const Context& context, VkCommandPool pool, VkDescriptorSetLayout search_layout,
-                                      const KernelShape& shape, const Database& database, const ClusterTable& table,
+                                      const KernelShape& shape, const ClusterTable& table,
                                       const ClusterKernelOptions& options);
 
   // K classes (1, 4, 16) the kernel has pipelines for.
@@ -78,6 +78,13 @@ class ClusterKernel {
     UniquePipeline scan;
     UniquePipeline merge;
   };
+  // The steps of create(), in order.
+  Status upload_table(const Context& context, VkCommandPool pool, const ClusterTable& table, bool force_staging);
+  Status create_layouts(const Context& context, VkDescriptorSetLayout search_layout, std::uint32_t slots);
+  Result<std::uint64_t> size_scratch(const Context& context, const ClusterKernelOptions& options);
+  Status create_slots(const Context& context, const ClusterKernelOptions& options, std::uint64_t chunk);
+  Status create_pipelines(const Context& context, std::uint32_t max_k);
+
   std::uint32_t chunk_for(std::uint32_t k_class) const;
 
   KernelShape shape_;

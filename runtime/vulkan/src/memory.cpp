@@ -5,6 +5,7 @@
 #include <string>
 
 #include "check.hpp"
+#include "commands.hpp"
 
 namespace mmvk::vulkan::detail {
 
@@ -112,31 +113,16 @@ Status upload(const Context& context, VkCommandPool pool, Buffer& destination, s
     ~Free() { vkFreeCommandBuffers(device, pool, 1, &commands); }
   } free_commands{device, pool, commands};
 
-  VkCommandBufferBeginInfo begin{};
-  begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  MMVK_VK_CHECK(vkBeginCommandBuffer(commands, &begin));
+  MMVK_TRY(begin_one_time(commands));
   VkBufferCopy copy{0, 0, data.size()};
   vkCmdCopyBuffer(commands, staging->buffer.get(), destination.buffer.get(), 1, &copy);
   // Makes the copy visible to every later compute dispatch on this queue.
-  VkMemoryBarrier barrier{};
-  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0,
-                       nullptr, 0, nullptr);
+  memory_barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   MMVK_VK_CHECK(vkEndCommandBuffer(commands));
-
-  VkFenceCreateInfo fence_info{};
-  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VkFence fence_handle = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence_handle));
-  UniqueFence fence(device, fence_handle);
-  VkSubmitInfo submit{};
-  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &commands;
-  MMVK_VK_CHECK(vkQueueSubmit(context.queue(), 1, &submit, fence_handle));
+  MMVK_ASSIGN_OR_RETURN(const UniqueFence fence, create_fence(context));
+  const VkFence fence_handle = fence.get();
+  MMVK_TRY(submit(context, commands, fence_handle));
   MMVK_VK_CHECK(vkWaitForFences(device, 1, &fence_handle, VK_TRUE, UINT64_MAX));
   return {};
 }

@@ -53,20 +53,48 @@ Result<UniquePipeline> create_compute_pipeline(const Context& context, VkPipelin
   return UniquePipeline(device, pipeline);
 }
 
-Status check_binding_limits(const Context& context) {
-  const VkPhysicalDeviceLimits& limits = context.properties().limits;
-  if (limits.maxPerStageDescriptorStorageBuffers < kStorageBindings ||
-      limits.maxPerStageDescriptorSampledImages < kTexelBindings || limits.maxBoundDescriptorSets < 1 ||
-      limits.maxPerStageResources < kBindingCount) {
-    return make_error("Vulkan: the device allows too few descriptors per stage for the search kernels (" +
-                      std::to_string(kStorageBindings) + " storage buffers and " + std::to_string(kTexelBindings) +
-                      " texel buffers needed)");
+Result<UniquePipelineLayout> create_pipeline_layout(const Context& context, std::span<const VkDescriptorSetLayout> sets,
+                                                    std::uint32_t push_bytes, std::string_view kernels) {
+  const std::uint32_t allowed = context.properties().limits.maxPushConstantsSize;
+  if (push_bytes > allowed) {
+    return make_error("Vulkan: the " + std::string(kernels) + " need " + std::to_string(push_bytes) +
+                      " bytes of push constants, the device allows " + std::to_string(allowed));
+  }
+  const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
+  VkPipelineLayoutCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  info.setLayoutCount = static_cast<std::uint32_t>(sets.size());
+  info.pSetLayouts = sets.data();
+  info.pushConstantRangeCount = 1;
+  info.pPushConstantRanges = &push;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  MMVK_VK_CHECK(vkCreatePipelineLayout(context.device(), &info, nullptr, &layout));
+  return UniquePipelineLayout(context.device(), layout);
+}
+
+namespace {
+
+Status check_push(const Context& context, std::span<const std::byte> push, std::string_view kernel) {
+  const std::uint32_t allowed = context.properties().limits.maxPushConstantsSize;
+  if (push.size() > allowed) {
+    return make_error("Vulkan: " + std::string(kernel) + " needs " + std::to_string(push.size()) +
+                      " bytes of push constants, the device allows " + std::to_string(allowed));
   }
   return {};
 }
 
-Status dispatch(const Context& context, VkCommandBuffer commands, VkPipeline pipeline, VkPipelineLayout layout,
-                const SearchPush& push, std::uint32_t groups_x, std::uint32_t groups_y, std::string_view kernel) {
+void bind_and_push(VkCommandBuffer commands, VkPipeline pipeline, VkPipelineLayout layout,
+                   std::span<const std::byte> push) {
+  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, static_cast<std::uint32_t>(push.size()),
+                     push.data());
+}
+
+}  // namespace
+
+Status record_dispatch(const Context& context, VkCommandBuffer commands, VkPipeline pipeline, VkPipelineLayout layout,
+                       std::span<const std::byte> push, std::uint32_t groups_x, std::uint32_t groups_y,
+                       std::string_view kernel) {
   const VkPhysicalDeviceLimits& limits = context.properties().limits;
   if (groups_x == 0 || groups_y == 0) return make_error("Vulkan: empty dispatch of " + std::string(kernel));
   if (groups_x > limits.maxComputeWorkGroupCount[0] || groups_y > limits.maxComputeWorkGroupCount[1]) {
@@ -75,33 +103,30 @@ Status dispatch(const Context& context, VkCommandBuffer commands, VkPipeline pip
                       std::to_string(limits.maxComputeWorkGroupCount[0]) + " x " +
                       std::to_string(limits.maxComputeWorkGroupCount[1]) + ")");
   }
-  if (sizeof(SearchPush) > limits.maxPushConstantsSize) {
-    return make_error("Vulkan: " + std::string(kernel) + " needs " + std::to_string(sizeof(SearchPush)) +
-                      " bytes of push constants, the device allows " + std::to_string(limits.maxPushConstantsSize));
-  }
-  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-  vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(SearchPush), &push);
+  MMVK_TRY(check_push(context, push, kernel));
+  bind_and_push(commands, pipeline, layout, push);
   vkCmdDispatch(commands, groups_x, groups_y, 1);
   return {};
 }
 
-Result<UniqueDescriptorSetLayout> create_set_layout(const Context& context, std::uint32_t binding_count,
-                                                    std::uint32_t texel_bindings) {
-  std::vector<VkDescriptorSetLayoutBinding> bindings(binding_count);
-  for (std::uint32_t b = 0; b < binding_count; ++b) {
-    bindings[b].binding = b;
-    bindings[b].descriptorType =
-        b < texel_bindings ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[b].descriptorCount = 1;
-    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+Status record_dispatch_indirect(const Context& context, VkCommandBuffer commands, VkPipeline pipeline,
+                                VkPipelineLayout layout, std::span<const std::byte> push, const Buffer& arguments,
+                                VkDeviceSize offset, std::uint64_t max_groups_x, std::string_view kernel) {
+  const VkPhysicalDeviceLimits& limits = context.properties().limits;
+  if (max_groups_x > limits.maxComputeWorkGroupCount[0]) {
+    return make_error("Vulkan: indirect dispatch of " + std::string(kernel) + " with up to " +
+                      std::to_string(max_groups_x) + " workgroups may exceed maxComputeWorkGroupCount (" +
+                      std::to_string(limits.maxComputeWorkGroupCount[0]) + ")");
   }
-  VkDescriptorSetLayoutCreateInfo info{};
-  info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  info.bindingCount = binding_count;
-  info.pBindings = bindings.data();
-  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateDescriptorSetLayout(context.device(), &info, nullptr, &layout));
-  return UniqueDescriptorSetLayout(context.device(), layout);
+  if (offset % 4 != 0 || offset + sizeof(VkDispatchIndirectCommand) > arguments.size) {
+    return make_error("Vulkan: the indirect arguments of " + std::string(kernel) + " at offset " +
+                      std::to_string(offset) + " do not lie in their " + std::to_string(arguments.size) +
+                      "-byte buffer (or are not 4-byte aligned)");
+  }
+  MMVK_TRY(check_push(context, push, kernel));
+  bind_and_push(commands, pipeline, layout, push);
+  vkCmdDispatchIndirect(commands, arguments.buffer.get(), offset);
+  return {};
 }
 
 }  // namespace mmvk::vulkan::detail

@@ -9,19 +9,19 @@
 #include "brute_force_kernel.hpp"
 #include "check.hpp"
 #include "cluster_kernel.hpp"
+#include "commands.hpp"
+#include "descriptors.hpp"
 #include "device_database.hpp"
-#include "gpu_layout.hpp"
+#include "kernel_shape.hpp"
 #include "memory.hpp"
 #include "pipeline.hpp"
+#include "search_layout.hpp"
 
 namespace mmvk::vulkan {
 
 using namespace detail;
 
 namespace {
-
-constexpr std::uint32_t kMaxRowsPerInvocation = 32768;  // llvmpipe's loop limit is 65,535
-constexpr std::uint32_t kMaxBlocks = 16384;             // merge loop iterations per query
 
 // Per-submission resources: a submit fills a free slot, wait() frees it.
 struct Slot {
@@ -43,6 +43,44 @@ struct Slot {
 float decode_cost(std::uint32_t key) {
   const std::uint32_t bits = (key & 0x80000000u) != 0 ? key & 0x7FFFFFFFu : ~key;
   return std::bit_cast<float>(bits);
+}
+
+// Everything create() can check before touching the device. The cluster
+// table is validated here, once, whatever the mode: a table from another
+// database is an error even where it would go unused.
+Status validate_options(const Database& database, const VulkanSearchOptions& options, const ClusterTable* clusters) {
+  if (options.max_batch == 0) return make_error("VulkanSearch: max_batch must be >= 1");
+  if (options.max_k < 1 || options.max_k > kMaxK) {
+    return make_error("VulkanSearch: max_k = " + std::to_string(options.max_k) + " is out of range [1, " +
+                      std::to_string(kMaxK) + "]");
+  }
+  if (options.slots == 0) return make_error("VulkanSearch: slots must be >= 1");
+  if (options.max_tile != 1 && options.max_tile != 4 && options.max_tile != 16 && options.max_tile != 32) {
+    return make_error("VulkanSearch: max_tile must be 1, 4, 16 or 32, got " + std::to_string(options.max_tile));
+  }
+  if (options.rows_per_invocation > kMaxRowsPerInvocation) {
+    return make_error("VulkanSearch: rows_per_invocation " + std::to_string(options.rows_per_invocation) +
+                      " is over " + std::to_string(kMaxRowsPerInvocation));
+  }
+  if (database.frame_count() == 0) return make_error("VulkanSearch: the database is empty");
+  if (database.dims() > kMaxKernelDims) {
+    return make_error("VulkanSearch: the database has " + std::to_string(database.dims()) +
+                      " dims; the Vulkan kernels support at most " + std::to_string(kMaxKernelDims));
+  }
+  if (clusters != nullptr) {
+    const Status valid = validate_cluster_table(*clusters, database);
+    if (!valid) {
+      return make_error("VulkanSearch: the cluster table does not belong to this database or is malformed: " +
+                        valid.message());
+    }
+  }
+  if (options.mode != SearchMode::BruteForce) {
+    if (clusters == nullptr) return make_error("VulkanSearch: cluster modes need a ClusterTable");
+    if (options.mode == SearchMode::NProbe && options.nprobe == 0) {
+      return make_error("VulkanSearch: nprobe must be >= 1 in NProbe mode");
+    }
+  }
+  return {};
 }
 
 }  // namespace
@@ -79,9 +117,12 @@ struct VulkanSearch::Impl {
     }
   }
 
+  // The steps of create(), in order.
   Status create_layouts();
+  Status upload(bool force_staging);
   Status create_slots();
-  Status write_descriptors(Slot& slot);
+  Status create_cluster_kernel(const ClusterTable& table);
+  Status warm_up();
   std::uint32_t chunk_for(std::uint32_t k) const {
     const std::uint64_t per_query = kernel.scratch_pairs_per_query(k);
     std::uint64_t chunk = std::min<std::uint64_t>(options.max_batch, scratch_pairs / per_query);
@@ -94,37 +135,15 @@ struct VulkanSearch::Impl {
 };
 
 Status VulkanSearch::Impl::create_layouts() {
-  MMVK_TRY(check_binding_limits(*context));
+  const std::array<SetShape, 1> sets = {kSearchSet};
+  MMVK_TRY(check_binding_limits(*context, sets, "search kernels"));
   const VkDevice device = context->device();
-  Result<UniqueDescriptorSetLayout> created = create_set_layout(*context, kBindingCount, kTexelBindings);
-  if (!created) return created.error();
-  set_layout = std::move(*created);
-
-  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(SearchPush)};
-  VkPipelineLayoutCreateInfo layout_info{};
-  layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  layout_info.setLayoutCount = 1;
+  MMVK_ASSIGN_OR_RETURN(set_layout, create_set_layout(*context, kSearchSet));
   const VkDescriptorSetLayout set_layout_handle = set_layout.get();
-  layout_info.pSetLayouts = &set_layout_handle;
-  layout_info.pushConstantRangeCount = 1;
-  layout_info.pPushConstantRanges = &push;
-  VkPipelineLayout pipeline_layout_handle = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_handle));
-  pipeline_layout = UniquePipelineLayout(device, pipeline_layout_handle);
-
+  MMVK_ASSIGN_OR_RETURN(pipeline_layout, create_pipeline_layout(*context, std::span(&set_layout_handle, 1),
+                                                                sizeof(SearchPush), "search kernels"));
   const std::uint32_t slot_count = options.slots;
-  const std::array<VkDescriptorPoolSize, 2> sizes = {{
-      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, kTexelBindings * slot_count},
-      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kStorageBindings * slot_count},
-  }};
-  VkDescriptorPoolCreateInfo pool_info{};
-  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool_info.maxSets = slot_count;
-  pool_info.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
-  pool_info.pPoolSizes = sizes.data();
-  VkDescriptorPool pool_handle = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateDescriptorPool(device, &pool_info, nullptr, &pool_handle));
-  descriptor_pool = UniqueDescriptorPool(device, pool_handle);
+  MMVK_ASSIGN_OR_RETURN(descriptor_pool, create_descriptor_pool(*context, kSearchSet, slot_count));
 
   VkCommandPoolCreateInfo command_info{};
   command_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
@@ -147,7 +166,6 @@ Status VulkanSearch::Impl::create_layouts() {
 }
 
 Status VulkanSearch::Impl::create_slots() {
-  const VkDevice device = context->device();
   const std::uint64_t max_batch = options.max_batch;
   const std::uint32_t largest_k = k_class(options.max_k);
   const std::uint64_t storage_range = context->properties().limits.maxStorageBufferRange;
@@ -161,7 +179,6 @@ Status VulkanSearch::Impl::create_slots() {
   }
   scratch_pairs = scratch_bytes / 8;
 
-  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const struct {
     Buffer Slot::*member;
     std::uint64_t bytes;
@@ -173,203 +190,95 @@ Status VulkanSearch::Impl::create_slots() {
       {&Slot::scratch, scratch_bytes, "the scratch buffer"},
       {&Slot::results, max_batch * largest_k * 8, "the result buffer"},
   };
-  slots.resize(options.slots);
-  std::vector<VkDescriptorSetLayout> layouts(options.slots, set_layout.get());
-  std::vector<VkDescriptorSet> sets(options.slots);
-  VkDescriptorSetAllocateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  set_info.descriptorPool = descriptor_pool.get();
-  set_info.descriptorSetCount = options.slots;
-  set_info.pSetLayouts = layouts.data();
-  MMVK_VK_CHECK(vkAllocateDescriptorSets(device, &set_info, sets.data()));
+  static_assert(std::size(buffers) == kSearchSet.storage);
+  const std::array<VkBufferView, kSearchSet.texel> views = {
+      device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get()};
   std::vector<VkCommandBuffer> commands(options.slots);
   VkCommandBufferAllocateInfo command_info{};
   command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   command_info.commandPool = command_pool.get();
   command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   command_info.commandBufferCount = options.slots;
-  MMVK_VK_CHECK(vkAllocateCommandBuffers(device, &command_info, commands.data()));
+  MMVK_VK_CHECK(vkAllocateCommandBuffers(context->device(), &command_info, commands.data()));
 
+  slots.resize(options.slots);
   for (std::uint32_t s = 0; s < options.slots; ++s) {
     Slot& slot = slots[s];
-    for (const auto& b : buffers) {
-      Result<Buffer> buffer = create_buffer(*context, b.bytes, storage, MemoryUse::HostMapped, b.what);
-      if (!buffer) return buffer.error();
-      slot.*(b.member) = std::move(*buffer);
+    std::array<VkBuffer, kSearchSet.storage> handles{};
+    for (std::size_t b = 0; b < std::size(buffers); ++b) {
+      MMVK_ASSIGN_OR_RETURN(slot.*(buffers[b].member),
+                            create_buffer(*context, buffers[b].bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                          MemoryUse::HostMapped, buffers[b].what));
+      handles[b] = (slot.*(buffers[b].member)).buffer.get();
     }
     // Padding lanes of the query vectors stay zero from here on.
     std::memset(slot.queries.mapped, 0, slot.queries.size);
-    VkFenceCreateInfo fence_info{};
-    fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    VkFence fence = VK_NULL_HANDLE;
-    MMVK_VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence));
-    slot.fence = UniqueFence(device, fence);
-    slot.descriptors = sets[s];
+    MMVK_ASSIGN_OR_RETURN(slot.fence, create_fence(*context));
+    MMVK_ASSIGN_OR_RETURN(slot.descriptors,
+                          allocate_set(*context, descriptor_pool.get(), set_layout.get(), views, handles));
     slot.commands = commands[s];
     slot.validation_out.resize(max_batch * options.max_k);
-    MMVK_TRY(write_descriptors(slot));
   }
   return {};
 }
 
-Status VulkanSearch::Impl::write_descriptors(Slot& slot) {
-  const std::array<VkBufferView, kTexelBindings> views = {
-      device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get()};
-  const std::array<const Buffer*, kStorageBindings> storage = {&slot.queries, &slot.params, &slot.weights,
-                                                               &slot.scratch, &slot.results};
-  std::array<VkDescriptorBufferInfo, kStorageBindings> infos{};
-  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
-  for (std::uint32_t b = 0; b < kBindingCount; ++b) {
-    VkWriteDescriptorSet& w = writes[b];
-    w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    w.dstSet = slot.descriptors;
-    w.dstBinding = b;
-    w.descriptorCount = 1;
-    if (b < kTexelBindings) {
-      w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-      w.pTexelBufferView = &views[b];
-    } else {
-      const Buffer* buffer = storage[b - kTexelBindings];
-      infos[b - kTexelBindings] = {buffer->buffer.get(), 0, VK_WHOLE_SIZE};
-      w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      w.pBufferInfo = &infos[b - kTexelBindings];
-    }
+Status VulkanSearch::Impl::upload(bool force_staging) {
+  MMVK_ASSIGN_OR_RETURN(device_database, upload_database(*context, command_pool.get(), *database, force_staging));
+  return {};
+}
+
+Status VulkanSearch::Impl::create_cluster_kernel(const ClusterTable& table) {
+  ClusterKernelOptions cluster_options;
+  cluster_options.max_batch = options.max_batch;
+  cluster_options.max_k = options.max_k;
+  cluster_options.slots = options.slots;
+  cluster_options.nprobe = options.mode == SearchMode::NProbe ? options.nprobe : 0;
+  cluster_options.scratch_bytes = options.scratch_bytes;
+  cluster_options.force_staging = options.force_staging_upload;
+  MMVK_ASSIGN_OR_RETURN(ClusterKernel created, ClusterKernel::create(*context, command_pool.get(), set_layout.get(),
+                                                                     shape, table, cluster_options));
+  clusters.emplace(std::move(created));
+  return {};
+}
+
+// One dispatch of every variant: lavapipe compiles at the first one.
+Status VulkanSearch::Impl::warm_up() {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> variants = kernel.variant_keys();
+  if (clusters) {
+    variants.clear();
+    for (const std::uint32_t kc : clusters->k_classes()) variants.emplace_back(kc, 1);
   }
-  vkUpdateDescriptorSets(context->device(), kBindingCount, writes.data(), 0, nullptr);
+  const std::span<const float> first_row = database->row(0);
+  for (const auto& [kc, tile] : variants) {
+    std::vector<float> batch_features;
+    for (std::uint32_t t = 0; t < tile; ++t) batch_features.insert(batch_features.end(), first_row.begin(), first_row.end());
+    const QueryBatch batch{batch_features, {}, tile};
+    const std::uint32_t k = std::min(kc, options.max_k);
+    MMVK_ASSIGN_OR_RETURN(const Ticket ticket, submit(batch, k, tile));
+    std::vector<Match> out(std::size_t{tile} * k);
+    MMVK_TRY(wait(ticket, out));
+  }
+  stats = {};
   return {};
 }
 
 Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, const Database& database,
                                                            const VulkanSearchOptions& options,
                                                            const ClusterTable* clusters) {
-  if (options.max_batch == 0) return make_error("VulkanSearch: max_batch must be >= 1");
-  if (options.max_k < 1 || options.max_k > kMaxK) {
-    return make_error("VulkanSearch: max_k = " + std::to_string(options.max_k) + " is out of range [1, " +
-                      std::to_string(kMaxK) + "]");
-  }
-  if (options.slots == 0) return make_error("VulkanSearch: slots must be >= 1");
-  if (options.max_tile != 1 && options.max_tile != 4 && options.max_tile != 16 && options.max_tile != 32) {
-    return make_error("VulkanSearch: max_tile must be 1, 4, 16 or 32, got " + std::to_string(options.max_tile));
-  }
-  if (options.rows_per_invocation > kMaxRowsPerInvocation) {
-    return make_error("VulkanSearch: rows_per_invocation " + std::to_string(options.rows_per_invocation) +
-                      " is over " + std::to_string(kMaxRowsPerInvocation));
-  }
-  if (database.frame_count() == 0) return make_error("VulkanSearch: the database is empty");
-  if (database.dims() > kMaxKernelDims) {
-    return make_error("VulkanSearch: the database has " + std::to_string(database.dims()) +
-                      " dims; the Vulkan kernels support at most " + std::to_string(kMaxKernelDims));
-  }
-  if (clusters != nullptr) {
-    if (clusters->database_hash != database.content_hash() || clusters->dims != database.dims() ||
-        clusters->members.size() != database.frame_count() || clusters->offsets.size() != clusters->cluster_count + 1u) {
-      return make_error("VulkanSearch: the cluster table does not belong to this database (hash, dims or frame count differ)");
-    }
-  }
-  if (options.mode != SearchMode::BruteForce) {
-    if (clusters == nullptr) return make_error("VulkanSearch: cluster modes need a ClusterTable");
-    MMVK_TRY(validate_cluster_table(*clusters, database));
-    if (options.mode == SearchMode::NProbe && options.nprobe == 0) {
-      return make_error("VulkanSearch: nprobe must be >= 1 in NProbe mode");
-    }
-  }
-
+  MMVK_TRY(validate_options(database, options, clusters));
   auto impl = std::make_unique<Impl>();
   impl->context = &context;
   impl->database = &database;
   impl->options = options;
-
-  // Kernel shape: channel ends as a bit mask over dims (empty channels add
-  // nothing to the total, so they are skipped).
-  KernelShape& shape = impl->shape;
-  shape.frame_count = database.frame_count();
-  shape.dims = database.dims();
-  shape.dim_vec4s = (shape.dims + 3) / 4;
-  std::uint32_t end = 0;
-  const FeatureSchema& schema = database.schema();
-  for (std::uint32_t c = 0; c < schema.channels.size(); ++c) {
-    const std::uint32_t dims = schema.channels[c].dims();
-    if (dims == 0) continue;
-    end += dims;
-    shape.end_mask[(end - 1) / 32] |= 1u << ((end - 1) % 32);
-    impl->channel_of_weight.push_back(c);
-  }
-  shape.channels = static_cast<std::uint32_t>(impl->channel_of_weight.size());
-  // One subgroup per workgroup on CPU drivers (LAVAPIPE.md: 8 invocations);
-  // at least 64 invocations on GPUs.
-  const VkPhysicalDeviceLimits& limits = context.properties().limits;
-  std::uint32_t wg = context.subgroup_size();
-  if (context.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) wg = std::max(wg, 64u);
-  wg = std::min({wg, limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
-  shape.workgroup_size = std::max(wg, 1u);
-  // Rows per invocation: about 1k (LAVAPIPE.md), fewer when a full batch
-  // has too few query tiles to give every core many invocations (measured
-  // on 22k frames, B = 1024: 64 rows ran at 60% of the speed of 1024, the
-  // per-invocation query loads dominating), and at most kMaxBlocks blocks.
-  const std::uint32_t frames = shape.frame_count;
-  std::uint32_t rows = options.rows_per_invocation;
-  if (rows == 0) {
-    const std::uint32_t full_tiles = (options.max_batch + options.max_tile - 1) / options.max_tile;
-    const std::uint32_t blocks_wanted = std::max(8u, 512u / full_tiles);
-    rows = std::clamp<std::uint32_t>((frames / blocks_wanted + 63) / 64 * 64, 64, 1024);
-    rows = std::max(rows, (frames + kMaxBlocks - 1) / kMaxBlocks);
-    if (rows > kMaxRowsPerInvocation) {
-      return make_error("VulkanSearch: " + std::to_string(frames) + " frames are more than the kernels can scan");
-    }
-  }
-  shape.rows_per_invocation = rows;
-  shape.block_count = (frames + rows - 1) / rows;
-  if (shape.block_count > kMaxBlocks) {
-    return make_error("VulkanSearch: rows_per_invocation " + std::to_string(rows) + " gives " +
-                      std::to_string(shape.block_count) + " blocks, over " + std::to_string(kMaxBlocks));
-  }
-
+  impl->channel_of_weight = weighted_channels(database.schema());
+  MMVK_ASSIGN_OR_RETURN(impl->shape, make_kernel_shape(context, database, options));
   MMVK_TRY(impl->create_layouts());
-  Result<DeviceDatabase> device_database =
-      upload_database(context, impl->command_pool.get(), database, options.force_staging_upload);
-  if (!device_database) return device_database.error();
-  impl->device_database = std::move(*device_database);
-  Result<BruteForceKernel> kernel =
-      BruteForceKernel::create(context, impl->pipeline_layout.get(), shape, options.max_batch, options.max_k,
-                               options.max_tile);
-  if (!kernel) return kernel.error();
-  impl->kernel = std::move(*kernel);
+  MMVK_TRY(impl->upload(options.force_staging_upload));
+  MMVK_ASSIGN_OR_RETURN(impl->kernel, BruteForceKernel::create(context, impl->pipeline_layout.get(), impl->shape,
+                                                               options.max_batch, options.max_k, options.max_tile));
   MMVK_TRY(impl->create_slots());
-  if (options.mode != SearchMode::BruteForce) {
-    ClusterKernelOptions cluster_options;
-    cluster_options.max_batch = options.max_batch;
-    cluster_options.max_k = options.max_k;
-    cluster_options.slots = options.slots;
-    cluster_options.nprobe = options.mode == SearchMode::NProbe ? options.nprobe : 0;
-    cluster_options.scratch_bytes = options.scratch_bytes;
-    cluster_options.force_staging = options.force_staging_upload;
-    Result<ClusterKernel> cluster_kernel = ClusterKernel::create(
-        context, impl->command_pool.get(), impl->set_layout.get(), shape, database, *clusters, cluster_options);
-    if (!cluster_kernel) return cluster_kernel.error();
-    impl->clusters.emplace(std::move(*cluster_kernel));
-  }
-
-  if (options.warm_up) {
-    // One dispatch of every variant: lavapipe compiles at the first one.
-    std::vector<float> queries;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> variants = impl->kernel.variant_keys();
-    if (impl->clusters) {
-      variants.clear();
-      for (const std::uint32_t kc : impl->clusters->k_classes()) variants.emplace_back(kc, 1);
-    }
-    for (const auto& [kc, tile] : variants) {
-      queries.assign(database.features().begin(), database.features().begin() + database.dims());
-      std::vector<float> batch_features;
-      for (std::uint32_t t = 0; t < tile; ++t) batch_features.insert(batch_features.end(), queries.begin(), queries.end());
-      const QueryBatch batch{batch_features, {}, tile};
-      const std::uint32_t k = std::min(kc, options.max_k);
-      Result<Ticket> ticket = impl->submit(batch, k, tile);
-      if (!ticket) return ticket.error();
-      std::vector<Match> out(std::size_t{tile} * k);
-      MMVK_TRY(impl->wait(*ticket, out));
-    }
-    impl->stats = {};
-  }
+  if (options.mode != SearchMode::BruteForce) MMVK_TRY(impl->create_cluster_kernel(*clusters));
+  if (options.warm_up) MMVK_TRY(impl->warm_up());
   return std::unique_ptr<VulkanSearch>(new VulkanSearch(std::move(impl)));
 }
 
@@ -457,10 +366,7 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
   const VkCommandBuffer commands = slot.commands;
   const std::uint32_t slot_index = static_cast<std::uint32_t>(&slot - slots.data());
   MMVK_VK_CHECK(vkResetCommandBuffer(commands, 0));
-  VkCommandBufferBeginInfo begin{};
-  begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  MMVK_VK_CHECK(vkBeginCommandBuffer(commands, &begin));
+  MMVK_TRY(begin_one_time(commands));
   if (timestamps) {
     vkCmdResetQueryPool(commands, timestamps.get(), 2 * slot_index, 2);
     vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps.get(), 2 * slot_index);
@@ -475,12 +381,8 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
     return recorded.error();
   }
   // Results become visible to the host once the fence signals.
-  VkMemoryBarrier barrier{};
-  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
-                       nullptr, 0, nullptr);
+  memory_barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                 VK_ACCESS_HOST_READ_BIT);
   if (timestamps) {
     vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps.get(), 2 * slot_index + 1);
   }
@@ -488,11 +390,7 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
 
   const VkFence fence = slot.fence.get();
   MMVK_VK_CHECK(vkResetFences(context->device(), 1, &fence));
-  VkSubmitInfo submit_info{};
-  submit_info.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  submit_info.commandBufferCount = 1;
-  submit_info.pCommandBuffers = &commands;
-  MMVK_VK_CHECK(vkQueueSubmit(context->queue(), 1, &submit_info, fence));
+  MMVK_TRY(detail::submit(*context, commands, fence));
   slot.in_flight = true;
   stats.queries += count;
   // Cluster modes count their rows on the GPU (added in wait()).

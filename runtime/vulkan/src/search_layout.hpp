@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "descriptors.hpp"
+
 namespace mmvk::vulkan::detail {
 
 // GLSL: QueryGpu (std430 array element).
@@ -54,20 +56,7 @@ enum Binding : std::uint32_t {
   kBindingResults = 7,    // storage buffer
   kBindingCount = 8,
 };
-inline constexpr std::uint32_t kTexelBindings = 3;
-inline constexpr std::uint32_t kStorageBindings = 5;
-
-// Specialization constant ids of the kernels.
-enum SpecId : std::uint32_t {
-  kSpecWorkgroupSize = 0,
-  kSpecDimVec4s = 1,
-  kSpecDims = 2,
-  kSpecTile = 3,
-  kSpecK = 4,
-  kSpecChannels = 5,
-  kSpecEndMask0 = 6,  // .. kSpecEndMask0 + 3
-  kSpecMergeContinuing = 10,  // topk_merge: evaluate the continuing frame
-};
-inline constexpr std::uint32_t kMaxKernelDims = 128;  // four 32-bit end masks
+inline constexpr SetShape kSearchSet{3, 5};
+static_assert(kSearchSet.texel == kBindingQueries && kSearchSet.bindings() == kBindingCount);
 
 }  // namespace mmvk::vulkan::detail

@@ -1,0 +1,70 @@
+// The C++ side of shaders/cluster_layout.glsl: the push constants, the
+// per-query state and the set 1 bindings of the cluster kernels, declared
+// once per side, next to each other, with their sizes and offsets checked
+// here. Change both files together.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "descriptors.hpp"
+
+namespace mmvk::vulkan::detail {
+
+// GLSL: ClusterPush (push constants of every cluster kernel).
+struct ClusterPush {
+  std::uint32_t query_base;
+  std::uint32_t query_count;
+  std::uint32_t k;
+  std::uint32_t round;
+  std::uint32_t cluster_count;
+  std::uint32_t block_count;
+  std::uint32_t nprobe;
+  std::uint32_t pad0;
+};
+static_assert(sizeof(ClusterPush) == 32);
+static_assert(sizeof(ClusterPush) <= 128, "Vulkan guarantees only 128 bytes of push constants");
+static_assert(offsetof(ClusterPush, round) == 12);
+static_assert(offsetof(ClusterPush, nprobe) == 24);
+
+// GLSL: ClusterQueryState (std430 array element; uvec2 aligned to 8).
+struct ClusterQueryState {
+  std::uint32_t seed;
+  std::uint32_t upper_key;
+  std::uint32_t rows;
+  std::uint32_t pad0;
+  std::uint32_t continuing_pair[2];
+  std::uint32_t pad1[2];
+};
+static_assert(sizeof(ClusterQueryState) == 32);
+static_assert(offsetof(ClusterQueryState, rows) == 8);
+static_assert(offsetof(ClusterQueryState, continuing_pair) == 16);
+
+// Descriptor bindings of set 1 (cluster_layout.glsl); set 0 is the search
+// layout (search_layout.hpp).
+enum ClusterBinding : std::uint32_t {
+  kBindingMembers = 0,         // uniform texel, R32UI
+  kBindingBlockInfo = 1,       // uniform texel, RGBA32UI
+  kBindingClusterInfo = 2,     // uniform texel, RGBA32UI
+  kBindingClusterVectors = 3,  // uniform texel, RGBA32F
+  kBindingBoundKeys = 4,       // storage
+  kBindingStates = 5,          // storage
+  kBindingBlockPairs = 6,      // storage
+  kBindingScanDispatch = 7,    // storage + indirect
+  kBindingWorkItems = 8,       // storage
+  kClusterBindingCount = 9,
+};
+inline constexpr SetShape kClusterSet{4, 5};
+static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
+
+// GLSL: kRowLanes, the invocations per member block.
+inline constexpr std::uint32_t kRowLanes = 8;
+
+// GLSL: ScanDispatch, per scan round (groups x, 1, 1, work items): the
+// indirect dispatch of cluster_scan, reset by the host before each chunk.
+inline constexpr std::array<std::uint32_t, 8> kScanDispatchReset = {0, 1, 1, 0, 0, 1, 1, 0};
+inline constexpr std::uint64_t kScanDispatchStride = 16;  // bytes per round (a uvec4)
+static_assert(sizeof(kScanDispatchReset) == 2 * kScanDispatchStride);
+
+}  // namespace mmvk::vulkan::detail

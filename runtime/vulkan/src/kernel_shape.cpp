@@ -1,0 +1,87 @@
+#include "kernel_shape.hpp"
+
+#include <algorithm>
+#include <string>
+
+namespace mmvk::vulkan::detail {
+
+std::uint32_t k_class(std::uint32_t k) { return k <= 1 ? 1 : k <= 4 ? 4 : 16; }
+
+std::vector<std::uint32_t> weighted_channels(const FeatureSchema& schema) {
+  std::vector<std::uint32_t> channels;
+  for (std::uint32_t c = 0; c < schema.channels.size(); ++c) {
+    if (schema.channels[c].dims() != 0) channels.push_back(c);
+  }
+  return channels;
+}
+
+namespace {
+
+// One subgroup per workgroup on CPU drivers (LAVAPIPE.md: 8 invocations);
+// at least 64 invocations on GPUs.
+std::uint32_t workgroup_size(const Context& context) {
+  const VkPhysicalDeviceLimits& limits = context.properties().limits;
+  std::uint32_t wg = context.subgroup_size();
+  if (context.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) wg = std::max(wg, 64u);
+  wg = std::min({wg, limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
+  return std::max(wg, 1u);
+}
+
+// Rows per invocation: about 1k (LAVAPIPE.md), fewer when a full batch has
+// too few query tiles to give every core many invocations (measured on 22k
+// frames, B = 1024: 64 rows ran at 60% of the speed of 1024, the
+// per-invocation query loads dominating), and at most kMaxScanBlocks blocks.
+Result<std::uint32_t> rows_per_invocation(std::uint32_t frames, const VulkanSearchOptions& options) {
+  if (options.rows_per_invocation != 0) return options.rows_per_invocation;
+  const std::uint32_t full_tiles = (options.max_batch + options.max_tile - 1) / options.max_tile;
+  const std::uint32_t blocks_wanted = std::max(8u, 512u / full_tiles);
+  std::uint32_t rows = std::clamp<std::uint32_t>((frames / blocks_wanted + 63) / 64 * 64, 64, 1024);
+  rows = std::max(rows, (frames + kMaxScanBlocks - 1) / kMaxScanBlocks);
+  if (rows > kMaxRowsPerInvocation) {
+    return make_error("VulkanSearch: " + std::to_string(frames) + " frames are more than the kernels can scan");
+  }
+  return rows;
+}
+
+}  // namespace
+
+Result<KernelShape> make_kernel_shape(const Context& context, const Database& database,
+                                      const VulkanSearchOptions& options) {
+  KernelShape shape;
+  shape.frame_count = database.frame_count();
+  shape.dims = database.dims();
+  shape.dim_vec4s = (shape.dims + 3) / 4;
+  // Channel ends as a bit mask over dims.
+  const FeatureSchema& schema = database.schema();
+  const std::vector<std::uint32_t> channels = weighted_channels(schema);
+  std::uint32_t end = 0;
+  for (const std::uint32_t c : channels) {
+    end += schema.channels[c].dims();
+    shape.end_mask[(end - 1) / 32] |= 1u << ((end - 1) % 32);
+  }
+  shape.channels = static_cast<std::uint32_t>(channels.size());
+  shape.workgroup_size = workgroup_size(context);
+  MMVK_ASSIGN_OR_RETURN(shape.rows_per_invocation, rows_per_invocation(shape.frame_count, options));
+  shape.block_count = (shape.frame_count + shape.rows_per_invocation - 1) / shape.rows_per_invocation;
+  if (shape.block_count > kMaxScanBlocks) {
+    return make_error("VulkanSearch: rows_per_invocation " + std::to_string(shape.rows_per_invocation) + " gives " +
+                      std::to_string(shape.block_count) + " blocks, over " + std::to_string(kMaxScanBlocks));
+  }
+  return shape;
+}
+
+std::vector<SpecValue> shape_spec(const KernelShape& shape, std::uint32_t k) {
+  return {
+      {kSpecWorkgroupSize, shape.workgroup_size},
+      {kSpecDimVec4s, shape.dim_vec4s},
+      {kSpecDims, shape.dims},
+      {kSpecK, k},
+      {kSpecChannels, shape.channels},
+      {kSpecEndMask0 + 0, shape.end_mask[0]},
+      {kSpecEndMask0 + 1, shape.end_mask[1]},
+      {kSpecEndMask0 + 2, shape.end_mask[2]},
+      {kSpecEndMask0 + 3, shape.end_mask[3]},
+  };
+}
+
+}  // namespace mmvk::vulkan::detail

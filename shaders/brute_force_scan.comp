@@ -31,21 +31,12 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 
+#include "kernel_shape.glsl"
 #include "search_layout.glsl"
-
-layout(local_size_x_id = 0) in;
-layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
-layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
-layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
-// Bit d set: dimension d is the last of its channel.
-layout(constant_id = 6) const uint END_MASK_0 = 0u;
-layout(constant_id = 7) const uint END_MASK_1 = 0u;
-layout(constant_id = 8) const uint END_MASK_2 = 0u;
-layout(constant_id = 9) const uint END_MASK_3 = 0u;
-layout(constant_id = 3) const uint T = 1;         // queries per tile
-layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
-
 #include "search_cost.glsl"
+#include "top_k.glsl"
+
+layout(constant_id = 3) const uint T = 1;  // queries per tile
 
 #define kInfinity uintBitsToFloat(0x7F800000u)
 #define kNaN uintBitsToFloat(0x7FC00000u)
@@ -106,14 +97,13 @@ void main() {
   float worst[T];
   [[unroll]] for (uint t = 0; t < T; ++t) {
     const uint query = query_index(tile_first + t);
-    [[unroll]] for (uint v = 0; v < DV; ++v) q[t][v] = query_features[query * DV + v];
-    [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[t][c] = query_weights[query * CHANNELS + c];
+    load_query(query, q[t], w[t]);
     const QueryGpu p = query_params[query];
     tags[t] = uvec4(p.require_lo, p.require_hi, p.exclude_lo, p.exclude_hi);
     skipped[t] = skipped_ranges(p);
     best_cost[t] = kInfinity;
     best_frame[t] = kNone;
-    [[unroll]] for (uint j = 0; j < K; ++j) best[t][j] = uvec2(kNone, kNone);
+    clear_pairs(best[t]);
     worst[t] = kInfinity;
   }
 
@@ -141,18 +131,7 @@ void main() {
         best_frame[t] = better ? r : best_frame[t];
       } else if (rejected == 0u && !(cost > worst[t])) {
         // Rare once good rows were seen (but lavapipe masks, not skips, it).
-        const uvec2 candidate = uvec2(orderable_bits(cost), r);
-        if (pair_less(candidate, best[t][K - 1u]) && !isnan(cost)) {
-          best[t][K - 1u] = candidate;
-          [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
-            if (pair_less(best[t][j], best[t][j - 1u])) {
-              const uvec2 swap = best[t][j];
-              best[t][j] = best[t][j - 1u];
-              best[t][j - 1u] = swap;
-            }
-          }
-          worst[t] = best[t][K - 1u].y == kNone ? kInfinity : cost_of_key(best[t][K - 1u].x);
-        }
+        insert_row(best[t], worst[t], cost, r);
       }
     }
   }

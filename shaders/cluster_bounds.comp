@@ -16,17 +16,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 
-layout(local_size_x_id = 0) in;
-layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
-layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
-layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
-layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
-// Bit d set: dimension d is the last of its channel.
-layout(constant_id = 6) const uint END_MASK_0 = 0u;
-layout(constant_id = 7) const uint END_MASK_1 = 0u;
-layout(constant_id = 8) const uint END_MASK_2 = 0u;
-layout(constant_id = 9) const uint END_MASK_3 = 0u;
-
+#include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
 
@@ -50,13 +40,12 @@ void main() {
     vec4 hi[DV];
     vec4 center[DV];
     float w[CHANNELS];
+    load_query(query, q, w);
     [[unroll]] for (uint v = 0; v < DV; ++v) {
-      q[v] = query_features[query * DV + v];
       lo[v] = texelFetch(cluster_vectors, int((c * 3u) * DV + v));
       hi[v] = texelFetch(cluster_vectors, int((c * 3u + 1u) * DV + v));
       center[v] = pc.nprobe != 0u ? texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v)) : vec4(0.0);
     }
-    [[unroll]] for (uint i = 0; i < CHANNELS; ++i) w[i] = query_weights[query * CHANNELS + i];
     precise float total = 0.0;
     precise float sum = 0.0;
     precise float distance_total = 0.0;

@@ -1,12 +1,9 @@
 // The data layout of the cluster kernels (cluster_*.comp): set 0 is the
 // search layout (search_layout.glsl: the database texels, the query
 // buffers, the results), set 1 the cluster table and the per-slot cluster
-// scratch, plus their own push constants. The C++ side is
-// runtime/vulkan/src/cluster_kernel.cpp (ClusterPush, ClusterQueryState,
-// the binding numbers); change both together.
-//
-// Every kernel declares the specialization constants before including this:
-// DV (padded dims / 4), DIMS, CHANNELS, END_MASK_0..3 and, where used, K.
+// scratch, plus their own push constants. The C++ side of every struct and
+// binding here is runtime/vulkan/src/cluster_layout.hpp, with static_asserts
+// on its size and offsets; change both together.
 #ifndef MMVK_CLUSTER_LAYOUT_GLSL
 #define MMVK_CLUSTER_LAYOUT_GLSL
 
@@ -19,12 +16,12 @@ const uint kSkip = 0xFFFFFFFFu;
 // Flags that make a frame a non-candidate (mmvk::kFrameDoNotUse |
 // kFrameEdgeExcluded | kFrameBlockTransition) when it is not continued.
 const uint kNeverCandidate = 7u;
-// Invocations per member block (cluster_kernel.cpp: kRowLanes): lane i
+// Invocations per member block (cluster_layout.hpp: kRowLanes): lane i
 // evaluates the block's rows i, i + kRowLanes, ..., so the lanes of a SIMD
 // group share one block and one visit decision.
 const uint kRowLanes = 8u;
 
-// cluster_kernel.cpp: ClusterPush (32 bytes).
+// cluster_layout.hpp: ClusterPush (32 bytes).
 layout(push_constant) uniform ClusterPush {
   uint query_base;     // first query of this chunk in the query buffers
   uint query_count;    // queries in this chunk
@@ -36,7 +33,7 @@ layout(push_constant) uniform ClusterPush {
   uint pad0;
 } pc;
 
-// cluster_kernel.cpp: ClusterQueryState (32 bytes, std430).
+// cluster_layout.hpp: ClusterQueryState (32 bytes, std430).
 struct ClusterQueryState {
   uint seed;              // cluster evaluated first (least bound), kNone if none
   uint upper_key;         // orderable key of the k-th best after the seed, kSkip if fewer than k
@@ -64,7 +61,8 @@ layout(std430, set = 1, binding = 5) buffer States { ClusterQueryState states[];
 // [chunk x blocks x kRowLanes x K] per-lane best (key, frame) pairs of each block.
 layout(std430, set = 1, binding = 6) buffer BlockPairs { uvec2 block_pairs[]; };
 // Per scan round: (workgroups x, 1, 1, work items), the indirect dispatch
-// of cluster_scan; the host zeroes x and the count before each chunk.
+// of cluster_scan (cluster_layout.hpp: kScanDispatchReset); the host
+// zeroes x and the count before each chunk.
 layout(std430, set = 1, binding = 7) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
 // [chunk x blocks] (local query, block) pairs the current scan round visits.
 layout(std430, set = 1, binding = 8) buffer WorkItems { uvec2 work_items[]; };

@@ -14,31 +14,10 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 
-layout(local_size_x_id = 0) in;
-layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
-layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
-layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
-layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
-// Bit d set: dimension d is the last of its channel.
-layout(constant_id = 6) const uint END_MASK_0 = 0u;
-layout(constant_id = 7) const uint END_MASK_1 = 0u;
-layout(constant_id = 8) const uint END_MASK_2 = 0u;
-layout(constant_id = 9) const uint END_MASK_3 = 0u;
-
+#include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
-
-void insert(inout uvec2 best[K], uvec2 candidate) {
-  if (!pair_less(candidate, best[K - 1u])) return;
-  best[K - 1u] = candidate;
-  [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
-    if (pair_less(best[j], best[j - 1u])) {
-      const uvec2 swap = best[j];
-      best[j] = best[j - 1u];
-      best[j - 1u] = swap;
-    }
-  }
-}
+#include "top_k.glsl"
 
 void main() {
   const uint local_query = gl_GlobalInvocationID.x;
@@ -47,8 +26,8 @@ void main() {
   const ClusterQueryState state = states[query];
 
   uvec2 best[K];
-  [[unroll]] for (uint j = 0; j < K; ++j) best[j] = uvec2(kNone, kNone);
-  insert(best, state.continuing_pair);
+  clear_pairs(best);
+  insert_pair(best, state.continuing_pair);
   const uint pair_base = local_query * pc.block_count;
 
   if (pc.round == 0u) {
@@ -56,7 +35,7 @@ void main() {
       const uint first = texelFetch(cluster_info, int(state.seed * 3u)).w;
       const uint end = texelFetch(cluster_info, int(state.seed * 3u + 2u)).z;
       for (uint lane_list = first * kRowLanes; lane_list < end * kRowLanes; ++lane_list) {
-        [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[(pair_base * kRowLanes + lane_list) * K + i]);
+        [[unroll]] for (uint i = 0; i < K; ++i) insert_pair(best, block_pairs[(pair_base * kRowLanes + lane_list) * K + i]);
       }
     }
     uint upper = kSkip;
@@ -88,7 +67,7 @@ void main() {
       rows += info.z - info.y;
       for (uint lane = 0u; lane < kRowLanes; ++lane) {
         const uint at = ((pair_base + b) * kRowLanes + lane) * K;
-        [[unroll]] for (uint i = 0; i < K; ++i) insert(best, block_pairs[at + i]);
+        [[unroll]] for (uint i = 0; i < K; ++i) insert_pair(best, block_pairs[at + i]);
       }
     }
   }

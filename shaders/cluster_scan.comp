@@ -19,19 +19,10 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 
-layout(local_size_x_id = 0) in;
-layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
-layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
-layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
-layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
-// Bit d set: dimension d is the last of its channel.
-layout(constant_id = 6) const uint END_MASK_0 = 0u;
-layout(constant_id = 7) const uint END_MASK_1 = 0u;
-layout(constant_id = 8) const uint END_MASK_2 = 0u;
-layout(constant_id = 9) const uint END_MASK_3 = 0u;
-
+#include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
+#include "top_k.glsl"
 
 void main() {
   const uint item = gl_GlobalInvocationID.x / kRowLanes;
@@ -45,11 +36,10 @@ void main() {
 
   vec4 q[DV];
   float w[CHANNELS];
-  [[unroll]] for (uint v = 0; v < DV; ++v) q[v] = query_features[query * DV + v];
-  [[unroll]] for (uint i = 0; i < CHANNELS; ++i) w[i] = query_weights[query * CHANNELS + i];
+  load_query(query, q, w);
   const QueryGpu p = query_params[query];
   uvec2 best[K];
-  [[unroll]] for (uint j = 0; j < K; ++j) best[j] = uvec2(kNone, kNone);
+  clear_pairs(best);
   float worst = uintBitsToFloat(0x7F800000u);  // cost of best[K - 1], +inf while empty
 
   for (uint m = info.y + lane; m < info.z; m += kRowLanes) {
@@ -59,19 +49,8 @@ void main() {
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(r * DV + v));
     const float cost = row_cost(x, q, w, texelFetch(frame_cost, int(r)).xy);
     // One float compare first (NaN and ties pass it), as the brute force.
-    if (!(cost > worst) && r != p.continuing_frame) {
-      const uvec2 candidate = uvec2(orderable_bits(cost), r);
-      if (pair_less(candidate, best[K - 1u]) && !isnan(cost) && frame_is_candidate(r, meta, false, p)) {
-        best[K - 1u] = candidate;
-        [[unroll]] for (uint j = K - 1u; j > 0u; --j) {
-          if (pair_less(best[j], best[j - 1u])) {
-            const uvec2 swap = best[j];
-            best[j] = best[j - 1u];
-            best[j - 1u] = swap;
-          }
-        }
-        worst = best[K - 1u].y == kNone ? uintBitsToFloat(0x7F800000u) : cost_of_key(best[K - 1u].x);
-      }
+    if (!(cost > worst) && r != p.continuing_frame && frame_is_candidate(r, meta, false, p)) {
+      insert_row(best, worst, cost, r);
     }
   }
   const uint out_base = ((local_query * pc.block_count + block) * kRowLanes + lane) * K;

@@ -12,17 +12,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 
-layout(local_size_x_id = 0) in;
-layout(constant_id = 1) const uint DV = 1;        // padded dims / 4
-layout(constant_id = 2) const uint DIMS = 1;      // real dims (<= 128)
-layout(constant_id = 4) const uint K = 1;         // best pairs kept per query
-layout(constant_id = 5) const uint CHANNELS = 1;  // non-empty channels
-// Bit d set: dimension d is the last of its channel.
-layout(constant_id = 6) const uint END_MASK_0 = 0u;
-layout(constant_id = 7) const uint END_MASK_1 = 0u;
-layout(constant_id = 8) const uint END_MASK_2 = 0u;
-layout(constant_id = 9) const uint END_MASK_3 = 0u;
-
+#include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
 
@@ -80,26 +70,6 @@ void main() {
     const uint end = texelFetch(cluster_info, int(seed * 3u + 2u)).z;
     for (uint b = first; b < end; ++b) append_work(0u, local_query, b);
   }
-
-  uvec2 continuing_pair = uvec2(kNone, kNone);
-  const QueryGpu p = query_params[query];
-  const uint r = p.continuing_frame;
-  if (r != kNone) {
-    const uvec4 meta = texelFetch(frame_meta, int(r));
-    if (frame_is_candidate(r, meta, true, p)) {
-      vec4 q[DV];
-      vec4 x[DV];
-      float w[CHANNELS];
-      [[unroll]] for (uint v = 0; v < DV; ++v) {
-        q[v] = query_features[query * DV + v];
-        x[v] = texelFetch(features, int(r * DV + v));
-      }
-      [[unroll]] for (uint i = 0; i < CHANNELS; ++i) w[i] = query_weights[query * CHANNELS + i];
-      precise float cost = row_cost(x, q, w, texelFetch(frame_cost, int(r)).xy);
-      cost = cost + p.continuing_bias;
-      if (!isnan(cost)) continuing_pair = uvec2(orderable_bits(cost), r);
-    }
-  }
   states[query].seed = seed;
-  states[query].continuing_pair = continuing_pair;
+  states[query].continuing_pair = continuing_pair(query);
 }

@@ -1,9 +1,11 @@
 // The cost and candidate rules of the search semantics (docs/search.md,
 // runtime/src/search.cpp), as the cluster kernels evaluate them; the same
 // arithmetic as brute_force_scan.comp, so both give the reference's bits.
-// The including kernel declares DV, DIMS, CHANNELS and END_MASK_0..3.
 #ifndef MMVK_SEARCH_COST_GLSL
 #define MMVK_SEARCH_COST_GLSL
+
+#include "kernel_shape.glsl"
+#include "search_layout.glsl"
 
 // Constant-folds once d is a constant (all callers are unrolled loops).
 bool ends_channel(uint d) {
@@ -45,6 +47,31 @@ float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
   }
   precise float cost = scale_bias.x * total + scale_bias.y;
   return cost;
+}
+
+// The features (padded like the rows) and channel weights of query `query`.
+void load_query(uint query, out vec4 q[DV], out float w[CHANNELS]) {
+  [[unroll]] for (uint v = 0; v < DV; ++v) q[v] = query_features[query * DV + v];
+  [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[c] = query_weights[query * CHANNELS + c];
+}
+
+// The (cost, frame) pair of query `query`'s continuing frame, continuing_bias
+// included, or (kNone, kNone) when it has none (validate_search keeps it
+// below the frame count otherwise), it is not a candidate or its cost is
+// NaN. The scans skip this frame: it is the only row with an extra cost term
+// and exemptions from the rules, so it is evaluated once per query.
+uvec2 continuing_pair(uint query) {
+  const QueryGpu p = query_params[query];
+  const uint frame = p.continuing_frame;
+  if (frame == kNone) return uvec2(kNone, kNone);
+  if (!frame_is_candidate(frame, texelFetch(frame_meta, int(frame)), true, p)) return uvec2(kNone, kNone);
+  vec4 x[DV];
+  vec4 q[DV];
+  float w[CHANNELS];
+  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(frame * DV + v));
+  load_query(query, q, w);
+  precise float cost = row_cost(x, q, w, texelFetch(frame_cost, int(frame)).xy) + p.continuing_bias;
+  return isnan(cost) ? uvec2(kNone, kNone) : uvec2(orderable_bits(cost), frame);
 }
 
 #endif

@@ -1,6 +1,6 @@
 // The data layout shared by the search kernels: descriptor bindings, the
 // per-query parameter struct and the push constants. The C++ side of every
-// struct here is in runtime/vulkan/src/gpu_layout.hpp, with static_asserts
+// struct here is in runtime/vulkan/src/search_layout.hpp, with static_asserts
 // on its size and offsets; change both together.
 #ifndef MMVK_SEARCH_LAYOUT_GLSL
 #define MMVK_SEARCH_LAYOUT_GLSL
@@ -12,7 +12,7 @@ const uint kFrameDoNotUse = 1u;
 const uint kFrameBlockTransition = 2u;
 const uint kFrameEdgeExcluded = 4u;
 
-// gpu_layout.hpp: QueryGpu (48 bytes, std430).
+// search_layout.hpp: QueryGpu (48 bytes, std430).
 struct QueryGpu {
   uint continuing_frame;   // kNone: no continuing frame
   uint exclusion_window;
@@ -28,7 +28,7 @@ struct QueryGpu {
   uint pad0;
 };
 
-// gpu_layout.hpp: SearchPush (32 bytes). Kernels with their own push
+// search_layout.hpp: SearchPush (32 bytes). Kernels with their own push
 // constants (the cluster kernels) define MMVK_SEARCH_LAYOUT_OWN_PUSH.
 #ifndef MMVK_SEARCH_LAYOUT_OWN_PUSH
 layout(push_constant) uniform SearchPush {

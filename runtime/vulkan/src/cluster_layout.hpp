@@ -30,11 +30,11 @@ static_assert(offsetof(ClusterPush, nprobe) == 24);
 
 // GLSL: ClusterQueryState (std430 array element; uvec2 aligned to 8).
 struct ClusterQueryState {
-  std::uint32_t seed;
-  std::uint32_t upper_key;
-  std::uint32_t rows;
+  std::uint32_t seed;                // cluster evaluated first (least bound), kNoFrame if none
+  std::uint32_t upper_key;           // orderable key of the k-th best after the seed
+  std::uint32_t rows;                // rows evaluated, read back for SearchStats
   std::uint32_t pad0;
-  std::uint32_t continuing_pair[2];
+  std::uint32_t continuing_pair[2];  // (key, frame) of the continuing frame
   std::uint32_t pad1[2];
 };
 static_assert(sizeof(ClusterQueryState) == 32);

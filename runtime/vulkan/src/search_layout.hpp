@@ -36,9 +36,7 @@ struct SearchPush {
   std::uint32_t block_count;
   std::uint32_t query_base;
   std::uint32_t query_count;
-  std::uint32_t pad0;
-  std::uint32_t pad1;
-  std::uint32_t pad2;
+  std::uint32_t pad[3];  // GLSL: pad0, pad1, pad2
 };
 static_assert(sizeof(SearchPush) == 32);
 static_assert(sizeof(SearchPush) <= 128, "Vulkan guarantees only 128 bytes of push constants");

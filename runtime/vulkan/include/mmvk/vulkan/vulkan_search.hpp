@@ -77,7 +77,8 @@ class VulkanSearch final : public SearchBackend {
  public:
   // Errors: database too large for the device (texel buffer elements,
   // allocation size), dims over 128, options out of range, a cluster table
-  // from another database, out of device memory, missing format support.
+  // from another database or malformed (validate_cluster_table, in every
+  // mode), out of device memory, missing format support.
   static Result<std::unique_ptr<VulkanSearch>> create(Context& context, const Database& database,
                                                       const VulkanSearchOptions& options = {},
                                                       const ClusterTable* clusters = nullptr);

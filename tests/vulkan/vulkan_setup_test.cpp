@@ -1,0 +1,135 @@
+// The Vulkan backend's setup helpers (runtime/vulkan/src: descriptors.hpp,
+// pipeline.hpp; white-box, through the private headers): what they refuse
+// before anything reaches the driver. And VulkanSearch::create validating a
+// cluster table once, whatever the mode.
+#include <array>
+#include <cstdint>
+#include <utility>
+
+#include "descriptors.hpp"
+#include "memory.hpp"
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/thread_pool.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#include "pipeline.hpp"
+#include "support/search_test_data.hpp"
+#include "vulkan_test_env.hpp"
+
+namespace mmvk::test {
+namespace {
+
+using namespace vulkan::detail;
+
+struct TestPush {
+  std::uint32_t words[4];
+};
+
+bool mentions(const Status& status, const char* text) {
+  return !status.ok() && status.message().find(text) != std::string::npos;
+}
+
+TEST(VulkanSetup, BindingLimitsNameTheKernels) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const std::array<SetShape, 2> fits = {SetShape{3, 5}, SetShape{4, 5}};
+  EXPECT_TRUE(check_binding_limits(*context, fits, "search kernels").ok());
+  const std::array<SetShape, 1> huge = {SetShape{1u << 24, 1u << 24}};
+  const Status refused = check_binding_limits(*context, huge, "huge kernels");
+  EXPECT_TRUE(mentions(refused, "huge kernels")) << refused.message();
+}
+
+// Every check fails before recording, so no command buffer or pipeline is
+// needed (null handles would crash any recording that slipped through).
+TEST(VulkanSetup, DispatchChecksBeforeRecording) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const VkPhysicalDeviceLimits& limits = context->properties().limits;
+  Result<UniquePipelineLayout> layout = create_pipeline_layout(*context, {}, sizeof(TestPush), "test kernels");
+  ASSERT_TRUE(layout.ok()) << layout.message();
+  const TestPush push{};
+
+  const Status empty = dispatch(*context, VK_NULL_HANDLE, VK_NULL_HANDLE, layout->get(), push, 0, 1, "test_kernel");
+  EXPECT_TRUE(mentions(empty, "empty dispatch of test_kernel")) << empty.message();
+  if (limits.maxComputeWorkGroupCount[1] < UINT32_MAX) {
+    const Status too_many = dispatch(*context, VK_NULL_HANDLE, VK_NULL_HANDLE, layout->get(), push, 1,
+                                     limits.maxComputeWorkGroupCount[1] + 1, "test_kernel");
+    EXPECT_TRUE(mentions(too_many, "maxComputeWorkGroupCount")) << too_many.message();
+    EXPECT_TRUE(mentions(too_many, "test_kernel")) << too_many.message();
+  }
+
+  Result<Buffer> arguments =
+      create_buffer(*context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                    MemoryUse::DeviceLocal, "the test arguments");
+  ASSERT_TRUE(arguments.ok()) << arguments.message();
+  const Status past_end = dispatch_indirect(*context, VK_NULL_HANDLE, VK_NULL_HANDLE, layout->get(), push, *arguments,
+                                            8, 1, "test_scan");
+  EXPECT_TRUE(mentions(past_end, "test_scan")) << past_end.message();
+  const Status unaligned = dispatch_indirect(*context, VK_NULL_HANDLE, VK_NULL_HANDLE, layout->get(), push,
+                                             *arguments, 2, 1, "test_scan");
+  EXPECT_TRUE(mentions(unaligned, "aligned")) << unaligned.message();
+  const Status too_many_indirect =
+      dispatch_indirect(*context, VK_NULL_HANDLE, VK_NULL_HANDLE, layout->get(), push, *arguments, 0,
+                        std::uint64_t{limits.maxComputeWorkGroupCount[0]} + 1, "test_scan");
+  EXPECT_TRUE(mentions(too_many_indirect, "maxComputeWorkGroupCount")) << too_many_indirect.message();
+}
+
+TEST(VulkanSetup, PipelineLayoutChecksPushConstantSize) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const std::uint32_t allowed = context->properties().limits.maxPushConstantsSize;
+  EXPECT_TRUE(create_pipeline_layout(*context, {}, allowed, "test kernels").ok());
+  Result<UniquePipelineLayout> too_big = create_pipeline_layout(*context, {}, allowed + 4, "big kernels");
+  ASSERT_FALSE(too_big.ok());
+  EXPECT_NE(too_big.message().find("big kernels"), std::string::npos) << too_big.message();
+}
+
+TEST(VulkanSetup, AllocatesAndWritesSets) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const SetShape shape{0, 2};
+  Result<UniqueDescriptorSetLayout> set_layout = create_set_layout(*context, shape);
+  ASSERT_TRUE(set_layout.ok()) << set_layout.message();
+  Result<UniqueDescriptorPool> pool = create_descriptor_pool(*context, shape, 2);
+  ASSERT_TRUE(pool.ok()) << pool.message();
+  std::array<Buffer, 2> buffers;
+  for (Buffer& buffer : buffers) {
+    Result<Buffer> created =
+        create_buffer(*context, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::HostMapped, "a test buffer");
+    ASSERT_TRUE(created.ok()) << created.message();
+    buffer = std::move(*created);
+  }
+  const std::array<VkBuffer, 2> handles = {buffers[0].buffer.get(), buffers[1].buffer.get()};
+  for (int s = 0; s < 2; ++s) {
+    Result<VkDescriptorSet> set = allocate_set(*context, pool->get(), set_layout->get(), {}, handles);
+    ASSERT_TRUE(set.ok()) << set.message();
+    EXPECT_NE(*set, VK_NULL_HANDLE);
+  }
+}
+
+// The table is checked in full (validate_cluster_table) even in BruteForce
+// mode, where it goes unused: one check, whatever the mode.
+TEST(VulkanSetup, CreateValidatesTheClusterTableInEveryMode) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const Database db = synthetic_database({.frames = 1000, .seed = 71});
+  ThreadPool pool{2};
+  KMeansParams params;
+  params.iterations = 5;
+  Result<ClusterTable> trained = train_cluster_table(db, params, pool);
+  ASSERT_TRUE(trained.ok()) << trained.message();
+  ClusterTable table = std::move(trained).value();
+  vulkan::VulkanSearchOptions options;
+  options.warm_up = false;
+  options.max_batch = 4;
+  ASSERT_TRUE(vulkan::VulkanSearch::create(*context, db, options, &table).ok());
+
+  // Same database, malformed: two members of one cluster swapped (members
+  // must ascend within a cluster).
+  std::uint32_t c = 0;
+  while (table.offsets[c + 1] - table.offsets[c] < 2) ++c;
+  std::swap(table.members[table.offsets[c]], table.members[table.offsets[c] + 1]);
+  for (const vulkan::SearchMode mode : {vulkan::SearchMode::BruteForce, vulkan::SearchMode::ClustersExact}) {
+    options.mode = mode;
+    Result<std::unique_ptr<vulkan::VulkanSearch>> created = vulkan::VulkanSearch::create(*context, db, options, &table);
+    ASSERT_FALSE(created.ok());
+    EXPECT_NE(created.message().find("members are not in ascending order"), std::string::npos) << created.message();
+  }
+}
+
+}  // namespace
+}  // namespace mmvk::test

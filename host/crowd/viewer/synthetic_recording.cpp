@@ -1,0 +1,170 @@
+#include "viewer/synthetic_recording.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+
+namespace mmvk::crowd {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+// The synthetic database: a walk clip and a run clip at the simulation fps.
+struct Clip {
+  int32_t first;
+  int32_t length;
+  float cycle_frames;  // frames per gait cycle (two steps)
+  float stride;        // leg swing amplitude, radians
+};
+constexpr Clip kWalk{0, 120, 32.0f, 0.45f};
+constexpr Clip kRun{200, 60, 20.0f, 0.8f};
+
+void set_skeleton(Recording& r) {
+  r.joint_names = {"Hips",      "Spine",      "Chest",     "Neck",        "Head",         "LeftShoulder", "LeftElbow",
+                   "LeftHand",  "RightShoulder", "RightElbow", "RightHand", "LeftUpLeg", "LeftLeg",      "LeftFoot",
+                   "LeftToe",   "RightUpLeg", "RightLeg",  "RightFoot",   "RightToe"};
+  r.joint_parents = {-1, 0, 1, 2, 3, 2, 5, 6, 2, 8, 9, 0, 11, 12, 13, 0, 15, 16, 17};
+}
+
+// Character space: +Z forward, +Y up, the character's left is +X.
+void append_pose(Recording& r, const Clip& clip, int32_t frame) {
+  const float phase = 2.0f * kPi * static_cast<float>(frame - clip.first) / clip.cycle_frames;
+  const float bob = 0.03f * std::cos(2.0f * phase);
+  const float hip_y = 0.95f + bob;
+  const float lean = clip.stride > 0.6f ? 0.15f : 0.04f;
+  std::vector<float> p;
+  auto add = [&](float x, float y, float z) { p.insert(p.end(), {x, y, z}); };
+  add(0, hip_y, 0);                                       // Hips
+  add(0, hip_y + 0.2f, 0.2f * lean);                      // Spine
+  add(0, hip_y + 0.45f, 0.45f * lean);                    // Chest
+  add(0, hip_y + 0.6f, 0.6f * lean);                      // Neck
+  add(0, hip_y + 0.75f, 0.75f * lean + 0.03f);            // Head
+  for (float side : {1.0f, -1.0f}) {                      // arms swing against the legs
+    const float swing = -side * 0.6f * clip.stride * std::sin(phase);
+    const float sx = side * 0.2f, sy = hip_y + 0.55f, sz = 0.55f * lean;
+    const float ex = sx + side * 0.03f, ey = sy - 0.28f * std::cos(swing), ez = sz + 0.28f * std::sin(swing);
+    const float bend = swing + 0.3f + 0.4f * clip.stride;
+    add(sx, sy, sz);
+    add(ex, ey, ez);
+    add(ex, ey - 0.26f * std::cos(bend), ez + 0.26f * std::sin(bend));
+  }
+  for (float side : {1.0f, -1.0f}) {
+    const float leg_phase = side > 0 ? phase : phase + kPi;
+    const float thigh = clip.stride * std::sin(leg_phase);
+    // The knee bends while the leg swings forward (the second half of the cycle).
+    const float knee = std::max(0.0f, std::sin(leg_phase + 0.5f * kPi)) * clip.stride * 1.4f + 0.05f;
+    const float hx = side * 0.1f;
+    const float ky = hip_y - 0.45f * std::cos(thigh), kz = 0.45f * std::sin(thigh);
+    const float ay = ky - 0.45f * std::cos(thigh - knee), az = kz + 0.45f * std::sin(thigh - knee);
+    add(hx, hip_y, 0);
+    add(hx, ky, kz);
+    add(hx, std::max(ay, 0.08f), az);
+    add(hx, std::max(ay - 0.06f, 0.02f), az + 0.14f);
+  }
+  r.pose_frames.push_back(frame);
+  r.pose_positions.insert(r.pose_positions.end(), p.begin(), p.end());
+}
+
+struct Agent {
+  float centre_x, centre_z, radius, speed, angle0;
+  bool running;
+};
+
+}  // namespace
+
+Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
+  Recording r;
+  std::mt19937 rng(params.seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  const std::size_t n = params.agents;
+  r.title = "synthetic crowd: " + std::to_string(n) + " agents walking circles";
+  r.sample_rate_hz = params.sample_rate_hz;
+  r.agent_count = n;
+  r.sample_count = static_cast<std::size_t>(std::floor(params.seconds * params.sample_rate_hz)) + 1;
+  r.trajectory_times_s = {0.333f, 0.667f, 1.0f};
+  set_skeleton(r);
+  for (int32_t f = 0; f < kWalk.length; ++f) append_pose(r, kWalk, kWalk.first + f);
+  for (int32_t f = 0; f < kRun.length; ++f) append_pose(r, kRun, kRun.first + f);
+
+  // Agents on a square grid, 6 m apart, each walking its own circle.
+  const std::size_t side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+  std::vector<Agent> agents(n);
+  for (std::size_t a = 0; a < n; ++a) {
+    Agent& g = agents[a];
+    g.running = unit(rng) < 0.15f;
+    g.centre_x = 6.0f * static_cast<float>(a % side) + unit(rng);
+    g.centre_z = 6.0f * static_cast<float>(a / side) + unit(rng);
+    g.radius = 1.5f + 1.2f * unit(rng);
+    g.speed = (g.running ? 3.2f : 1.2f + 0.4f * unit(rng)) * (unit(rng) < 0.5f ? 1.0f : -1.0f);
+    g.angle0 = 2.0f * kPi * unit(rng);
+  }
+  // Position on the circle at time t, with a small sway so the achieved path
+  // differs visibly from the desired one.
+  auto circle = [](const Agent& g, float t, float sway, float& x, float& z) {
+    const float angle = g.angle0 + g.speed / g.radius * t;
+    const float radius = g.radius + sway;
+    x = g.centre_x + radius * std::sin(angle);
+    z = g.centre_z + radius * std::cos(angle);
+  };
+
+  const std::size_t samples = r.sample_count * n;
+  const std::size_t points = r.trajectory_points();
+  r.root_x.resize(samples), r.root_z.resize(samples), r.facing.resize(samples), r.frame.resize(samples);
+  r.desired_x.resize(samples * points), r.desired_z.resize(samples * points);
+  r.matched_x.resize(samples * points), r.matched_z.resize(samples * points);
+  r.goals.resize(n), r.searches.resize(n);
+
+  const float dt = 1.0f / params.simulation_rate_hz;
+  const std::size_t ticks = static_cast<std::size_t>(std::ceil(params.seconds * params.simulation_rate_hz)) + 1;
+  const int search_ticks = std::max(1, static_cast<int>(std::lround(params.search_interval_s / dt)));
+  for (std::size_t a = 0; a < n; ++a) {
+    const Agent& g = agents[a];
+    const Clip& clip = g.running ? kRun : kWalk;
+    for (int k = 0; k < 8; ++k) {
+      float x, z;
+      circle(g, (static_cast<float>(k) + 1.0f) * 2.0f * kPi * g.radius / std::abs(g.speed) / 8.0f, 0.0f, x, z);
+      r.goals[a].push_back({x, z});
+    }
+    int32_t offset = static_cast<int32_t>(unit(rng) * static_cast<float>(clip.length));
+    std::size_t next_sample = 0;
+    const float sway_phase = 2.0f * kPi * unit(rng);
+    for (std::size_t tick = 0; tick < ticks && next_sample < r.sample_count; ++tick) {
+      const float t = static_cast<float>(tick) * dt;
+      const int32_t frame = clip.first + offset;
+      if (static_cast<int>(tick + a) % search_ticks == 0) {  // staggered searches
+        SearchEvent event;
+        event.time_s = t;
+        event.from_frame = frame;
+        event.jumped = unit(rng) < params.search_interval_s;  // about one jump a second
+        event.forced = event.jumped && unit(rng) < 0.1f;
+        const int32_t jump_to = static_cast<int32_t>(unit(rng) * static_cast<float>(clip.length - 1));
+        event.to_frame = event.jumped ? clip.first + jump_to : frame;
+        event.cost = event.jumped ? 0.4f + 1.5f * unit(rng) : 1.5f + 2.0f * unit(rng);
+        r.searches[a].push_back(event);
+        if (event.jumped) offset = jump_to;
+      }
+      if (static_cast<float>(next_sample) / params.sample_rate_hz <= t + 0.5f * dt) {
+        const std::size_t i = r.sample_index(next_sample, a);
+        const float sway = 0.15f * std::sin(1.3f * t + sway_phase);
+        circle(g, t, sway, r.root_x[i], r.root_z[i]);
+        float ax, az;
+        circle(g, t + 0.05f, sway, ax, az);
+        r.facing[i] = std::atan2(ax - r.root_x[i], az - r.root_z[i]);
+        r.frame[i] = clip.first + offset;
+        for (std::size_t p = 0; p < points; ++p) {
+          const std::size_t j = r.trajectory_index(next_sample, a, p);
+          const float ahead = r.trajectory_times_s[p];
+          circle(g, t + ahead, 0.0f, r.desired_x[j], r.desired_z[j]);
+          circle(g, t + ahead * 0.93f, sway * 0.5f, r.matched_x[j], r.matched_z[j]);
+        }
+        ++next_sample;
+      }
+      offset = (offset + 1) % clip.length;
+    }
+  }
+  return r;
+}
+
+}  // namespace mmvk::crowd

@@ -1,0 +1,599 @@
+// The mmvk crowd viewer: decodes the recording embedded in the page (see
+// viewer_payload.cpp for the layout) and draws four views of it. Plain
+// JavaScript and 2-D canvas, no libraries, no network.
+//
+// Conventions (as in recording.hpp): world Y-up, metres, ground XZ; a facing
+// f looks along (sin f, 0, cos f); character space has +Z forward and the
+// character's left at +X. The crowd view looks down from +Y with +X to the
+// right and +Z down the screen, which is not mirrored.
+'use strict';
+(function () {
+  const statusEl = document.getElementById('status');
+  let failed = false;
+  function reportError(message) {
+    failed = true;
+    statusEl.dataset.state = 'error';
+    statusEl.textContent = 'viewer error: ' + message;
+    document.title = 'mmvk crowd viewer: error';
+  }
+  window.addEventListener('error', (e) => reportError(e.message + ' (line ' + e.lineno + ')'));
+  window.addEventListener('unhandledrejection', (e) =>
+    reportError(String((e.reason && (e.reason.stack || e.reason.message)) || e.reason)));
+
+  // ---- decoding --------------------------------------------------------
+
+  async function inflate(base64) {
+    const binary = atob(base64.trim());
+    const bytes = new Uint8Array(binary.length);
+    for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
+    if (typeof DecompressionStream === 'undefined') {
+      throw new Error('this browser has no DecompressionStream; use a current Chromium, Firefox or Safari');
+    }
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+
+  // LEB128 varints, read with doubles (values stay below 2^53).
+  class Reader {
+    constructor(bytes, name, start, end) {
+      this.bytes = bytes; this.name = name; this.pos = start; this.end = end;
+    }
+    u() {
+      let value = 0, scale = 1, b;
+      do {
+        if (this.pos >= this.end) throw new Error('section ' + this.name + ' ends early');
+        b = this.bytes[this.pos++];
+        value += (b & 127) * scale;
+        scale *= 128;
+      } while (b & 128);
+      return value;
+    }
+    z() {
+      const u = this.u();
+      return u % 2 ? -(u + 1) / 2 : u / 2;
+    }
+    finish() {
+      if (this.pos !== this.end) throw new Error('section ' + this.name + ' has ' + (this.end - this.pos) + ' bytes left over');
+    }
+  }
+
+  function decodePayload(meta, bytes) {
+    if (meta.format !== 1) throw new Error('unknown payload format ' + meta.format);
+    if (bytes.length !== meta.raw_bytes) throw new Error('payload is ' + bytes.length + ' bytes, expected ' + meta.raw_bytes);
+    const readers = {};
+    let offset = 0;
+    for (const s of meta.sections) {
+      readers[s.name] = new Reader(bytes, s.name, offset, offset + s.bytes);
+      offset += s.bytes;
+    }
+    const N = meta.agent_count, S = meta.sample_count, K = meta.trajectory_times_s.length;
+    const J = meta.joint_parents.length, P = meta.pose_count;
+    const d = {
+      N, S, K, J, P, rate: meta.sample_rate_hz,
+      duration: Math.max(0, (S - 1) / meta.sample_rate_hz),
+      times: meta.trajectory_times_s,
+      parents: meta.joint_parents, names: meta.joint_names,
+      rootX: new Float32Array(N * S), rootZ: new Float32Array(N * S),
+      facing: new Float32Array(N * S), slot: new Int32Array(N * S),
+    };
+    let r = readers.roots;
+    for (let a = 0; a < N; a++) {
+      let x = 0, z = 0;
+      for (let s = 0; s < S; s++) {
+        x += r.z(); z += r.z();
+        d.rootX[a * S + s] = x / 100; d.rootZ[a * S + s] = z / 100;
+      }
+    }
+    r.finish();
+    r = readers.facings;
+    for (let a = 0; a < N; a++) {
+      let q = 0;
+      for (let s = 0; s < S; s++) {
+        q = (q + r.z() + 4096) % 4096;
+        d.facing[a * S + s] = q / 4096 * 2 * Math.PI;
+      }
+    }
+    r.finish();
+    r = readers.frames;
+    for (let a = 0; a < N; a++) {
+      let v = 0;
+      for (let s = 0; s < S; s++) { v += r.z(); d.slot[a * S + s] = v - 1; }
+    }
+    r.finish();
+    const trajectory = (reader) => {
+      const xs = new Float32Array(N * S * K), zs = new Float32Array(N * S * K);
+      const prev = new Float64Array(2 * K);
+      for (let a = 0; a < N; a++) {
+        prev.fill(0);
+        for (let s = 0; s < S; s++) {
+          const rx = Math.round(d.rootX[a * S + s] * 100), rz = Math.round(d.rootZ[a * S + s] * 100);
+          for (let k = 0; k < K; k++) {
+            prev[2 * k] += reader.z(); prev[2 * k + 1] += reader.z();
+            xs[(a * S + s) * K + k] = (rx + prev[2 * k]) / 100;
+            zs[(a * S + s) * K + k] = (rz + prev[2 * k + 1]) / 100;
+          }
+        }
+      }
+      reader.finish();
+      return [xs, zs];
+    };
+    [d.desX, d.desZ] = trajectory(readers.desired);
+    if (meta.has_matched) [d.matX, d.matZ] = trajectory(readers.matched);
+    r = readers.goals;
+    d.goals = [];
+    for (let a = 0; a < N; a++) {
+      const count = r.u(), g = new Float32Array(2 * count);
+      let x = 0, z = 0;
+      for (let i = 0; i < count; i++) { x += r.z(); z += r.z(); g[2 * i] = x / 100; g[2 * i + 1] = z / 100; }
+      d.goals.push(g);
+    }
+    r.finish();
+    r = readers.searches;
+    d.searches = [];
+    for (let a = 0; a < N; a++) {
+      const count = r.u();
+      const e = { t: new Float32Array(count), flags: new Uint8Array(count), from: new Int32Array(count),
+                  to: new Int32Array(count), cost: new Float32Array(count) };
+      let ms = 0, from = 0;
+      for (let i = 0; i < count; i++) {
+        ms += r.z(); e.t[i] = ms / 1000;
+        e.flags[i] = r.u();
+        from += r.z(); e.from[i] = from;
+        e.to[i] = e.flags[i] & 4 ? from + r.z() : -1;
+        e.cost[i] = r.z() / 1000;
+      }
+      d.searches.push(e);
+    }
+    r.finish();
+    r = readers.pose_frames;
+    d.poseFrames = new Int32Array(P);
+    for (let p = 0, f = 0; p < P; p++) { f += r.z(); d.poseFrames[p] = f; }
+    r.finish();
+    r = readers.poses;
+    d.poses = new Float32Array(P * J * 3);
+    const prev = new Float64Array(J * 3);
+    for (let p = 0; p < P; p++) {
+      for (let c = 0; c < J * 3; c++) { prev[c] += r.z(); d.poses[p * J * 3 + c] = prev[c] / 1000; }
+    }
+    r.finish();
+    return d;
+  }
+
+  // ---- state and sampling ------------------------------------------------
+
+  let D = null;  // the decoded recording
+  const state = { t: 0, playing: true, speed: 1, selected: 0, view: null, yaw: -Math.PI / 2 + 0.6, dirty: true };
+
+  // Position of agent a at time t, interpolated between samples.
+  function sampleAt(a, t) {
+    const u = Math.min(Math.max(t * D.rate, 0), D.S - 1);
+    const s0 = Math.floor(u), s1 = Math.min(s0 + 1, D.S - 1), w = u - s0;
+    const i0 = a * D.S + s0, i1 = a * D.S + s1;
+    let df = D.facing[i1] - D.facing[i0];
+    if (df > Math.PI) df -= 2 * Math.PI;
+    if (df < -Math.PI) df += 2 * Math.PI;
+    return { x: D.rootX[i0] + w * (D.rootX[i1] - D.rootX[i0]), z: D.rootZ[i0] + w * (D.rootZ[i1] - D.rootZ[i0]),
+             f: D.facing[i0] + w * df, s0, s1, w };
+  }
+
+  // The pose of agent a at time t in character space ([J*3]), blending the
+  // two neighbouring samples when they play nearby frames of one clip.
+  function poseAt(a, t) {
+    const p = sampleAt(a, t);
+    const slot0 = D.slot[a * D.S + p.s0], slot1 = D.slot[a * D.S + p.s1];
+    if (slot0 < 0) return null;
+    const n = D.J * 3, out = new Float32Array(n);
+    const blend = slot1 >= 0 && Math.abs(D.poseFrames[slot1] - D.poseFrames[slot0]) <= 12 ? p.w : 0;
+    for (let c = 0; c < n; c++) {
+      const v0 = D.poses[slot0 * n + c];
+      out[c] = v0 + blend * (D.poses[slot1 * n + c] - v0);
+    }
+    return { pose: out, frame: D.poseFrames[slot0] };
+  }
+
+  const hue = (a) => (a * 137.508) % 360;
+
+  // ---- canvases ----------------------------------------------------------
+
+  function prepare(canvas) {
+    const dpr = window.devicePixelRatio || 1;
+    const w = canvas.clientWidth, h = canvas.clientHeight;
+    if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+      canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
+    }
+    const ctx = canvas.getContext('2d');
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.clearRect(0, 0, w, h);
+    return { ctx, w, h };
+  }
+
+  function polyline(ctx, pts, color, width, dash) {
+    if (pts.length < 2) return;
+    ctx.strokeStyle = color; ctx.lineWidth = width; ctx.setLineDash(dash || []);
+    ctx.beginPath();
+    ctx.moveTo(pts[0][0], pts[0][1]);
+    for (let i = 1; i < pts.length; i++) ctx.lineTo(pts[i][0], pts[i][1]);
+    ctx.stroke();
+    ctx.setLineDash([]);
+  }
+
+  function dots(ctx, pts, color, radius) {
+    ctx.fillStyle = color;
+    for (const p of pts) { ctx.beginPath(); ctx.arc(p[0], p[1], radius, 0, 2 * Math.PI); ctx.fill(); }
+  }
+
+  const css = (name) => getComputedStyle(document.documentElement).getPropertyValue(name).trim();
+  const colors = {};
+
+  // ---- the crowd from above ---------------------------------------------
+
+  const crowdCanvas = document.getElementById('crowd');
+
+  function fitView(w, h) {
+    const [x0, z0, x1, z1] = D.bounds;
+    const scale = Math.min(w / Math.max(x1 - x0 + 4, 1), h / Math.max(z1 - z0 + 4, 1));
+    state.view = { cx: (x0 + x1) / 2, cz: (z0 + z1) / 2, scale };
+  }
+  const toScreen = (v, w, h, x, z) => [w / 2 + (x - v.cx) * v.scale, h / 2 + (z - v.cz) * v.scale];
+
+  function drawCrowd() {
+    const { ctx, w, h } = prepare(crowdCanvas);
+    if (!state.view) fitView(w, h);
+    const v = state.view;
+    // Ground grid: 1 m lines when zoomed in, else 10 m.
+    const step = v.scale > 12 ? 1 : 10;
+    ctx.strokeStyle = '#242a33'; ctx.lineWidth = 1;
+    ctx.beginPath();
+    const xa = v.cx - w / 2 / v.scale, xb = v.cx + w / 2 / v.scale, za = v.cz - h / 2 / v.scale, zb = v.cz + h / 2 / v.scale;
+    for (let x = Math.ceil(xa / step) * step; x <= xb; x += step) { const sx = toScreen(v, w, h, x, 0)[0]; ctx.moveTo(sx, 0); ctx.lineTo(sx, h); }
+    for (let z = Math.ceil(za / step) * step; z <= zb; z += step) { const sy = toScreen(v, w, h, 0, z)[1]; ctx.moveTo(0, sy); ctx.lineTo(w, sy); }
+    ctx.stroke();
+    // Goal paths of everyone, faint, in one path.
+    ctx.strokeStyle = 'rgba(160,170,190,0.16)'; ctx.lineWidth = 1;
+    ctx.beginPath();
+    for (const g of D.goals) {
+      for (let i = 0; i < g.length; i += 2) {
+        const [sx, sy] = toScreen(v, w, h, g[i], g[i + 1]);
+        if (i === 0) ctx.moveTo(sx, sy); else ctx.lineTo(sx, sy);
+      }
+    }
+    ctx.stroke();
+    // The characters: a disc (0.3 m, at least 2.5 px) and a facing tick.
+    const radius = Math.max(0.3 * v.scale, 2.5);
+    let drawn = 0;
+    for (let a = 0; a < D.N; a++) {
+      const p = sampleAt(a, state.t);
+      const [sx, sy] = toScreen(v, w, h, p.x, p.z);
+      if (sx < -radius || sy < -radius || sx > w + radius || sy > h + radius) continue;
+      ctx.fillStyle = 'hsl(' + hue(a) + ',75%,58%)';
+      ctx.beginPath(); ctx.arc(sx, sy, radius, 0, 2 * Math.PI); ctx.fill();
+      ctx.strokeStyle = '#0b0d10'; ctx.lineWidth = Math.max(1, radius * 0.3);
+      ctx.beginPath(); ctx.moveTo(sx, sy);
+      ctx.lineTo(sx + Math.sin(p.f) * radius * 1.6, sy + Math.cos(p.f) * radius * 1.6); ctx.stroke();
+      drawn++;
+    }
+    state.drawn = drawn;
+    drawSelectionOnCrowd(ctx, v, w, h, radius);
+  }
+
+  function drawSelectionOnCrowd(ctx, v, w, h, radius) {
+    const a = state.selected;
+    if (a < 0) return;
+    const g = D.goals[a], goalPts = [];
+    for (let i = 0; i < g.length; i += 2) goalPts.push(toScreen(v, w, h, g[i], g[i + 1]));
+    polyline(ctx, goalPts, 'rgba(255,255,255,0.55)', 1.5, [4, 4]);
+    dots(ctx, goalPts, '#fff', 3);
+    // Achieved path: 2 s behind (grey) and the samples ahead (cyan).
+    const p = sampleAt(a, state.t), past = [], ahead = [];
+    for (let s = Math.max(0, p.s0 - Math.round(2 * D.rate)); s <= p.s0; s++) past.push(toScreen(v, w, h, D.rootX[a * D.S + s], D.rootZ[a * D.S + s]));
+    past.push(toScreen(v, w, h, p.x, p.z));
+    const horizon = D.times.length ? D.times[D.times.length - 1] : 1;
+    ahead.push(toScreen(v, w, h, p.x, p.z));
+    for (let s = p.s1; s < D.S && s <= p.s0 + Math.ceil(horizon * D.rate); s++) ahead.push(toScreen(v, w, h, D.rootX[a * D.S + s], D.rootZ[a * D.S + s]));
+    polyline(ctx, past, 'rgba(200,200,200,0.6)', 2);
+    polyline(ctx, ahead, colors.achieved, 2.5);
+    const desired = [toScreen(v, w, h, D.rootX[a * D.S + p.s0], D.rootZ[a * D.S + p.s0])];
+    for (let k = 0; k < D.K; k++) desired.push(toScreen(v, w, h, D.desX[(a * D.S + p.s0) * D.K + k], D.desZ[(a * D.S + p.s0) * D.K + k]));
+    polyline(ctx, desired, colors.desired, 2.5);
+    dots(ctx, desired.slice(1), colors.desired, 3);
+    const [sx, sy] = toScreen(v, w, h, p.x, p.z);
+    ctx.strokeStyle = '#fff'; ctx.lineWidth = 2;
+    ctx.beginPath(); ctx.arc(sx, sy, radius + 4, 0, 2 * Math.PI); ctx.stroke();
+  }
+
+  function pickAgent(mx, my) {
+    const v = state.view, { clientWidth: w, clientHeight: h } = crowdCanvas;
+    let best = -1, bestD = Math.max(0.6 * v.scale, 12) ** 2;
+    for (let a = 0; a < D.N; a++) {
+      const p = sampleAt(a, state.t), [sx, sy] = toScreen(v, w, h, p.x, p.z);
+      const dd = (sx - mx) ** 2 + (sy - my) ** 2;
+      if (dd < bestD) { bestD = dd; best = a; }
+    }
+    return best;
+  }
+
+  // ---- the selected character's skeleton (orthographic 3-D) ------------
+
+  const skeletonCanvas = document.getElementById('skeleton');
+
+  function drawSkeleton() {
+    const { ctx, w, h } = prepare(skeletonCanvas);
+    const label = document.getElementById('skeleton-label');
+    const a = state.selected;
+    if (a < 0) { label.textContent = 'skeleton: click a character'; return; }
+    const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), pitch = 0.3, cp = Math.cos(pitch), sp = Math.sin(pitch);
+    const scale = Math.min(h / 2.6, w / 3.2), ox = w / 2, oy = h * 0.82;
+    // Character space -> screen: yaw about +Y, then look down by `pitch`.
+    const project = (x, y, z) => {
+      const xr = cy * x - sy * z, zr = sy * x + cy * z;
+      return [ox + xr * scale, oy - (y * cp + zr * sp) * scale];
+    };
+    ctx.strokeStyle = '#2c323d'; ctx.lineWidth = 1; ctx.beginPath();
+    for (let i = -2; i <= 2; i++) {
+      let p = project(i * 0.5, 0, -1), q = project(i * 0.5, 0, 1); ctx.moveTo(p[0], p[1]); ctx.lineTo(q[0], q[1]);
+      p = project(-1, 0, i * 0.5); q = project(1, 0, i * 0.5); ctx.moveTo(p[0], p[1]); ctx.lineTo(q[0], q[1]);
+    }
+    ctx.stroke();
+    polyline(ctx, [project(0, 0, 0), project(0, 0, 0.8)], '#55606f', 2);  // forward
+    const now = poseAt(a, state.t), p = sampleAt(a, state.t);
+    label.textContent = 'agent ' + a + (now ? ' \u00b7 frame ' + now.frame : '') + ' \u00b7 facing ' +
+      Math.round(p.f * 180 / Math.PI) + '\u00b0 \u00b7 drag to turn';
+    if (!now) {
+      ctx.fillStyle = colors.dim; ctx.fillText('no pose recorded for this frame', 10, 40);
+      return;
+    }
+    const q = now.pose, J = D.J, screen = [];
+    for (let j = 0; j < J; j++) screen.push(project(q[3 * j], q[3 * j + 1], q[3 * j + 2]));
+    // Shadows of the joints on the ground, then bones coloured by side.
+    ctx.fillStyle = 'rgba(0,0,0,0.35)';
+    for (let j = 0; j < J; j++) { const s = project(q[3 * j], 0, q[3 * j + 2]); ctx.fillRect(s[0] - 2, s[1] - 1, 4, 2); }
+    ctx.lineCap = 'round';
+    for (let j = 0; j < J; j++) {
+      const parent = D.parents[j];
+      if (parent < 0) continue;
+      const side = q[3 * j];
+      ctx.strokeStyle = side > 0.03 ? '#5ec8ff' : side < -0.03 ? '#ff8fb1' : '#e8ecf2';
+      ctx.lineWidth = Math.max(2, scale * 0.035);
+      ctx.beginPath(); ctx.moveTo(screen[parent][0], screen[parent][1]); ctx.lineTo(screen[j][0], screen[j][1]); ctx.stroke();
+    }
+    dots(ctx, screen, '#fff', Math.max(2, scale * 0.02));
+  }
+
+  // ---- desired against achieved trajectory (character space) -----------
+
+  const trajectoryCanvas = document.getElementById('trajectory');
+
+  function drawTrajectory() {
+    const { ctx, w, h } = prepare(trajectoryCanvas);
+    const a = state.selected;
+    if (a < 0) return;
+    // The latest sample at or before t: its desired trajectory is what the
+    // controller searched with; the achieved points are where the root really
+    // was that much later.
+    const s = Math.min(Math.floor(state.t * D.rate + 1e-6), D.S - 1), i = a * D.S + s;
+    const x0 = D.rootX[i], z0 = D.rootZ[i], f = D.facing[i], c = Math.cos(f), sn = Math.sin(f);
+    const local = (x, z) => { const dx = x - x0, dz = z - z0; return [c * dx - sn * dz, sn * dx + c * dz]; };
+    const desired = [[0, 0]], matched = [[0, 0]], achieved = [[0, 0]], marks = [], past = [];
+    for (let k = 0; k < D.K; k++) {
+      desired.push(local(D.desX[i * D.K + k], D.desZ[i * D.K + k]));
+      if (D.matX) matched.push(local(D.matX[i * D.K + k], D.matZ[i * D.K + k]));
+      const p = sampleAt(a, s / D.rate + D.times[k]);
+      marks.push(local(p.x, p.z));
+    }
+    const horizon = D.times.length ? D.times[D.times.length - 1] : 1;
+    for (let u = s + 1; u < D.S && u <= s + Math.ceil(horizon * D.rate); u++) achieved.push(local(D.rootX[a * D.S + u], D.rootZ[a * D.S + u]));
+    for (let u = Math.max(0, s - Math.round(D.rate)); u <= s; u++) past.push(local(D.rootX[a * D.S + u], D.rootZ[a * D.S + u]));
+    let extent = 1.5;
+    for (const p of desired.concat(matched, achieved, marks)) extent = Math.max(extent, Math.abs(p[0]), Math.abs(p[1]));
+    const scale = Math.min(w, h - 40) / 2 / (extent * 1.15), ox = w / 2, oy = 20 + (h - 40) / 2;
+    // Forward is up; the character's left (+X) is on the screen's left.
+    const screen = (p) => [ox - p[0] * scale, oy - p[1] * scale];
+    ctx.strokeStyle = '#2c323d'; ctx.lineWidth = 1;
+    for (let r = 1; r <= Math.ceil(extent); r++) { ctx.beginPath(); ctx.arc(ox, oy, r * scale, 0, 2 * Math.PI); ctx.stroke(); }
+    polyline(ctx, past.map(screen), 'rgba(200,200,200,0.45)', 2);
+    if (D.matX) polyline(ctx, matched.map(screen), colors.matched, 2, [5, 4]);
+    polyline(ctx, achieved.map(screen), colors.achieved, 2.5);
+    dots(ctx, marks.map(screen), colors.achieved, 4);
+    polyline(ctx, desired.map(screen), colors.desired, 2.5);
+    dots(ctx, desired.slice(1).map(screen), colors.desired, 4);
+    ctx.fillStyle = colors.desired; ctx.font = '11px system-ui, sans-serif';
+    desired.slice(1).forEach((p, k) => { const q = screen(p); ctx.fillText(D.times[k].toFixed(2) + ' s', q[0] + 6, q[1] - 4); });
+    ctx.fillStyle = '#fff';
+    ctx.beginPath(); ctx.moveTo(ox, oy - 9); ctx.lineTo(ox - 6, oy + 6); ctx.lineTo(ox + 6, oy + 6); ctx.closePath(); ctx.fill();
+    if (D.K > 0) {
+      const e = desired[D.K], m = marks[D.K - 1], err = Math.hypot(e[0] - m[0], e[1] - m[1]);
+      ctx.fillStyle = colors.dim; ctx.font = '12px system-ui, sans-serif';
+      ctx.fillText('sample at ' + (s / D.rate).toFixed(2) + ' s: desired vs achieved after ' + horizon.toFixed(2) + ' s: ' + err.toFixed(2) + ' m', 8, h - 8);
+    }
+  }
+
+  // ---- searches and jumps on a timeline ---------------------------------
+
+  const timelineCanvas = document.getElementById('timeline');
+  const TL = { left: 40, right: 14 };
+  const timeToX = (t, w) => TL.left + (D.duration > 0 ? t / D.duration : 0) * (w - TL.left - TL.right);
+  const xToTime = (x, w) => Math.min(Math.max((x - TL.left) / (w - TL.left - TL.right), 0), 1) * D.duration;
+
+  function drawTimeline() {
+    const { ctx, w, h } = prepare(timelineCanvas);
+    const a = state.selected, label = document.getElementById('timeline-label');
+    ctx.font = '11px system-ui, sans-serif';
+    ctx.fillStyle = colors.dim; ctx.strokeStyle = '#2c323d'; ctx.lineWidth = 1;
+    const top = 24, frameH = (h - top - 22) * 0.55, axisY = top + frameH + 8, costTop = axisY + 6, costH = h - 18 - costTop;
+    const tickStep = D.duration > 30 ? 10 : D.duration > 8 ? 2 : 1;
+    for (let t = 0; t <= D.duration + 1e-6; t += tickStep) {
+      const x = timeToX(t, w);
+      ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, h - 16); ctx.stroke();
+      ctx.fillText(t.toFixed(0) + ' s', x - 6, h - 4);
+    }
+    if (a < 0) { label.textContent = 'searches: click a character'; return; }
+    const e = D.searches[a];
+    // The played frame over time (upper band): jumps show as breaks.
+    let fmin = Infinity, fmax = -Infinity;
+    for (let s = 0; s < D.S; s++) { const slot = D.slot[a * D.S + s]; if (slot >= 0) { fmin = Math.min(fmin, D.poseFrames[slot]); fmax = Math.max(fmax, D.poseFrames[slot]); } }
+    for (let i = 0; i < e.to.length; i++) if (e.to[i] >= 0) { fmin = Math.min(fmin, e.to[i], e.from[i]); fmax = Math.max(fmax, e.to[i], e.from[i]); }
+    const frameY = (f) => top + frameH - (fmax > fmin ? (f - fmin) / (fmax - fmin) : 0.5) * frameH;
+    ctx.fillStyle = 'rgba(200,210,230,0.75)';
+    for (let s = 0; s < D.S; s++) {
+      const slot = D.slot[a * D.S + s];
+      if (slot >= 0) ctx.fillRect(timeToX(s / D.rate, w) - 1, frameY(D.poseFrames[slot]) - 1, 2, 2);
+    }
+    // Searches on the axis: a short grey tick, a tall jump bar from the old
+    // frame to the new one, a red cross where no candidate was found.
+    let jumps = 0, forced = 0, none = 0, cmax = 0;
+    for (let i = 0; i < e.t.length; i++) cmax = Math.max(cmax, e.cost[i]);
+    for (let i = 0; i < e.t.length; i++) {
+      const x = timeToX(e.t[i], w), jumped = e.flags[i] & 1;
+      if (e.flags[i] & 2) forced++;
+      if (e.to[i] < 0) {
+        none++; ctx.strokeStyle = '#ff3b30'; ctx.lineWidth = 2;
+        ctx.beginPath(); ctx.moveTo(x - 4, axisY - 4); ctx.lineTo(x + 4, axisY + 4); ctx.moveTo(x + 4, axisY - 4); ctx.lineTo(x - 4, axisY + 4); ctx.stroke();
+        continue;
+      }
+      if (jumped) {
+        jumps++;
+        ctx.strokeStyle = e.flags[i] & 2 ? '#ff3b30' : colors.jump; ctx.lineWidth = 2;
+        ctx.beginPath(); ctx.moveTo(x, frameY(e.from[i])); ctx.lineTo(x, frameY(e.to[i])); ctx.stroke();
+        ctx.fillStyle = colors.jump; ctx.fillRect(x - 1.5, axisY - 6, 3, 12);
+      } else {
+        ctx.fillStyle = '#6b7483'; ctx.fillRect(x - 0.5, axisY - 3, 1, 6);
+      }
+      const cy = costTop + costH - (cmax > 0 ? e.cost[i] / cmax : 0) * costH;
+      ctx.fillStyle = jumped ? colors.jump : '#8a93a3'; ctx.fillRect(x - 1, cy - 1, 2, 2);
+    }
+    ctx.fillStyle = colors.dim;
+    ctx.fillText('frame', 4, top + 10);
+    ctx.fillText('cost', 4, costTop + 10);
+    const x = timeToX(state.t, w);
+    ctx.strokeStyle = '#fff'; ctx.lineWidth = 1.5; ctx.beginPath(); ctx.moveTo(x, top - 4); ctx.lineTo(x, h - 16); ctx.stroke();
+    // The latest search at or before the cursor, in words.
+    let last = -1;
+    for (let i = 0; i < e.t.length && e.t[i] <= state.t + 1e-6; i++) last = i;
+    let text = 'agent ' + a + ': ' + e.t.length + ' searches, ' + jumps + ' jumps' + (forced ? ', ' + forced + ' forced' : '') +
+      (none ? ', ' + none + ' without candidate' : '') + (D.duration > 0 ? ' (' + (jumps / D.duration).toFixed(2) + ' jumps/s)' : '');
+    if (last >= 0) {
+      text += ' \u00b7 last search ' + e.t[last].toFixed(2) + ' s: ' + (e.to[last] < 0 ? 'no candidate' :
+        (e.flags[last] & 1 ? 'jump ' + e.from[last] + ' \u2192 ' + e.to[last] : 'stay at ' + e.from[last]) + ', cost ' + e.cost[last].toFixed(3));
+    }
+    label.textContent = text;
+  }
+
+  // ---- the loop and the controls ----------------------------------------
+
+  const playButton = document.getElementById('play'), slider = document.getElementById('time'), clock = document.getElementById('clock');
+
+  function setTime(t) { state.t = Math.min(Math.max(t, 0), D.duration); state.dirty = true; }
+  function setPlaying(on) { state.playing = on; playButton.textContent = on ? 'Pause' : 'Play'; }
+
+  function render() {
+    drawCrowd(); drawSkeleton(); drawTrajectory(); drawTimeline();
+    slider.value = D.duration > 0 ? state.t / D.duration : 0;
+    clock.textContent = state.t.toFixed(2) + ' / ' + D.duration.toFixed(2) + ' s';
+    state.dirty = false;
+  }
+
+  let lastFrame = null;
+  function frame(now) {
+    if (failed) return;
+    if (state.playing && lastFrame !== null) {
+      let t = state.t + (now - lastFrame) / 1000 * state.speed;
+      if (t > D.duration) t = 0;
+      setTime(t);
+    }
+    lastFrame = now;
+    if (state.dirty) render();
+    requestAnimationFrame(frame);
+  }
+
+  function installControls() {
+    playButton.onclick = () => setPlaying(!state.playing);
+    document.getElementById('speed').onchange = (e) => { state.speed = parseFloat(e.target.value); };
+    slider.oninput = () => { setPlaying(false); setTime(parseFloat(slider.value) * D.duration); };
+    window.addEventListener('keydown', (e) => {
+      if (e.target.tagName === 'SELECT') return;
+      if (e.code === 'Space') { e.preventDefault(); setPlaying(!state.playing); }
+      if (e.code === 'ArrowRight') { setPlaying(false); setTime(state.t + 1 / D.rate); }
+      if (e.code === 'ArrowLeft') { setPlaying(false); setTime(state.t - 1 / D.rate); }
+    });
+    window.addEventListener('resize', () => { state.dirty = true; });
+    // Crowd view: drag pans, wheel zooms about the cursor, a click selects.
+    let drag = null;
+    crowdCanvas.addEventListener('mousedown', (e) => { drag = { x: e.offsetX, y: e.offsetY, moved: false }; });
+    window.addEventListener('mouseup', (e) => {
+      if (drag && !drag.moved && e.target === crowdCanvas) {
+        const a = pickAgent(e.offsetX, e.offsetY);
+        if (a >= 0) { state.selected = a; state.dirty = true; }
+      }
+      drag = null;
+    });
+    crowdCanvas.addEventListener('mousemove', (e) => {
+      if (!drag) return;
+      const dx = e.offsetX - drag.x, dy = e.offsetY - drag.y;
+      if (Math.abs(dx) + Math.abs(dy) > 3) drag.moved = true;
+      if (drag.moved) {
+        state.view.cx -= dx / state.view.scale; state.view.cz -= dy / state.view.scale;
+        drag.x = e.offsetX; drag.y = e.offsetY; state.dirty = true;
+      }
+    });
+    crowdCanvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      const v = state.view, w = crowdCanvas.clientWidth, h = crowdCanvas.clientHeight;
+      const wx = v.cx + (e.offsetX - w / 2) / v.scale, wz = v.cz + (e.offsetY - h / 2) / v.scale;
+      v.scale *= Math.exp(-e.deltaY * 0.0015);
+      v.cx = wx - (e.offsetX - w / 2) / v.scale; v.cz = wz - (e.offsetY - h / 2) / v.scale;
+      state.dirty = true;
+    }, { passive: false });
+    // Skeleton view: horizontal drag turns the camera.
+    let turn = null;
+    skeletonCanvas.addEventListener('mousedown', (e) => { turn = e.offsetX; });
+    window.addEventListener('mouseup', () => { turn = null; });
+    skeletonCanvas.addEventListener('mousemove', (e) => {
+      if (turn === null) return;
+      state.yaw += (e.offsetX - turn) * 0.01; turn = e.offsetX; state.dirty = true;
+    });
+    // Timeline: click or drag seeks.
+    let seeking = false;
+    const seek = (e) => { setPlaying(false); setTime(xToTime(e.offsetX, timelineCanvas.clientWidth)); };
+    timelineCanvas.addEventListener('mousedown', (e) => { seeking = true; seek(e); });
+    timelineCanvas.addEventListener('mousemove', (e) => { if (seeking) seek(e); });
+    window.addEventListener('mouseup', () => { seeking = false; });
+  }
+
+  // URL options, so a page can be opened (or screenshotted) at a known
+  // state: ?t=SECONDS&agent=INDEX&paused=1
+  function applyQuery() {
+    const q = new URLSearchParams(window.location.search);
+    if (q.has('t')) setTime(parseFloat(q.get('t')) || 0);
+    if (q.has('agent')) {
+      const a = parseInt(q.get('agent'), 10);
+      state.selected = a >= 0 && a < D.N ? a : -1;
+    }
+    setPlaying(!(q.get('paused') === '1'));
+  }
+
+  async function main() {
+    const started = performance.now();
+    const meta = JSON.parse(document.getElementById('mmvk-meta').textContent);
+    const bytes = await inflate(document.getElementById('mmvk-data').textContent);
+    D = decodePayload(meta, bytes);
+    D.bounds = meta.bounds;
+    for (const name of ['desired', 'achieved', 'matched', 'jump', 'dim']) colors[name] = css('--' + name);
+    document.getElementById('title').textContent = meta.title || 'mmvk crowd';
+    document.getElementById('title').title = meta.title || '';
+    if (D.N === 0) state.selected = -1;
+    applyQuery();
+    installControls();
+    render();
+    if (failed) return;
+    const ms = Math.round(performance.now() - started);
+    statusEl.dataset.state = 'ready';
+    statusEl.dataset.agents = String(D.N);
+    statusEl.dataset.drawn = String(state.drawn);
+    statusEl.dataset.decodeMs = String(ms);
+    statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + D.rate + ' Hz, ' + D.P + ' poses; loaded in ' + ms + ' ms';
+    document.title = 'mmvk crowd viewer: ' + (meta.title || 'ready');
+    requestAnimationFrame(frame);
+  }
+
+  main().catch((e) => reportError(String((e && (e.stack || e.message)) || e)));
+})();

@@ -1,0 +1,121 @@
+#include "viewer/viewer_html.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <string_view>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "mmvk_viewer_assets.hpp"  // generated from viewer.html and viewer.js
+#include "viewer/recording_check.hpp"
+#include "viewer/viewer_payload.hpp"
+
+namespace mmvk::crowd {
+namespace {
+
+std::string base64(const std::vector<uint8_t>& bytes) {
+  static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const uint32_t v = (uint32_t{bytes[i]} << 16) | (uint32_t{bytes[i + 1]} << 8) | bytes[i + 2];
+    out += kAlphabet[v >> 18];
+    out += kAlphabet[(v >> 12) & 63];
+    out += kAlphabet[(v >> 6) & 63];
+    out += kAlphabet[v & 63];
+  }
+  if (i < bytes.size()) {
+    const bool two = i + 1 < bytes.size();
+    const uint32_t v = (uint32_t{bytes[i]} << 16) | (two ? uint32_t{bytes[i + 1]} << 8 : 0u);
+    out += kAlphabet[v >> 18];
+    out += kAlphabet[(v >> 12) & 63];
+    out += two ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// Fills the template's placeholders, each of which must occur exactly once.
+// Positions are found in the template itself, so substituted text (the
+// script, the data) is never searched again.
+Result<std::string> fill_template(std::string_view page, const std::array<std::pair<std::string_view, std::string_view>, 3>& fills) {
+  std::array<std::size_t, 3> at{};
+  for (std::size_t i = 0; i < fills.size(); ++i) {
+    at[i] = page.find(fills[i].first);
+    if (at[i] == std::string_view::npos || page.find(fills[i].first, at[i] + 1) != std::string_view::npos) {
+      return make_error("viewer: the embedded viewer.html must hold " + std::string(fills[i].first) + " exactly once");
+    }
+  }
+  std::array<std::size_t, 3> order{0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return at[a] < at[b]; });
+  std::string out;
+  std::size_t cursor = 0;
+  for (std::size_t i : order) {
+    out.append(page.substr(cursor, at[i] - cursor));
+    out.append(fills[i].second);
+    cursor = at[i] + fills[i].first.size();
+  }
+  out.append(page.substr(cursor));
+  return out;
+}
+
+Status write_all(int fd, const std::string& text, const std::string& temp) {
+  std::size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return make_error("viewer: cannot write " + temp + ": " + std::strerror(errno));
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) return make_error("viewer: cannot flush " + temp + ": " + std::strerror(errno));
+  return {};
+}
+
+}  // namespace
+
+Result<ViewerPage> render_viewer_html(const Recording& recording) {
+  MMVK_TRY(validate_recording(recording));
+  MMVK_ASSIGN_OR_RETURN(ViewerPayload payload, encode_viewer_payload(recording));
+  const std::string_view script(kViewerJs, sizeof(kViewerJs) - 1);
+  if (script.find("</script") != std::string_view::npos) {
+    return make_error("viewer: the embedded viewer.js must not contain \"</script\"");
+  }
+  const std::string data = base64(payload.compressed);
+  MMVK_ASSIGN_OR_RETURN(std::string html,
+                        fill_template(std::string_view(kViewerHtml, sizeof(kViewerHtml) - 1),
+                                      {{{"/*@MMVK_SCRIPT@*/", script},
+                                        {"@MMVK_META@", payload.meta_json},
+                                        {"@MMVK_DATA@", data}}}));
+  return ViewerPage{std::move(html), payload.raw.size(), payload.compressed.size()};
+}
+
+Result<std::size_t> write_viewer_html(const std::filesystem::path& path, const Recording& recording) {
+  MMVK_ASSIGN_OR_RETURN(ViewerPage page, render_viewer_html(recording));
+  // The temporary file sits beside the target so the rename stays on one
+  // file system and is atomic.
+  std::string temp = path.string() + ".XXXXXX";
+  const int fd = ::mkstemp(temp.data());
+  if (fd < 0) return make_error("viewer: cannot create a temporary file beside " + path.string() + ": " + std::strerror(errno));
+  Status status = write_all(fd, page.html, temp);
+  // mkstemp creates 0600; a page is for people to open, so make it readable.
+  if (status.ok() && ::fchmod(fd, 0644) != 0) {
+    status = make_error("viewer: cannot set permissions of " + temp + ": " + std::strerror(errno));
+  }
+  if (::close(fd) != 0 && status.ok()) status = make_error("viewer: cannot close " + temp + ": " + std::strerror(errno));
+  if (status.ok() && std::rename(temp.c_str(), path.c_str()) != 0) {
+    status = make_error("viewer: cannot rename " + temp + " to " + path.string() + ": " + std::strerror(errno));
+  }
+  if (!status.ok()) {
+    ::unlink(temp.c_str());
+    return status;
+  }
+  return page.html.size();
+}
+
+}  // namespace mmvk::crowd

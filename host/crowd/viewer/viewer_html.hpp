@@ -1,0 +1,33 @@
+// The crowd viewer: one self-contained HTML page (no network, no CDN) that
+// replays a Recording: the crowd from above with a time slider, a selected
+// character's skeleton, its desired against its achieved trajectory, and its
+// searches and jumps on a timeline. The page's HTML and JavaScript live in
+// viewer.html and viewer.js beside this file and are embedded at build time.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+#include "mmvk/status.hpp"
+#include "recording.hpp"
+
+namespace mmvk::crowd {
+
+struct ViewerPage {
+  std::string html;
+  std::size_t payload_raw_bytes = 0;         // the encoded recording before deflate
+  std::size_t payload_compressed_bytes = 0;  // after deflate, before base64
+};
+
+// Builds the page in memory. Errors: an inconsistent recording (the field at
+// fault is named; see validate_recording) or a compression failure.
+Result<ViewerPage> render_viewer_html(const Recording& recording);
+
+// Renders the page and writes it to `path` atomically: a temporary file in
+// the same folder, flushed to disk, then renamed over `path`, so a reader
+// never sees half a page. Errors name the path and the failing step.
+// Returns the size of the written file in bytes.
+Result<std::size_t> write_viewer_html(const std::filesystem::path& path, const Recording& recording);
+
+}  // namespace mmvk::crowd

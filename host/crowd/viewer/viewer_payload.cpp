@@ -1,0 +1,276 @@
+// Layout of the raw blob (all integers are LEB128 varints; "z" marks a
+// zigzag-coded signed value; every coordinate is quantized before the deltas
+// are taken, so decoding accumulates exactly and never drifts):
+//   roots     for agent, for sample: z dx_cm, z dz_cm   (delta along time)
+//   facings   for agent, for sample: z d_q               (q = 1/4096 turn, delta wrapped to +-2048)
+//   frames    for agent, for sample: z d(pose_slot + 1)  (0: no pose)
+//   desired   for agent, for sample, for point: z d_rel_x_cm, z d_rel_z_cm
+//             (rel = point - root at that sample; delta along time per point)
+//   matched   same as desired, present when meta.has_matched
+//   goals     for agent: count, then for goal: z dx_cm, z dz_cm
+//   searches  for agent: count, then for event: z dt_ms, flags (1 jumped,
+//             2 forced, 4 has to_frame), z d_from_frame, [z to - from], z cost_milli
+//   pose_frames  for slot: z d_frame
+//   poses     for slot, joint, axis: z d_mm (delta against the previous slot)
+#include "viewer/viewer_payload.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <nlohmann/json.hpp>
+#include <zlib.h>
+
+namespace mmvk::crowd {
+namespace {
+
+class VarintWriter {
+ public:
+  explicit VarintWriter(std::vector<uint8_t>& out) : out_(out) {}
+  void u(uint64_t value) {
+    while (value >= 0x80) {
+      out_.push_back(static_cast<uint8_t>(value | 0x80));
+      value >>= 7;
+    }
+    out_.push_back(static_cast<uint8_t>(value));
+  }
+  void z(int64_t value) { u((static_cast<uint64_t>(value) << 1) ^ static_cast<uint64_t>(value >> 63)); }
+
+ private:
+  std::vector<uint8_t>& out_;
+};
+
+// The page decodes varints with doubles: keep every value well inside 2^53.
+constexpr double kLimit = 1e14;
+
+int64_t quantize(double value, double scale) {
+  return static_cast<int64_t>(std::llround(std::clamp(value * scale, -kLimit, kLimit)));
+}
+
+constexpr double kCm = 100.0;
+constexpr double kMm = 1000.0;
+constexpr double kMilli = 1000.0;
+constexpr int64_t kTurn = 4096;
+
+// Appends one section and records its size in the header.
+template <class Fill>
+void add_section(nlohmann::json& sections, std::vector<uint8_t>& raw, const char* name, Fill&& fill) {
+  const std::size_t before = raw.size();
+  VarintWriter out(raw);
+  fill(out);
+  sections.push_back({{"name", name}, {"bytes", raw.size() - before}});
+}
+
+// Maps each sample's database frame to a slot among the poses actually
+// played, so frames recorded but never shown cost nothing in the page.
+struct PoseSlots {
+  std::vector<int64_t> sample_slot;  // [agent x sample layout of Recording::frame], -1: none
+  std::vector<std::size_t> poses;    // slot -> index into Recording::pose_frames
+};
+
+PoseSlots assign_pose_slots(const Recording& r) {
+  PoseSlots slots;
+  std::vector<int64_t> pose_slot(r.pose_frames.size(), -1);
+  slots.sample_slot.assign(r.frame.size(), -1);
+  std::vector<std::size_t> found(r.frame.size(), r.pose_frames.size());
+  for (std::size_t i = 0; i < r.frame.size(); ++i) {
+    const auto it = std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]);
+    if (it != r.pose_frames.end() && *it == r.frame[i]) {
+      found[i] = static_cast<std::size_t>(it - r.pose_frames.begin());
+      pose_slot[found[i]] = 0;
+    }
+  }
+  // Slots in ascending frame order, so neighbouring slots are similar poses.
+  for (std::size_t p = 0; p < pose_slot.size(); ++p) {
+    if (pose_slot[p] == 0) {
+      pose_slot[p] = static_cast<int64_t>(slots.poses.size());
+      slots.poses.push_back(p);
+    }
+  }
+  for (std::size_t i = 0; i < r.frame.size(); ++i) {
+    if (found[i] < pose_slot.size()) slots.sample_slot[i] = pose_slot[found[i]];
+  }
+  return slots;
+}
+
+void write_trajectory(VarintWriter& out, const Recording& r, const std::vector<float>& xs,
+                      const std::vector<float>& zs) {
+  const std::size_t points = r.trajectory_points();
+  std::vector<int64_t> previous(points * 2);
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    std::fill(previous.begin(), previous.end(), 0);
+    for (std::size_t s = 0; s < r.sample_count; ++s) {
+      const std::size_t root = r.sample_index(s, a);
+      const int64_t root_x = quantize(r.root_x[root], kCm);
+      const int64_t root_z = quantize(r.root_z[root], kCm);
+      for (std::size_t k = 0; k < points; ++k) {
+        const std::size_t i = r.trajectory_index(s, a, k);
+        const int64_t rel_x = quantize(xs[i], kCm) - root_x;
+        const int64_t rel_z = quantize(zs[i], kCm) - root_z;
+        out.z(rel_x - previous[2 * k]);
+        out.z(rel_z - previous[2 * k + 1]);
+        previous[2 * k] = rel_x;
+        previous[2 * k + 1] = rel_z;
+      }
+    }
+  }
+}
+
+void write_searches(VarintWriter& out, const Recording& r) {
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    out.u(r.searches[a].size());
+    int64_t previous_ms = 0;
+    int64_t previous_from = 0;
+    for (const SearchEvent& event : r.searches[a]) {
+      const int64_t ms = quantize(event.time_s, kMilli);
+      const bool has_to = event.to_frame >= 0;
+      out.z(ms - previous_ms);
+      out.u((event.jumped ? 1u : 0u) | (event.forced ? 2u : 0u) | (has_to ? 4u : 0u));
+      out.z(int64_t{event.from_frame} - previous_from);
+      if (has_to) out.z(int64_t{event.to_frame} - event.from_frame);
+      out.z(quantize(std::isfinite(event.cost) ? event.cost : kLimit, kMilli));
+      previous_ms = ms;
+      previous_from = event.from_frame;
+    }
+  }
+}
+
+nlohmann::json bounds_of(const Recording& r) {
+  float min_x = INFINITY, min_z = INFINITY, max_x = -INFINITY, max_z = -INFINITY;
+  auto grow = [&](float x, float z) {
+    min_x = std::min(min_x, x), max_x = std::max(max_x, x);
+    min_z = std::min(min_z, z), max_z = std::max(max_z, z);
+  };
+  for (std::size_t i = 0; i < r.root_x.size(); ++i) grow(r.root_x[i], r.root_z[i]);
+  for (const auto& goals : r.goals) {
+    for (const auto& goal : goals) grow(goal.x, goal.z);
+  }
+  if (min_x > max_x) return {-10.0, -10.0, 10.0, 10.0};
+  return {min_x, min_z, max_x, max_z};
+}
+
+Result<std::vector<uint8_t>> deflate_bytes(const std::vector<uint8_t>& raw) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::vector<uint8_t> out(size);
+  const int rc = compress2(out.data(), &size, raw.data(), static_cast<uLong>(raw.size()), 6);
+  if (rc != Z_OK) return make_error("viewer: deflate of the recording failed (zlib error " + std::to_string(rc) + ")");
+  out.resize(size);
+  return out;
+}
+
+}  // namespace
+
+Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
+  ViewerPayload payload;
+  nlohmann::json sections = nlohmann::json::array();
+  std::vector<uint8_t>& raw = payload.raw;
+  const PoseSlots slots = assign_pose_slots(r);
+  const bool has_matched = !r.matched_x.empty();
+
+  add_section(sections, raw, "roots", [&](VarintWriter& out) {
+    for (std::size_t a = 0; a < r.agent_count; ++a) {
+      int64_t px = 0, pz = 0;
+      for (std::size_t s = 0; s < r.sample_count; ++s) {
+        const int64_t x = quantize(r.root_x[r.sample_index(s, a)], kCm);
+        const int64_t z = quantize(r.root_z[r.sample_index(s, a)], kCm);
+        out.z(x - px);
+        out.z(z - pz);
+        px = x, pz = z;
+      }
+    }
+  });
+  add_section(sections, raw, "facings", [&](VarintWriter& out) {
+    for (std::size_t a = 0; a < r.agent_count; ++a) {
+      int64_t previous = 0;
+      for (std::size_t s = 0; s < r.sample_count; ++s) {
+        const double turns = r.facing[r.sample_index(s, a)] / (2.0 * std::numbers::pi);
+        const int64_t q = ((quantize(turns, kTurn) % kTurn) + kTurn) % kTurn;
+        int64_t delta = q - previous;
+        if (delta >= kTurn / 2) delta -= kTurn;
+        if (delta < -kTurn / 2) delta += kTurn;
+        out.z(delta);
+        previous = q;
+      }
+    }
+  });
+  add_section(sections, raw, "frames", [&](VarintWriter& out) {
+    for (std::size_t a = 0; a < r.agent_count; ++a) {
+      int64_t previous = 0;
+      for (std::size_t s = 0; s < r.sample_count; ++s) {
+        const int64_t value = slots.sample_slot[r.sample_index(s, a)] + 1;
+        out.z(value - previous);
+        previous = value;
+      }
+    }
+  });
+  add_section(sections, raw, "desired",
+              [&](VarintWriter& out) { write_trajectory(out, r, r.desired_x, r.desired_z); });
+  if (has_matched) {
+    add_section(sections, raw, "matched",
+                [&](VarintWriter& out) { write_trajectory(out, r, r.matched_x, r.matched_z); });
+  }
+  add_section(sections, raw, "goals", [&](VarintWriter& out) {
+    for (const auto& goals : r.goals) {
+      out.u(goals.size());
+      int64_t px = 0, pz = 0;
+      for (const auto& goal : goals) {
+        const int64_t x = quantize(goal.x, kCm), z = quantize(goal.z, kCm);
+        out.z(x - px);
+        out.z(z - pz);
+        px = x, pz = z;
+      }
+    }
+  });
+  add_section(sections, raw, "searches", [&](VarintWriter& out) { write_searches(out, r); });
+  add_section(sections, raw, "pose_frames", [&](VarintWriter& out) {
+    int64_t previous = 0;
+    for (std::size_t p : slots.poses) {
+      out.z(int64_t{r.pose_frames[p]} - previous);
+      previous = r.pose_frames[p];
+    }
+  });
+  add_section(sections, raw, "poses", [&](VarintWriter& out) {
+    std::vector<int64_t> previous(r.joint_count() * 3, 0);
+    for (std::size_t p : slots.poses) {
+      for (std::size_t c = 0; c < previous.size(); ++c) {
+        const int64_t mm = quantize(r.pose_positions[r.pose_index(p, 0) + c], kMm);
+        out.z(mm - previous[c]);
+        previous[c] = mm;
+      }
+    }
+  });
+
+  MMVK_ASSIGN_OR_RETURN(payload.compressed, deflate_bytes(raw));
+
+  const nlohmann::json meta = {
+      {"format", 1},
+      {"title", r.title},
+      {"sample_rate_hz", r.sample_rate_hz},
+      {"agent_count", r.agent_count},
+      {"sample_count", r.sample_count},
+      {"trajectory_times_s", r.trajectory_times_s},
+      {"has_matched", has_matched},
+      {"joint_names", r.joint_names},
+      {"joint_parents", r.joint_parents},
+      {"pose_count", slots.poses.size()},
+      {"bounds", bounds_of(r)},
+      {"sections", sections},
+      {"raw_bytes", raw.size()},
+  };
+  // '<' only occurs inside JSON strings, where \u003c means the same; this
+  // keeps a title such as "</script>" from ending the page's script block.
+  std::string json = meta.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string escaped;
+  escaped.reserve(json.size());
+  for (char c : json) {
+    if (c == '<') {
+      escaped += "\\u003c";
+    } else {
+      escaped += c;
+    }
+  }
+  payload.meta_json = std::move(escaped);
+  return payload;
+}
+
+}  // namespace mmvk::crowd

@@ -1,0 +1,199 @@
+// The crowd viewer in a real browser: headless Chromium (Debian's `chromium`)
+// loads a page written by write_viewer_html at the scale (1,000
+// characters x 20 s), the page reports that it initialized without a script
+// error, and a screenshot shows the crowd, the selected skeleton, both
+// trajectories and the jumps on the timeline.
+//
+// Skipped when no chromium is installed, unless MMVK_REQUIRE_VIEWER=1 (CI
+// sets it), which turns a missing browser into a failure.
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "png/png_decode.hpp"
+#include "support/test_data.hpp"
+#include "viewer/synthetic_recording.hpp"
+#include "viewer/viewer_html.hpp"
+
+namespace mmvk::crowd {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::optional<fs::path> find_chromium() {
+  if (const char* path = std::getenv("MMVK_CHROMIUM"); path && *path) return fs::path(path);
+  const char* env_path = std::getenv("PATH");
+  std::stringstream dirs(env_path ? env_path : "");
+  for (std::string dir; std::getline(dirs, dir, ':');) {
+    for (const char* name : {"chromium", "chromium-browser"}) {
+      const fs::path candidate = fs::path(dir) / name;
+      if (!dir.empty() && fs::exists(candidate)) return candidate;
+    }
+  }
+  return std::nullopt;
+}
+
+bool viewer_required() {
+  const char* value = std::getenv("MMVK_REQUIRE_VIEWER");
+  return value && std::string(value) == "1";
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Where the page is opened: paused at 4 s with agent 3 selected, so the
+// screenshot is deterministic.
+constexpr const char* kQuery = "?t=4&agent=3&paused=1";
+
+class ViewerChromium : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("mmvk-viewer-chromium-" + std::to_string(::getpid())));
+    fs::remove_all(*dir_);
+    fs::create_directories(*dir_);
+    SyntheticRecordingParams params;
+    params.agents = kAgents;
+    params.seconds = 20.0f;
+    const auto size = write_viewer_html(*dir_ / "crowd.html", make_synthetic_recording(params));
+    page_error_ = new std::string(size.ok() ? "" : size.message());
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+    delete page_error_;
+  }
+
+  void SetUp() override {
+    ASSERT_TRUE(page_error_->empty()) << *page_error_;
+    chromium_ = find_chromium();
+    if (!chromium_) {
+      if (viewer_required()) FAIL() << "chromium not found on PATH, and MMVK_REQUIRE_VIEWER=1 (apt-get install chromium)";
+      GTEST_SKIP() << "chromium not found (apt-get install chromium, or set MMVK_CHROMIUM)";
+    }
+  }
+
+  // Runs headless Chromium on `page` with one mode flag (--dump-dom or
+  // --screenshot=...); returns its stdout. The virtual time budget lets the
+  // page's asynchronous decoding finish before the DOM or the pixels are
+  // taken.
+  std::string run_chromium(const fs::path& page, const std::string& mode, const std::string& tag) {
+    const fs::path profile = *dir_ / ("profile-" + tag);
+    fs::remove_all(profile);
+    fs::create_directories(profile);
+    const fs::path out = *dir_ / (tag + ".out"), err = *dir_ / (tag + ".err");
+    const std::string command = "timeout 120 '" + chromium_->string() +
+                                "' --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
+                                " --disable-background-networking --disable-component-update --disable-sync"
+                                " --hide-scrollbars --window-size=1280,800 --virtual-time-budget=10000"
+                                " --user-data-dir='" + profile.string() + "' " + mode + " 'file://" +
+                                page.string() + kQuery + "' >'" + out.string() + "' 2>'" + err.string() + "'";
+    const int rc = std::system(command.c_str());
+    EXPECT_EQ(rc, 0) << command << "\nstderr:\n" << read_text(err);
+    return read_text(out);
+  }
+
+  static constexpr std::size_t kAgents = 1000;
+  static fs::path* dir_;
+  static std::string* page_error_;
+  std::optional<fs::path> chromium_;
+};
+
+fs::path* ViewerChromium::dir_ = nullptr;
+std::string* ViewerChromium::page_error_ = nullptr;
+
+// The page sets data-state="ready" on #status after its first full draw, and
+// "error" (with the message) on any uncaught error or rejected promise.
+std::string status_of(const std::string& dom) {
+  std::smatch match;
+  static const std::regex status_div("<div id=\"status\"[^>]*>[^<]*");
+  return std::regex_search(dom, match, status_div) ? match.str() : "(no #status in the DOM)";
+}
+
+TEST_F(ViewerChromium, PageInitializesWithoutScriptError) {
+  const std::string status = status_of(run_chromium(*dir_ / "crowd.html", "--dump-dom", "dom"));
+  EXPECT_NE(status.find("data-state=\"ready\""), std::string::npos) << status;
+  EXPECT_NE(status.find("data-drawn=\"" + std::to_string(kAgents) + "\""), std::string::npos) << status;
+  std::cout << "[ viewer ] " << status << "\n";
+}
+
+// A negative control: the same page with its data corrupted must say so,
+// which shows the ready marker above is not set regardless.
+TEST_F(ViewerChromium, CorruptDataIsReportedAsAnError) {
+  std::string html = read_text(*dir_ / "crowd.html");
+  const std::size_t data = html.find("id=\"mmvk-data\">");
+  ASSERT_NE(data, std::string::npos);
+  html.replace(data + 15, 64, std::string(64, 'A'));
+  const fs::path broken = *dir_ / "broken.html";
+  std::ofstream(broken) << html;
+  const std::string status = status_of(run_chromium(broken, "--dump-dom", "broken"));
+  EXPECT_NE(status.find("data-state=\"error\""), std::string::npos) << status;
+}
+
+struct Rgb {
+  int r, g, b;
+};
+
+// Pixels in [x0, x1) x [y0, y1) that pass `keep`.
+template <class Keep>
+std::size_t count_pixels(const test::RgbImage& image, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1, Keep keep) {
+  std::size_t count = 0;
+  for (uint32_t y = y0; y < std::min(y1, image.height); ++y) {
+    for (uint32_t x = x0; x < std::min(x1, image.width); ++x) {
+      const uint8_t* p = image.pixel(x, y);
+      if (keep(Rgb{p[0], p[1], p[2]})) ++count;
+    }
+  }
+  return count;
+}
+
+bool near(Rgb p, Rgb target) {
+  return std::abs(p.r - target.r) + std::abs(p.g - target.g) + std::abs(p.b - target.b) < 60;
+}
+
+// The regions follow viewer.html's grid at 1280 x 800: the crowd on the left,
+// the skeleton and the trajectory stacked on the right, the timeline below;
+// each region skips its panel's text label.
+TEST_F(ViewerChromium, ScreenshotShowsCrowdSkeletonTrajectoriesAndTimeline) {
+  const fs::path png = *dir_ / "crowd.png";
+  run_chromium(*dir_ / "crowd.html", "--screenshot=" + png.string(), "shot");
+  const auto image = test::read_png(png);
+  ASSERT_TRUE(image.ok()) << image.message();
+  ASSERT_EQ(image->width, 1280u);
+  ASSERT_EQ(image->height, 800u);
+
+  // Characters are discs in saturated hues; the ground, grid and goal paths
+  // are grey.
+  const std::size_t characters = count_pixels(*image, 10, 80, 820, 610, [](Rgb p) {
+    return std::max({p.r, p.g, p.b}) - std::min({p.r, p.g, p.b}) >= 80;
+  });
+  // Bones: left cyan, right pink, centre near white.
+  const std::size_t bones = count_pixels(*image, 840, 80, 1270, 340, [](Rgb p) {
+    return near(p, {0x5e, 0xc8, 0xff}) || near(p, {0xff, 0x8f, 0xb1}) || near(p, {0xe8, 0xec, 0xf2});
+  });
+  const std::size_t desired = count_pixels(*image, 840, 375, 1270, 615, [](Rgb p) { return near(p, {0xff, 0xa2, 0x3a}); });
+  const std::size_t achieved = count_pixels(*image, 840, 375, 1270, 615, [](Rgb p) { return near(p, {0x39, 0xc6, 0xf0}); });
+  const std::size_t jumps = count_pixels(*image, 40, 665, 1270, 780, [](Rgb p) { return near(p, {0xff, 0x6b, 0x5a}); });
+  std::cout << "[ viewer ] screenshot pixels: characters " << characters << ", bones " << bones << ", desired "
+            << desired << ", achieved " << achieved << ", jumps " << jumps << "\n";
+  // Each character covers ~20 pixels at this zoom; a quarter of that for
+  // every character is the floor.
+  EXPECT_GE(characters, kAgents * 5);
+  EXPECT_GE(bones, 300u);
+  EXPECT_GE(desired, 100u);
+  EXPECT_GE(achieved, 100u);
+  EXPECT_GE(jumps, 30u);
+}
+
+}  // namespace
+}  // namespace mmvk::crowd

@@ -38,12 +38,12 @@ void append_pose(Recording& r, const Clip& clip, int32_t frame) {
   auto add = [&](float x, float y, float z) { p.insert(p.end(), {x, y, z}); };
   add(0, hip_y, 0);                                       // Hips
   add(0, hip_y + 0.2f, 0.2f * lean);                      // Spine
-  add(0, hip_y + 0.45f, 0.45f * lean);                    // Chest
+  add(0, hip_y + 0.5f, 0.5f * lean);                      // Chest
   add(0, hip_y + 0.6f, 0.6f * lean);                      // Neck
   add(0, hip_y + 0.75f, 0.75f * lean + 0.03f);            // Head
   for (float side : {1.0f, -1.0f}) {                      // arms swing against the legs
     const float swing = -side * 0.6f * clip.stride * std::sin(phase);
-    const float sx = side * 0.2f, sy = hip_y + 0.55f, sz = 0.55f * lean;
+    const float sx = side * 0.2f, sy = hip_y + 0.5f, sz = 0.5f * lean;
     const float ex = sx + side * 0.03f, ey = sy - 0.28f * std::cos(swing), ez = sz + 0.28f * std::sin(swing);
     const float bend = swing + 0.3f + 0.4f * clip.stride;
     add(sx, sy, sz);

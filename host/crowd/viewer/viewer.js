@@ -238,7 +238,14 @@
 
   function drawCrowd() {
     const { ctx, w, h } = prepare(crowdCanvas);
-    if (!state.view) fitView(w, h);
+    if (!state.view) {
+      fitView(w, h);
+      // ?zoom=PX_PER_METRE starts close to the selected character.
+      if (state.zoom > 0 && state.selected >= 0) {
+        const p = sampleAt(state.selected, state.t);
+        state.view = { cx: p.x, cz: p.z, scale: state.zoom };
+      }
+    }
     const v = state.view;
     // Ground grid: 1 m lines when zoomed in, else 10 m.
     const step = v.scale > 12 ? 1 : 10;
@@ -265,15 +272,36 @@
       const p = sampleAt(a, state.t);
       const [sx, sy] = toScreen(v, w, h, p.x, p.z);
       if (sx < -radius || sy < -radius || sx > w + radius || sy > h + radius) continue;
-      ctx.fillStyle = 'hsl(' + hue(a) + ',75%,58%)';
+      // Zoomed in, the disc fades so the pose drawn over it shows.
+      ctx.fillStyle = 'hsla(' + hue(a) + ',75%,58%,' + (v.scale >= 40 ? 0.45 : 1) + ')';
       ctx.beginPath(); ctx.arc(sx, sy, radius, 0, 2 * Math.PI); ctx.fill();
       ctx.strokeStyle = '#0b0d10'; ctx.lineWidth = Math.max(1, radius * 0.3);
       ctx.beginPath(); ctx.moveTo(sx, sy);
       ctx.lineTo(sx + Math.sin(p.f) * radius * 1.6, sy + Math.cos(p.f) * radius * 1.6); ctx.stroke();
       drawn++;
+      if (v.scale >= 40) drawTopDownPose(ctx, v, w, h, a, p);
     }
     state.drawn = drawn;
     drawSelectionOnCrowd(ctx, v, w, h, radius);
+  }
+
+  // Zoomed in, each character also shows its pose from above.
+  function drawTopDownPose(ctx, v, w, h, a, p) {
+    const now = poseAt(a, state.t);
+    if (!now) return;
+    const q = now.pose, c = Math.cos(p.f), s = Math.sin(p.f), pts = [];
+    for (let j = 0; j < D.J; j++) {
+      const x = q[3 * j], z = q[3 * j + 2];
+      pts.push(toScreen(v, w, h, p.x + c * x + s * z, p.z - s * x + c * z));
+    }
+    ctx.strokeStyle = 'rgba(240,244,250,0.9)'; ctx.lineWidth = Math.max(1, v.scale * 0.025);
+    ctx.beginPath();
+    for (let j = 0; j < D.J; j++) {
+      const parent = D.parents[j];
+      if (parent < 0) continue;
+      ctx.moveTo(pts[parent][0], pts[parent][1]); ctx.lineTo(pts[j][0], pts[j][1]);
+    }
+    ctx.stroke();
   }
 
   function drawSelectionOnCrowd(ctx, v, w, h, radius) {
@@ -560,9 +588,10 @@
   }
 
   // URL options, so a page can be opened (or screenshotted) at a known
-  // state: ?t=SECONDS&agent=INDEX&paused=1
+  // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE
   function applyQuery() {
     const q = new URLSearchParams(window.location.search);
+    if (q.has('zoom')) state.zoom = parseFloat(q.get('zoom')) || 0;
     if (q.has('t')) setTime(parseFloat(q.get('t')) || 0);
     if (q.has('agent')) {
       const a = parseInt(q.get('agent'), 10);

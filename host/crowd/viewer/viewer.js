@@ -166,7 +166,8 @@
 
   // Position of agent a at time t, interpolated between samples.
   function sampleAt(a, t) {
-    const u = Math.min(Math.max(t * D.rate, 0), D.S - 1);
+    let u = Math.min(Math.max(t * D.rate, 0), D.S - 1);
+    if (Math.abs(u - Math.round(u)) < 1e-3) u = Math.round(u);  // on a sample despite float rates
     const s0 = Math.floor(u), s1 = Math.min(s0 + 1, D.S - 1), w = u - s0;
     const i0 = a * D.S + s0, i1 = a * D.S + s1;
     let df = D.facing[i1] - D.facing[i0];
@@ -398,7 +399,7 @@
     // The latest sample at or before t: its desired trajectory is what the
     // controller searched with; the achieved points are where the root really
     // was that much later.
-    const s = Math.min(Math.floor(state.t * D.rate + 1e-6), D.S - 1), i = a * D.S + s;
+    const s = sampleAt(a, state.t).s0, i = a * D.S + s;
     const x0 = D.rootX[i], z0 = D.rootZ[i], f = D.facing[i], c = Math.cos(f), sn = Math.sin(f);
     const local = (x, z) => { const dx = x - x0, dz = z - z0; return [c * dx - sn * dz, sn * dx + c * dz]; };
     const desired = [[0, 0]], matched = [[0, 0]], achieved = [[0, 0]], marks = [], past = [];
@@ -411,13 +412,17 @@
     const horizon = D.times.length ? D.times[D.times.length - 1] : 1;
     for (let u = s + 1; u < D.S && u <= s + Math.ceil(horizon * D.rate); u++) achieved.push(local(D.rootX[a * D.S + u], D.rootZ[a * D.S + u]));
     for (let u = Math.max(0, s - Math.round(D.rate)); u <= s; u++) past.push(local(D.rootX[a * D.S + u], D.rootZ[a * D.S + u]));
-    let extent = 1.5;
+    let extent = 0.6;
     for (const p of desired.concat(matched, achieved, marks)) extent = Math.max(extent, Math.abs(p[0]), Math.abs(p[1]));
     const scale = Math.min(w, h - 40) / 2 / (extent * 1.15), ox = w / 2, oy = 20 + (h - 40) / 2;
     // Forward is up; the character's left (+X) is on the screen's left.
     const screen = (p) => [ox - p[0] * scale, oy - p[1] * scale];
+    // Rings every metre, or every 25 cm around a slow walker.
+    const ring = extent > 2 ? 1 : 0.25;
     ctx.strokeStyle = '#2c323d'; ctx.lineWidth = 1;
-    for (let r = 1; r <= Math.ceil(extent); r++) { ctx.beginPath(); ctx.arc(ox, oy, r * scale, 0, 2 * Math.PI); ctx.stroke(); }
+    for (let r = ring; r <= extent * 1.15; r += ring) { ctx.beginPath(); ctx.arc(ox, oy, r * scale, 0, 2 * Math.PI); ctx.stroke(); }
+    ctx.fillStyle = '#4a5261'; ctx.font = '11px system-ui, sans-serif';
+    ctx.fillText('rings: ' + (ring * 100) + ' cm', w - 90, 16);
     polyline(ctx, past.map(screen), 'rgba(200,200,200,0.45)', 2);
     if (D.matX) polyline(ctx, matched.map(screen), colors.matched, 2, [5, 4]);
     polyline(ctx, achieved.map(screen), colors.achieved, 2.5);
@@ -619,7 +624,7 @@
     statusEl.dataset.agents = String(D.N);
     statusEl.dataset.drawn = String(state.drawn);
     statusEl.dataset.decodeMs = String(ms);
-    statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + D.rate + ' Hz, ' + D.P + ' poses; loaded in ' + ms + ' ms';
+    statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + Number(D.rate.toPrecision(4)) + ' Hz, ' + D.P + ' poses; loaded in ' + ms + ' ms';
     document.title = 'mmvk crowd viewer: ' + (meta.title || 'ready');
     requestAnimationFrame(frame);
   }

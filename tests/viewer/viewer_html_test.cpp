@@ -53,6 +53,10 @@ TEST(ViewerRecording, ErrorsNameTheField) {
   expect_error(r, "sample_rate_hz");
 
   r = small_recording();
+  r.sample_count = 0;
+  expect_error(r, "sample_count");
+
+  r = small_recording();
   r.desired_z.resize(3);
   expect_error(r, "desired_z");
 
@@ -107,6 +111,14 @@ TEST(ViewerPage, IsSelfContained) {
   EXPECT_EQ(html.find("https://"), std::string::npos);
   EXPECT_EQ(html.find("src="), std::string::npos);
   EXPECT_NE(html.find("\"agent_count\":7"), std::string::npos);
+}
+
+TEST(ViewerPage, EmptyCrowdStillMakesAPage) {
+  Recording r;
+  r.title = "nobody";
+  const auto page = render_viewer_html(r);
+  ASSERT_TRUE(page.ok()) << page.message();
+  EXPECT_NE(page->html.find("\"agent_count\":0"), std::string::npos);
 }
 
 TEST(ViewerPage, PosesOnlyForPlayedFrames) {

@@ -101,6 +101,10 @@ Status validate_recording(const Recording& r) {
   if (!std::isfinite(r.sample_rate_hz) || r.sample_rate_hz <= 0.0f) {
     return make_error("recording: sample_rate_hz = " + std::to_string(r.sample_rate_hz) + " must be positive");
   }
+  if (r.agent_count > 0 && r.sample_count == 0) {
+    return make_error("recording: sample_count is 0 for " + std::to_string(r.agent_count) +
+                      " agents (nothing was sampled)");
+  }
   const std::size_t samples = r.agent_count * r.sample_count;
   const std::string shape = "sample_count x agent_count = " + std::to_string(r.sample_count) + " x " +
                             std::to_string(r.agent_count);

@@ -10,7 +10,7 @@ namespace mmvk::crowd {
 
 // Errors name the Recording field and the offending index: sizes that do not
 // match agent_count x sample_count (x trajectory points, x joints x 3), a
-// non-positive sample rate, non-finite coordinates, trajectory times that
+// non-positive sample rate, agents without a sample, non-finite coordinates, trajectory times that
 // are not ascending and positive, a joint parent that is not smaller than
 // its child, pose_frames not ascending and unique, search events out of
 // time order.

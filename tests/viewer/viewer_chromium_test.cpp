@@ -7,12 +7,15 @@
 // Skipped when no chromium is installed, unless MMVK_REQUIRE_VIEWER=1 (CI
 // sets it), which turns a missing browser into a failure.
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <numbers>
 #include <fstream>
 #include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -65,13 +68,15 @@ class ViewerChromium : public ::testing::Test {
     SyntheticRecordingParams params;
     params.agents = kAgents;
     params.seconds = 20.0f;
-    const auto size = write_viewer_html(*dir_ / "crowd.html", make_synthetic_recording(params));
+    recording_ = new Recording(make_synthetic_recording(params));
+    const auto size = write_viewer_html(*dir_ / "crowd.html", *recording_);
     page_error_ = new std::string(size.ok() ? "" : size.message());
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
     delete dir_;
     delete page_error_;
+    delete recording_;
   }
 
   void SetUp() override {
@@ -106,11 +111,13 @@ class ViewerChromium : public ::testing::Test {
   static constexpr std::size_t kAgents = 1000;
   static fs::path* dir_;
   static std::string* page_error_;
+  static Recording* recording_;
   std::optional<fs::path> chromium_;
 };
 
 fs::path* ViewerChromium::dir_ = nullptr;
 std::string* ViewerChromium::page_error_ = nullptr;
+Recording* ViewerChromium::recording_ = nullptr;
 
 // The page sets data-state="ready" on #status after its first full draw, and
 // "error" (with the message) on any uncaught error or rejected promise.
@@ -125,6 +132,43 @@ TEST_F(ViewerChromium, PageInitializesWithoutScriptError) {
   EXPECT_NE(status.find("data-state=\"ready\""), std::string::npos) << status;
   EXPECT_NE(status.find("data-drawn=\"" + std::to_string(kAgents) + "\""), std::string::npos) << status;
   std::cout << "[ viewer ] " << status << "\n";
+}
+
+// The page's decoder against the recording: what the page says it decoded
+// for the selected character (agent 3 at 4 s, sample 40; see probe() in
+// viewer.js) equals the recording within the quantization (1 cm, 1/4096
+// turn, 1 mm, 1/1000 of cost).
+TEST_F(ViewerChromium, PageDecodesWhatWasRecorded) {
+  const std::string status = status_of(run_chromium(*dir_ / "crowd.html", "--dump-dom", "probe"));
+  std::smatch match;
+  static const std::regex probe_attribute("data-probe=\"([^\"]*)\"");
+  ASSERT_TRUE(std::regex_search(status, match, probe_attribute)) << status;
+  std::vector<double> v;
+  std::stringstream fields(match[1].str());
+  for (std::string field; std::getline(fields, field, ',');) v.push_back(std::stod(field));
+  ASSERT_EQ(v.size(), 16u) << match[1].str();
+
+  const Recording& r = *recording_;
+  const std::size_t a = 3, s = 40, i = r.sample_index(s, a), k = r.trajectory_index(s, a, r.trajectory_points() - 1);
+  EXPECT_EQ(v[0], double(a));
+  EXPECT_EQ(v[1], double(s));
+  EXPECT_NEAR(v[2], r.root_x[i], 0.0051);
+  EXPECT_NEAR(v[3], r.root_z[i], 0.0051);
+  const double turn = 2.0 * std::numbers::pi;
+  EXPECT_NEAR(std::remainder(v[4] - r.facing[i], turn), 0.0, turn / 4096.0);
+  EXPECT_EQ(v[5], double(r.frame[i]));
+  EXPECT_NEAR(v[6], r.desired_x[k], 0.0051);
+  EXPECT_NEAR(v[7], r.desired_z[k], 0.0051);
+  EXPECT_NEAR(v[8], r.matched_x[k], 0.0051);
+  EXPECT_NEAR(v[9], r.matched_z[k], 0.0051);
+  const SearchEvent& last = r.searches[a].back();
+  EXPECT_EQ(v[10], double(r.searches[a].size()));
+  EXPECT_EQ(v[11], double(last.from_frame));
+  EXPECT_EQ(v[12], double(last.to_frame));
+  EXPECT_NEAR(v[13], last.cost, 0.00051);
+  EXPECT_EQ(v[14], double(r.goals[a].size()));
+  const auto pose = std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]) - r.pose_frames.begin();
+  EXPECT_NEAR(v[15], r.pose_positions[r.pose_index(std::size_t(pose), r.joint_count() - 1) + 1], 0.00051);
 }
 
 // A negative control: the same page with its data corrupted must say so,

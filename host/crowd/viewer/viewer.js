@@ -605,6 +605,22 @@
     setPlaying(!(q.get('paused') === '1'));
   }
 
+  // What the page decoded for the selected character at the current sample,
+  // as comma-separated numbers, so a test can compare it with the recording:
+  // agent, sample, x, z, facing, frame, last desired x z, last matched x z
+  // (0 0 without), searches, the last search's from, to and cost, goals,
+  // and the last joint's y in the pose played (0 without).
+  function probe() {
+    const a = state.selected;
+    if (a < 0) return '';
+    const s = sampleAt(a, state.t).s0, i = a * D.S + s, k = (i + 1) * D.K - 1, e = D.searches[a];
+    const slot = D.slot[i], last = e.t.length - 1;
+    return [a, s, D.rootX[i], D.rootZ[i], D.facing[i], slot >= 0 ? D.poseFrames[slot] : -1,
+      D.K ? D.desX[k] : 0, D.K ? D.desZ[k] : 0, D.matX && D.K ? D.matX[k] : 0, D.matX && D.K ? D.matZ[k] : 0,
+      e.t.length, last >= 0 ? e.from[last] : 0, last >= 0 ? e.to[last] : 0, last >= 0 ? e.cost[last] : 0,
+      D.goals[a].length / 2, slot >= 0 ? D.poses[(slot + 1) * D.J * 3 - 2] : 0].join(',');
+  }
+
   async function main() {
     const started = performance.now();
     const meta = JSON.parse(document.getElementById('mmvk-meta').textContent);
@@ -624,6 +640,7 @@
     statusEl.dataset.agents = String(D.N);
     statusEl.dataset.drawn = String(state.drawn);
     statusEl.dataset.decodeMs = String(ms);
+    statusEl.dataset.probe = probe();
     statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + Number(D.rate.toPrecision(4)) + ' Hz, ' + D.P + ' poses; loaded in ' + ms + ' ms';
     document.title = 'mmvk crowd viewer: ' + (meta.title || 'ready');
     requestAnimationFrame(frame);

@@ -162,7 +162,8 @@
   // ---- state and sampling ------------------------------------------------
 
   let D = null;  // the decoded recording
-  const state = { t: 0, playing: true, speed: 1, selected: 0, view: null, yaw: -Math.PI / 2 + 0.6, dirty: true };
+  const state = { t: 0, playing: true, speed: 1, selected: 0, view: null, yaw: -Math.PI / 2 + 0.6, dirty: true,
+                  follow: false, hover: -1 };
 
   // Position of agent a at time t, interpolated between samples.
   function sampleAt(a, t) {
@@ -248,6 +249,10 @@
       }
     }
     const v = state.view;
+    if (state.follow && state.selected >= 0) {
+      const p = sampleAt(state.selected, state.t);
+      v.cx = p.x; v.cz = p.z;
+    }
     // Ground grid: 1 m lines when zoomed in, else 10 m.
     const step = v.scale > 12 ? 1 : 10;
     ctx.strokeStyle = '#242a33'; ctx.lineWidth = 1;
@@ -499,13 +504,20 @@
     ctx.fillText('cost', 4, costTop + 10);
     const x = timeToX(state.t, w);
     ctx.strokeStyle = '#fff'; ctx.lineWidth = 1.5; ctx.beginPath(); ctx.moveTo(x, top - 4); ctx.lineTo(x, h - 16); ctx.stroke();
-    // The latest search at or before the cursor, in words.
+    // The search under the pointer, or else the latest one at or before the
+    // cursor, in words.
     let last = -1;
     for (let i = 0; i < e.t.length && e.t[i] <= state.t + 1e-6; i++) last = i;
+    if (state.hover >= 0 && state.hover < e.t.length) {
+      last = state.hover;
+      const hx = timeToX(e.t[last], w);
+      ctx.strokeStyle = 'rgba(255,255,255,0.5)'; ctx.lineWidth = 1; ctx.setLineDash([3, 3]);
+      ctx.beginPath(); ctx.moveTo(hx, top - 4); ctx.lineTo(hx, h - 16); ctx.stroke(); ctx.setLineDash([]);
+    }
     let text = 'agent ' + a + ': ' + e.t.length + ' searches, ' + jumps + ' jumps' + (forced ? ', ' + forced + ' forced' : '') +
       (none ? ', ' + none + ' without candidate' : '') + (D.duration > 0 ? ' (' + (jumps / D.duration).toFixed(2) + ' jumps/s)' : '');
     if (last >= 0) {
-      text += ' \u00b7 last search ' + e.t[last].toFixed(2) + ' s: ' + (e.to[last] < 0 ? 'no candidate' :
+      text += ' \u00b7 ' + (last === state.hover ? 'search at ' : 'last search ') + e.t[last].toFixed(2) + ' s: ' + (e.to[last] < 0 ? 'no candidate' :
         (e.flags[last] & 1 ? 'jump ' + e.from[last] + ' \u2192 ' + e.to[last] : 'stay at ' + e.from[last]) + ', cost ' + e.cost[last].toFixed(3));
     }
     label.textContent = text;
@@ -541,6 +553,8 @@
   function installControls() {
     playButton.onclick = () => setPlaying(!state.playing);
     document.getElementById('speed').onchange = (e) => { state.speed = parseFloat(e.target.value); };
+    const follow = document.getElementById('follow');
+    follow.onchange = () => { state.follow = follow.checked; state.dirty = true; };
     slider.oninput = () => { setPlaying(false); setTime(parseFloat(slider.value) * D.duration); };
     window.addEventListener('keydown', (e) => {
       if (e.target.tagName === 'SELECT') return;
@@ -588,15 +602,31 @@
     let seeking = false;
     const seek = (e) => { setPlaying(false); setTime(xToTime(e.offsetX, timelineCanvas.clientWidth)); };
     timelineCanvas.addEventListener('mousedown', (e) => { seeking = true; seek(e); });
-    timelineCanvas.addEventListener('mousemove', (e) => { if (seeking) seek(e); });
+    timelineCanvas.addEventListener('mousemove', (e) => {
+      if (seeking) { seek(e); return; }
+      // Hovering names the search under the pointer.
+      const a = state.selected, w = timelineCanvas.clientWidth;
+      let best = -1, bestD = 6;
+      if (a >= 0) {
+        const ev = D.searches[a];
+        for (let i = 0; i < ev.t.length; i++) {
+          const d = Math.abs(timeToX(ev.t[i], w) - e.offsetX);
+          if (d < bestD || (d === bestD && ev.flags[i] & 1)) { bestD = d; best = i; }
+        }
+      }
+      if (best !== state.hover) { state.hover = best; state.dirty = true; }
+    });
+    timelineCanvas.addEventListener('mouseleave', () => { state.hover = -1; state.dirty = true; });
     window.addEventListener('mouseup', () => { seeking = false; });
   }
 
   // URL options, so a page can be opened (or screenshotted) at a known
-  // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE
+  // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE&follow=1
   function applyQuery() {
     const q = new URLSearchParams(window.location.search);
     if (q.has('zoom')) state.zoom = parseFloat(q.get('zoom')) || 0;
+    state.follow = q.get('follow') === '1';
+    document.getElementById('follow').checked = state.follow;
     if (q.has('t')) setTime(parseFloat(q.get('t')) || 0);
     if (q.has('agent')) {
       const a = parseInt(q.get('agent'), 10);

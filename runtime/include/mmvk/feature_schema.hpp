@@ -9,20 +9,12 @@
 #include <string_view>
 #include <vector>
 
+#include "mmvk/channel_kinds.hpp"
 #include "mmvk/status.hpp"
 
 namespace mmvk {
 
 inline constexpr std::size_t kMaxChannels = 32;
-
-enum class ChannelKind : std::uint8_t {
-  TrajectoryPosition,   // future root positions (x, z) in character space, metres; 2 dims per offset
-  TrajectoryDirection,  // future facing directions (x, z) in character space; 2 dims per offset
-  BonePosition,         // bone position (x, y, z) in character space, metres; 3 dims
-  BoneVelocity,         // bone velocity (x, y, z) in character space, m/s; 3 dims
-  RootVelocity,         // hip (source bone) velocity (x, y, z) in character space, m/s; 3 dims
-  Custom,               // per-frame values from a sidecar file; `custom_dims` dims
-};
 
 enum class Normalization : std::uint8_t {
   GroupStd,     // z-score; one spread for the channel = mean of its per-dim std
@@ -35,11 +27,13 @@ struct FeatureChannel {
   std::string name;                     // unique within the schema
   ChannelKind kind = ChannelKind::BonePosition;
   std::string bone;                     // Bone*: joint name or role, see find_bone()
+  std::string second_bone;              // kinds spanning two joints (none yet): joint name or role
   std::vector<float> offsets_seconds;   // Trajectory*: future times, seconds, > 0
   std::uint32_t custom_dims = 0;        // Custom: dims per frame
   float weight = 1.0f;                  // > 0; folded into the scale (scale = spread / weight)
   Normalization normalization = Normalization::GroupStd;
 
+  // By the kind's DimsRule (channel_kinds.hpp).
   std::uint32_t dims() const;
 };
 
@@ -66,11 +60,12 @@ std::string_view normalization_name(Normalization mode);
 // and 1.0 s.
 FeatureSchema default_schema();
 
-// JSON form: {"channels": [{"name": ..., "kind": "trajectory_position" |
-// "trajectory_direction" | "bone_position" | "bone_velocity" |
-// "root_velocity" | "custom", "bone": ..., "offsets_seconds": [...],
-// "dims": n, "weight": w, "normalization": "group_std" | "per_dim_std" |
-// "mean_abs_dev" | "min_max"}]}. Errors name the field at fault.
+// JSON form: {"channels": [{"name": ..., "kind": <a name from
+// channel_kinds(): "trajectory_position", "bone_position", "custom", ...>,
+// "bone": ..., "second_bone": ... (kinds that read it), "offsets_seconds":
+// [...], "dims": n, "weight": w, "normalization": "group_std" |
+// "per_dim_std" | "mean_abs_dev" | "min_max"}]}. Errors name the field at
+// fault.
 Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source);
 Result<FeatureSchema> load_schema(const std::filesystem::path& path);
 std::string schema_to_json(const FeatureSchema& schema);

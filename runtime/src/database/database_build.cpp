@@ -137,7 +137,7 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta) {
 
   std::vector<std::vector<float>> custom;
   for (const FeatureChannel& channel : manifest.schema.channels) {
-    if (channel.kind != ChannelKind::Custom) continue;
+    if (!reads_sidecar(channel.kind)) continue;
     Result<std::vector<float>> values = load_custom_sidecar(meta.file, channel, source_frames);
     if (!values.ok()) return fail(values.message());
     custom.push_back(std::move(*values));
@@ -147,7 +147,7 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta) {
     if (!resampled.ok()) return fail(meta.file.string() + ": " + resampled.message());
     for (std::size_t i = 0, c = 0; c < manifest.schema.channels.size(); ++c) {
       const FeatureChannel& channel = manifest.schema.channels[c];
-      if (channel.kind != ChannelKind::Custom) continue;
+      if (!reads_sidecar(channel.kind)) continue;
       custom[i] = resample_values(custom[i], channel.custom_dims, source_frames, motion->fps,
                                   resampled->frame_count, resampled->fps);
       ++i;

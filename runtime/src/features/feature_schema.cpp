@@ -6,15 +6,14 @@
 namespace mmvk {
 
 std::uint32_t FeatureChannel::dims() const {
-  switch (kind) {
-    case ChannelKind::TrajectoryPosition:
-    case ChannelKind::TrajectoryDirection:
-      return 2 * static_cast<std::uint32_t>(offsets_seconds.size());
-    case ChannelKind::BonePosition:
-    case ChannelKind::BoneVelocity:
-    case ChannelKind::RootVelocity:
-      return 3;
-    case ChannelKind::Custom:
+  const ChannelKindInfo& info = channel_kind_info(kind);
+  const auto labels = static_cast<std::uint32_t>(info.labels.size());
+  switch (info.dims_rule) {
+    case DimsRule::Labels:
+      return labels;
+    case DimsRule::LabelsPerOffset:
+      return labels * static_cast<std::uint32_t>(offsets_seconds.size());
+    case DimsRule::Declared:
       return custom_dims;
   }
   return 0;
@@ -40,20 +39,17 @@ int FeatureSchema::find(std::string_view name) const {
 }
 
 std::string FeatureSchema::dim_name(std::uint32_t d) const {
-  static constexpr const char* kXyz[] = {"x", "y", "z"};
-  static constexpr const char* kXz[] = {"x", "z"};
   for (const FeatureChannel& channel : channels) {
     const std::uint32_t n = channel.dims();
     if (d < n) {
-      switch (channel.kind) {
-        case ChannelKind::TrajectoryPosition:
-        case ChannelKind::TrajectoryDirection:
-          return channel.name + "[" + std::to_string(d / 2) + "]." + kXz[d % 2];
-        case ChannelKind::BonePosition:
-        case ChannelKind::BoneVelocity:
-        case ChannelKind::RootVelocity:
-          return channel.name + "." + kXyz[d];
-        case ChannelKind::Custom:
+      const ChannelKindInfo& info = channel_kind_info(channel.kind);
+      const std::size_t labels = info.labels.size();
+      switch (info.dims_rule) {
+        case DimsRule::Labels:
+          return channel.name + "." + std::string(info.labels[d]);
+        case DimsRule::LabelsPerOffset:
+          return channel.name + "[" + std::to_string(d / labels) + "]." + std::string(info.labels[d % labels]);
+        case DimsRule::Declared:
           return channel.name + "[" + std::to_string(d) + "]";
       }
     }
@@ -77,23 +73,21 @@ Status FeatureSchema::validate() const {
     if (!(channel.weight > 0.0f) || !std::isfinite(channel.weight)) {
       return make_error(where + ": weight must be finite and > 0");
     }
-    switch (channel.kind) {
-      case ChannelKind::TrajectoryPosition:
-      case ChannelKind::TrajectoryDirection:
-        if (channel.offsets_seconds.empty()) return make_error(where + ": offsets_seconds is empty");
-        for (float t : channel.offsets_seconds) {
-          if (!(t > 0.0f) || !std::isfinite(t)) return make_error(where + ": offsets_seconds must be finite and > 0");
-        }
-        break;
-      case ChannelKind::BonePosition:
-      case ChannelKind::BoneVelocity:
-        if (channel.bone.empty()) return make_error(where + ": bone is missing");
-        break;
-      case ChannelKind::RootVelocity:
-        break;
-      case ChannelKind::Custom:
-        if (channel.custom_dims == 0) return make_error(where + ": dims must be > 0");
-        break;
+    const ChannelKindInfo& info = channel_kind_info(channel.kind);
+    if (has_field(info.fields, ChannelField::Offsets)) {
+      if (channel.offsets_seconds.empty()) return make_error(where + ": offsets_seconds is empty");
+      for (float t : channel.offsets_seconds) {
+        if (!(t > 0.0f) || !std::isfinite(t)) return make_error(where + ": offsets_seconds must be finite and > 0");
+      }
+    }
+    if (has_field(info.fields, ChannelField::Bone) && info.default_bone.empty() && channel.bone.empty()) {
+      return make_error(where + ": bone is missing");
+    }
+    if (has_field(info.fields, ChannelField::SecondBone) && channel.second_bone.empty()) {
+      return make_error(where + ": second_bone is missing");
+    }
+    if (has_field(info.fields, ChannelField::Dims) && channel.custom_dims == 0) {
+      return make_error(where + ": dims must be > 0");
     }
   }
   return {};

@@ -5,68 +5,11 @@
 #include <cstring>
 
 #include "common/file_io.hpp"
+#include "features/channel_extraction.hpp"
 
 namespace mmvk {
 
 namespace {
-
-// A character root on the ground: position (y = 0) and unit facing in XZ.
-struct GroundPose {
-  glm::vec3 position{0.0f};
-  glm::vec3 facing{0.0f, 0.0f, 1.0f};
-};
-
-// World vector -> character space of a root facing `facing` (+Z forward, +X left).
-glm::vec3 to_local(const glm::vec3& v, const glm::vec3& facing) {
-  return {v.x * facing.z - v.z * facing.x, v.y, v.x * facing.x + v.z * facing.z};
-}
-
-// Character space vector -> world (inverse of to_local).
-glm::vec3 to_world(const glm::vec3& v, const glm::vec3& facing) {
-  return {v.x * facing.z + v.z * facing.x, v.y, -v.x * facing.x + v.z * facing.z};
-}
-
-// `pose` expressed in the frame of `base`.
-GroundPose relative(const GroundPose& base, const GroundPose& pose) {
-  return {to_local(pose.position - base.position, base.facing), to_local(pose.facing, base.facing)};
-}
-
-// A pose given relative to `base`, back in world space.
-GroundPose compose(const GroundPose& base, const GroundPose& rel) {
-  return {base.position + to_world(rel.position, base.facing), to_world(rel.facing, base.facing)};
-}
-
-// Future root poses, looping or clamped. For a looping clip the frame after
-// the last is the last advanced by the clip's final step; every further cycle
-// repeats the rigid motion from frame 0 to that frame.
-class Trajectory {
- public:
-  Trajectory(const CharacterRoot& root, std::uint32_t frames, bool loop) : root_(root), frames_(frames), loop_(loop) {
-    if (loop_ && frames_ > 0) {
-      const GroundPose last = pose(frames_ - 1);
-      const GroundPose step = frames_ >= 2 ? relative(pose(frames_ - 2), last) : GroundPose{};
-      after_last_ = compose(last, step);
-    }
-  }
-
-  // Root pose `j` frames from the start (j may run past the end).
-  GroundPose at(std::uint64_t j) const {
-    if (j < frames_) return pose(static_cast<std::uint32_t>(j));
-    if (!loop_) return pose(frames_ - 1);
-    GroundPose result = pose(static_cast<std::uint32_t>(j % frames_));
-    const GroundPose first = pose(0);
-    for (std::uint64_t cycle = j / frames_; cycle > 0; --cycle) result = compose(after_last_, relative(first, result));
-    return result;
-  }
-
- private:
-  GroundPose pose(std::uint32_t f) const { return {root_.positions[f], root_.facings[f]}; }
-
-  const CharacterRoot& root_;
-  std::uint32_t frames_;
-  bool loop_;
-  GroundPose after_last_;
-};
 
 std::string where(const FeatureExtractionOptions& options, const FeatureChannel& channel) {
   return (options.source.empty() ? std::string("clip") : options.source) + ": channel '" + channel.name + "'";
@@ -84,7 +27,7 @@ std::uint32_t offset_frames(float offset_seconds, float fps) {
 std::uint32_t max_offset_frames(const FeatureSchema& schema, float fps) {
   std::uint32_t result = 0;
   for (const FeatureChannel& channel : schema.channels) {
-    if (channel.kind != ChannelKind::TrajectoryPosition && channel.kind != ChannelKind::TrajectoryDirection) continue;
+    if (!uses_trajectory_offsets(channel.kind)) continue;
     for (float t : channel.offsets_seconds) result = std::max(result, offset_frames(t, fps));
   }
   return result;
@@ -104,31 +47,39 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
                       " frames, the motion has " + std::to_string(frames));
   }
 
-  // Resolve bones once per clip (skeletons may differ between clips).
-  const std::size_t joints = motion.joint_count();
-  std::vector<int> channel_bone(schema.channels.size(), -1);
-  std::vector<std::size_t> channel_custom(schema.channels.size(), 0);
-  std::vector<bool> joint_used(joints, false);
+  // Resolve each channel's inputs once per clip (skeletons may differ between clips).
+  struct Inputs {
+    int bone = -1;
+    int second_bone = -1;
+    std::span<const float> custom;
+  };
+  std::vector<Inputs> inputs(schema.channels.size());
   std::size_t custom_count = 0;
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
-    if (channel.kind == ChannelKind::BonePosition || channel.kind == ChannelKind::BoneVelocity ||
-        channel.kind == ChannelKind::RootVelocity) {
-      const std::string bone = channel.bone.empty() ? std::string("@hips") : channel.bone;
+    const ChannelKindInfo& info = channel_kind_info(channel.kind);
+    if (has_field(info.fields, ChannelField::Bone)) {
+      const std::string bone = channel.bone.empty() ? std::string(info.default_bone) : channel.bone;
       Result<int> index = find_bone(motion.skeleton, bone);
       if (!index.ok()) return make_error(where(options, channel) + ": " + index.message());
-      channel_bone[c] = *index;
-      joint_used[static_cast<std::size_t>(*index)] = true;
-    } else if (channel.kind == ChannelKind::Custom) {
-      channel_custom[c] = custom_count++;
-      if (custom_count <= options.custom.size()) {
-        const std::vector<float>& values = options.custom[custom_count - 1];
+      inputs[c].bone = *index;
+    }
+    if (has_field(info.fields, ChannelField::SecondBone)) {
+      Result<int> index = find_bone(motion.skeleton, channel.second_bone);
+      if (!index.ok()) return make_error(where(options, channel) + ": second_bone: " + index.message());
+      inputs[c].second_bone = *index;
+    }
+    if (has_field(info.fields, ChannelField::Dims)) {
+      if (custom_count < options.custom.size()) {
+        const std::vector<float>& values = options.custom[custom_count];
         if (values.size() != std::size_t{frames} * channel.custom_dims) {
           return make_error(where(options, channel) + ": custom values hold " + std::to_string(values.size()) +
                             " floats, expected " + std::to_string(frames) + " frames x " +
                             std::to_string(channel.custom_dims) + " dims");
         }
+        inputs[c].custom = values;
       }
+      ++custom_count;
     }
   }
   if (custom_count != options.custom.size()) {
@@ -136,74 +87,38 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
                       std::to_string(options.custom.size()) + " custom arrays were given");
   }
 
-  // Global positions of the bones the schema reads, [frames x joints].
-  std::vector<glm::vec3> global(std::size_t{frames} * joints);
+  // Global positions of every joint, [frames x joints], shared by the channels.
+  const std::size_t joints = motion.joint_count();
+  detail::ClipSamples clip{motion, root, detail::Trajectory(root, frames, options.loop),
+                           std::vector<glm::vec3>(std::size_t{frames} * joints)};
   {
     std::vector<glm::vec3> positions(joints);
     std::vector<glm::quat> rotations(joints);
     for (std::uint32_t f = 0; f < frames; ++f) {
       forward_kinematics(motion, f, positions, rotations);
-      std::copy(positions.begin(), positions.end(), global.begin() + static_cast<std::ptrdiff_t>(std::size_t{f} * joints));
+      std::copy(positions.begin(), positions.end(),
+                clip.global.begin() + static_cast<std::ptrdiff_t>(std::size_t{f} * joints));
     }
   }
-  auto bone_position = [&](std::uint32_t f, int joint) { return global[std::size_t{f} * joints + static_cast<std::size_t>(joint)]; };
-  auto bone_velocity = [&](std::uint32_t f, int joint) -> glm::vec3 {
-    if (frames < 2) return glm::vec3(0.0f);
-    if (f == 0) return (bone_position(1, joint) - bone_position(0, joint)) * motion.fps;
-    if (f == frames - 1) return (bone_position(f, joint) - bone_position(f - 1, joint)) * motion.fps;
-    return (bone_position(f + 1, joint) - bone_position(f - 1, joint)) * (0.5f * motion.fps);
-  };
 
   RawFeatures out;
   out.frame_count = frames;
   out.dims = dims;
   out.values.assign(std::size_t{frames} * dims, 0.0f);
   out.past_end.assign(frames, 0);
-  const Trajectory trajectory(root, frames, options.loop);
   const std::uint32_t furthest = max_offset_frames(schema, motion.fps);
-
   for (std::uint32_t f = 0; f < frames; ++f) {
-    const glm::vec3 origin = root.positions[f];
-    const glm::vec3 facing = root.facings[f];
-    float* row = out.values.data() + std::size_t{f} * dims;
     if (!options.loop && furthest > 0 && std::uint64_t{f} + furthest > std::uint64_t{frames} - 1) out.past_end[f] = 1;
-    for (std::size_t c = 0; c < schema.channels.size(); ++c) {
-      const FeatureChannel& channel = schema.channels[c];
-      switch (channel.kind) {
-        case ChannelKind::TrajectoryPosition:
-        case ChannelKind::TrajectoryDirection:
-          for (float t : channel.offsets_seconds) {
-            const GroundPose future = trajectory.at(std::uint64_t{f} + offset_frames(t, motion.fps));
-            const glm::vec3 local = channel.kind == ChannelKind::TrajectoryPosition
-                                        ? to_local(future.position - origin, facing)
-                                        : to_local(future.facing, facing);
-            *row++ = local.x;
-            *row++ = local.z;
-          }
-          break;
-        case ChannelKind::BonePosition: {
-          const glm::vec3 local = to_local(bone_position(f, channel_bone[c]) - origin, facing);
-          *row++ = local.x;
-          *row++ = local.y;
-          *row++ = local.z;
-          break;
-        }
-        case ChannelKind::BoneVelocity:
-        case ChannelKind::RootVelocity: {
-          const glm::vec3 local = to_local(bone_velocity(f, channel_bone[c]), facing);
-          *row++ = local.x;
-          *row++ = local.y;
-          *row++ = local.z;
-          break;
-        }
-        case ChannelKind::Custom: {
-          const std::vector<float>& values = options.custom[channel_custom[c]];
-          const float* src = values.data() + std::size_t{f} * channel.custom_dims;
-          row = std::copy(src, src + channel.custom_dims, row);
-          break;
-        }
-      }
-    }
+  }
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const detail::ChannelExtraction job{.clip = clip,
+                                        .channel = schema.channels[c],
+                                        .bone = inputs[c].bone,
+                                        .second_bone = inputs[c].second_bone,
+                                        .custom = inputs[c].custom,
+                                        .out = out.values.data() + schema.offset(c),
+                                        .stride = dims};
+    channel_kind_info(schema.channels[c].kind).extract(job);
   }
   for (std::size_t i = 0; i < out.values.size(); ++i) {
     if (!std::isfinite(out.values[i])) {

@@ -14,19 +14,6 @@ namespace {
 
 using Json = nlohmann::json;
 
-struct KindName {
-  ChannelKind kind;
-  const char* name;
-};
-constexpr KindName kKinds[] = {
-    {ChannelKind::TrajectoryPosition, "trajectory_position"},
-    {ChannelKind::TrajectoryDirection, "trajectory_direction"},
-    {ChannelKind::BonePosition, "bone_position"},
-    {ChannelKind::BoneVelocity, "bone_velocity"},
-    {ChannelKind::RootVelocity, "root_velocity"},
-    {ChannelKind::Custom, "custom"},
-};
-
 struct NormalizationName {
   Normalization mode;
   const char* name;
@@ -37,12 +24,6 @@ constexpr NormalizationName kModes[] = {
     {Normalization::MeanAbsDev, "mean_abs_dev"},
     {Normalization::MinMax, "min_max"},
 };
-
-std::string kind_list() {
-  std::string list;
-  for (const KindName& k : kKinds) list += std::string(list.empty() ? "" : ", ") + '"' + k.name + '"';
-  return list;
-}
 
 std::string mode_list() {
   std::string list;
@@ -59,7 +40,8 @@ Result<float> finite_number(const Json& value, const std::string& where) {
 
 Result<FeatureChannel> parse_channel(const Json& object, const std::string& where) {
   if (!object.is_object()) return make_error(where + ": expected an object");
-  static const std::set<std::string> kKnown = {"name", "kind", "bone", "offsets_seconds", "dims", "weight", "normalization"};
+  static const std::set<std::string> kKnown = {"name",           "kind", "bone",   "second_bone",
+                                               "offsets_seconds", "dims", "weight", "normalization"};
   for (const auto& item : object.items()) {
     if (!kKnown.count(item.key())) return make_error(where + "." + item.key() + ": unknown field");
   }
@@ -67,20 +49,24 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
   if (!object.contains("name") || !object["name"].is_string()) return make_error(where + ".name: expected a string");
   channel.name = object["name"].get<std::string>();
   if (!object.contains("kind") || !object["kind"].is_string()) {
-    return make_error(where + ".kind: expected one of " + kind_list());
+    return make_error(where + ".kind: expected one of " + channel_kind_list());
   }
   const std::string kind = object["kind"].get<std::string>();
-  bool found = false;
-  for (const KindName& k : kKinds) {
-    if (kind == k.name) {
-      channel.kind = k.kind;
-      found = true;
-    }
+  const ChannelKindInfo* info = find_channel_kind(kind);
+  if (info == nullptr) {
+    return make_error(where + ".kind: unknown kind \"" + kind + "\", expected one of " + channel_kind_list());
   }
-  if (!found) return make_error(where + ".kind: unknown kind \"" + kind + "\", expected one of " + kind_list());
+  channel.kind = info->kind;
   if (object.contains("bone")) {
     if (!object["bone"].is_string()) return make_error(where + ".bone: expected a string");
     channel.bone = object["bone"].get<std::string>();
+  }
+  if (object.contains("second_bone")) {
+    if (!has_field(info->fields, ChannelField::SecondBone)) {
+      return make_error(where + ".second_bone: a " + kind + " channel reads no second bone");
+    }
+    if (!object["second_bone"].is_string()) return make_error(where + ".second_bone: expected a string");
+    channel.second_bone = object["second_bone"].get<std::string>();
   }
   if (object.contains("offsets_seconds")) {
     const Json& offsets = object["offsets_seconds"];
@@ -96,16 +82,15 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     if (!dims.is_number_integer() || dims.get<std::int64_t>() <= 0 || dims.get<std::int64_t>() > 4096) {
       return make_error(where + ".dims: expected an integer in [1, 4096]");
     }
-    if (kind != "custom") {
-      const std::int64_t expected = FeatureChannel{.name = {}, .kind = channel.kind, .bone = {},
-                                                   .offsets_seconds = channel.offsets_seconds}
-                                        .dims();
+    if (has_field(info->fields, ChannelField::Dims)) {
+      channel.custom_dims = static_cast<std::uint32_t>(dims.get<std::int64_t>());
+    } else {
+      // Every field the width depends on (offsets) is read above.
+      const std::int64_t expected = channel.dims();
       if (dims.get<std::int64_t>() != expected) {
         return make_error(where + ".dims: a " + kind + " channel has " + std::to_string(expected) + " dims, not " +
                           std::to_string(dims.get<std::int64_t>()));
       }
-    } else {
-      channel.custom_dims = static_cast<std::uint32_t>(dims.get<std::int64_t>());
     }
   }
   if (object.contains("weight")) {
@@ -130,13 +115,6 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
 }
 
 }  // namespace
-
-std::string_view channel_kind_name(ChannelKind kind) {
-  for (const KindName& k : kKinds) {
-    if (k.kind == kind) return k.name;
-  }
-  return "?";
-}
 
 std::string_view normalization_name(Normalization mode) {
   for (const NormalizationName& m : kModes) {
@@ -179,14 +157,12 @@ std::string schema_to_json(const FeatureSchema& schema) {
   for (const FeatureChannel& channel : schema.channels) {
     Json object;
     object["name"] = channel.name;
-    for (const KindName& k : kKinds) {
-      if (k.kind == channel.kind) object["kind"] = k.name;
-    }
+    const ChannelKindInfo& info = channel_kind_info(channel.kind);
+    object["kind"] = info.name;
     if (!channel.bone.empty()) object["bone"] = channel.bone;
-    if (channel.kind == ChannelKind::TrajectoryPosition || channel.kind == ChannelKind::TrajectoryDirection) {
-      object["offsets_seconds"] = channel.offsets_seconds;
-    }
-    if (channel.kind == ChannelKind::Custom) object["dims"] = channel.custom_dims;
+    if (!channel.second_bone.empty()) object["second_bone"] = channel.second_bone;
+    if (has_field(info.fields, ChannelField::Offsets)) object["offsets_seconds"] = channel.offsets_seconds;
+    if (has_field(info.fields, ChannelField::Dims)) object["dims"] = channel.custom_dims;
     object["weight"] = channel.weight;
     for (const NormalizationName& m : kModes) {
       if (m.mode == channel.normalization) object["normalization"] = m.name;

@@ -1,0 +1,92 @@
+// The table of channel kinds: each kind of feature channel is one entry,
+// holding everything the schema, its JSON form, feature extraction, the CLI
+// and the benchmarks need to know about it. Nothing else switches over
+// ChannelKind, so adding a kind is one enum value, one entry in
+// runtime/src/features/channel_kinds.cpp and one extractor function (see
+// runtime/README.md, "Adding a channel kind").
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace mmvk {
+
+enum class ChannelKind : std::uint8_t {
+  TrajectoryPosition,   // future root positions (x, z) in character space, metres; 2 dims per offset
+  TrajectoryDirection,  // future facing directions (x, z) in character space; 2 dims per offset
+  BonePosition,         // bone position (x, y, z) in character space, metres; 3 dims
+  BoneVelocity,         // bone velocity (x, y, z) in character space, m/s; 3 dims
+  RootVelocity,         // hip (source bone) velocity (x, y, z) in character space, m/s; 3 dims
+  Custom,               // per-frame values from a sidecar file; `custom_dims` dims
+};
+
+// The FeatureChannel fields a kind reads (a bit set). A field a kind reads is
+// required, except `bone` when the kind names a default bone.
+enum class ChannelField : std::uint8_t {
+  None = 0,
+  Bone = 1,        // FeatureChannel::bone, a joint name or role
+  SecondBone = 2,  // FeatureChannel::second_bone (for kinds spanning two joints)
+  Offsets = 4,     // FeatureChannel::offsets_seconds: the kind samples the root trajectory at these times
+  Dims = 8,        // FeatureChannel::custom_dims: the values come from a sidecar, this many per frame
+};
+constexpr ChannelField operator|(ChannelField a, ChannelField b) {
+  return static_cast<ChannelField>(static_cast<std::uint8_t>(a) | static_cast<std::uint8_t>(b));
+}
+constexpr bool has_field(ChannelField set, ChannelField field) {
+  return (static_cast<std::uint8_t>(set) & static_cast<std::uint8_t>(field)) != 0;
+}
+
+// How a channel's dims follow from its fields.
+enum class DimsRule : std::uint8_t {
+  Labels,           // one dim per label: "name.x"
+  LabelsPerOffset,  // the labels once per trajectory offset: "name[i].x"
+  Declared,         // `custom_dims` dims, named by index: "name[i]"
+};
+
+// What a mirrored clip (manifest "mirror") does to the kind's values.
+enum class MirrorRule : std::uint8_t {
+  Remeasured,  // extracted again from the mirrored motion (roles then name the mirrored joints)
+  Unchanged,   // copied unchanged from the source clip (sidecar values)
+};
+
+namespace detail {
+struct ChannelExtraction;  // runtime/src/features/channel_extraction.hpp
+}  // namespace detail
+
+// Fills one channel's dims for every frame of a clip.
+using ChannelExtractor = void (*)(const detail::ChannelExtraction& job);
+
+struct ChannelKindInfo {
+  ChannelKind kind;
+  std::string_view name;          // the JSON name, e.g. "trajectory_position"
+  std::string_view summary;       // one line: what the values are, in which units
+  DimsRule dims_rule;
+  std::span<const std::string_view> labels;  // dimension labels (empty for DimsRule::Declared)
+  ChannelField fields;            // the FeatureChannel fields the kind reads
+  std::string_view default_bone;  // used when `bone` is empty; empty = `bone` is required
+  MirrorRule mirror;
+  ChannelExtractor extract;       // library-internal
+};
+
+// Every kind, in ChannelKind order.
+std::span<const ChannelKindInfo> channel_kinds();
+const ChannelKindInfo& channel_kind_info(ChannelKind kind);
+// The kind with JSON name `name`, or nullptr.
+const ChannelKindInfo* find_channel_kind(std::string_view name);
+// The JSON names, quoted and comma-separated, for error messages.
+std::string channel_kind_list();
+
+// The kind samples the root trajectory at its offsets_seconds: its frames
+// near a clip's end fall under the edge rule, and a query's "trajectory"
+// part (as opposed to its pose) is made of such channels.
+inline bool uses_trajectory_offsets(ChannelKind kind) {
+  return has_field(channel_kind_info(kind).fields, ChannelField::Offsets);
+}
+
+// The kind's values come from the caller (a sidecar file beside each clip,
+// see features.hpp), custom_dims per frame.
+inline bool reads_sidecar(ChannelKind kind) { return has_field(channel_kind_info(kind).fields, ChannelField::Dims); }
+
+}  // namespace mmvk

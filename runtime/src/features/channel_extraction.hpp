@@ -1,0 +1,85 @@
+// What a channel kind's extractor reads and writes (see mmvk/channel_kinds.hpp):
+// the clip's motion measured once (global joint positions, the root and its
+// future poses) and one channel's place in the output matrix. Extractors are
+// pure functions of this; extract_features() in features.cpp builds it.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mmvk/channel_kinds.hpp"
+#include "mmvk/character.hpp"
+#include "mmvk/feature_schema.hpp"
+#include "mmvk/motion.hpp"
+
+namespace mmvk::detail {
+
+// A character root on the ground: position (y = 0) and unit facing in XZ.
+struct GroundPose {
+  glm::vec3 position{0.0f};
+  glm::vec3 facing{0.0f, 0.0f, 1.0f};
+};
+
+// World vector -> character space of a root facing `facing` (+Z forward, +X left).
+inline glm::vec3 to_local(const glm::vec3& v, const glm::vec3& facing) {
+  return {v.x * facing.z - v.z * facing.x, v.y, v.x * facing.x + v.z * facing.z};
+}
+
+// Future root poses, looping or clamped. For a looping clip the frame after
+// the last is the last advanced by the clip's final step; every further cycle
+// repeats the rigid motion from frame 0 to that frame.
+class Trajectory {
+ public:
+  Trajectory(const CharacterRoot& root, std::uint32_t frames, bool loop);
+
+  // Root pose `j` frames from the start (j may run past the end).
+  GroundPose at(std::uint64_t j) const;
+
+ private:
+  GroundPose pose(std::uint32_t f) const { return {root_.positions[f], root_.facings[f]}; }
+
+  const CharacterRoot& root_;
+  std::uint32_t frames_;
+  bool loop_;
+  GroundPose after_last_;
+};
+
+// One clip, measured once for all of its channels.
+struct ClipSamples {
+  const Motion& motion;
+  const CharacterRoot& root;
+  Trajectory trajectory;
+  std::vector<glm::vec3> global;  // [frames x joints] global joint positions
+
+  std::uint32_t frames() const { return motion.frame_count; }
+
+  glm::vec3 bone_position(std::uint32_t f, int joint) const {
+    return global[std::size_t{f} * motion.joint_count() + static_cast<std::size_t>(joint)];
+  }
+
+  // Finite differences of global positions: central inside the clip,
+  // one-sided on its first and last frame, 0 for a one-frame clip.
+  glm::vec3 bone_velocity(std::uint32_t f, int joint) const {
+    const std::uint32_t n = frames();
+    if (n < 2) return glm::vec3(0.0f);
+    if (f == 0) return (bone_position(1, joint) - bone_position(0, joint)) * motion.fps;
+    if (f == n - 1) return (bone_position(f, joint) - bone_position(f - 1, joint)) * motion.fps;
+    return (bone_position(f + 1, joint) - bone_position(f - 1, joint)) * (0.5f * motion.fps);
+  }
+};
+
+// One channel of one clip: its resolved inputs and where its values go.
+struct ChannelExtraction {
+  const ClipSamples& clip;
+  const FeatureChannel& channel;
+  int bone = -1;                  // joint index, when the kind reads Bone
+  int second_bone = -1;           // joint index, when the kind reads SecondBone
+  std::span<const float> custom;  // [frames x custom_dims] sidecar values, when the kind reads Dims
+  float* out = nullptr;           // dim i of frame f goes to out[f * stride + i]
+  std::uint32_t stride = 0;       // the schema's dims
+
+  float* row(std::uint32_t f) const { return out + std::size_t{f} * stride; }
+};
+
+}  // namespace mmvk::detail

@@ -28,10 +28,6 @@ class Random {
   std::uint64_t state_;
 };
 
-bool is_trajectory(ChannelKind kind) {
-  return kind == ChannelKind::TrajectoryPosition || kind == ChannelKind::TrajectoryDirection;
-}
-
 }  // namespace
 
 std::string_view query_stream_name(QueryStream stream) {
@@ -61,7 +57,7 @@ std::vector<float> make_queries(const Database& database, QueryStream stream, st
   for (std::size_t c = 0; c < database.schema().channels.size(); ++c) {
     const FeatureChannel& channel = database.schema().channels[c];
     const std::uint32_t offset = database.schema().offset(c);
-    for (std::uint32_t d = 0; d < channel.dims(); ++d) trajectory_dim[offset + d] = is_trajectory(channel.kind);
+    for (std::uint32_t d = 0; d < channel.dims(); ++d) trajectory_dim[offset + d] = uses_trajectory_offsets(channel.kind);
   }
   for (std::size_t q = 0; q < count; ++q) {
     float* out = &queries[q * dims];

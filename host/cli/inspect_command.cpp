@@ -143,7 +143,7 @@ int run_inspect(Args args) {
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
     std::string detail = channel.bone;
-    if (channel.kind == ChannelKind::TrajectoryPosition || channel.kind == ChannelKind::TrajectoryDirection) {
+    if (uses_trajectory_offsets(channel.kind)) {
       detail = "offsets (s):";
       for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);
     }

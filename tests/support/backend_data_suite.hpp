@@ -55,8 +55,7 @@ inline std::vector<float> real_queries(const Database& db, std::size_t count, st
   std::uniform_int_distribution<std::uint32_t> frame(0, db.frame_count() - 1);
   std::vector<bool> trajectory(db.dims(), false);
   for (std::size_t c = 0; c < db.schema().channels.size(); ++c) {
-    const ChannelKind kind = db.schema().channels[c].kind;
-    if (kind == ChannelKind::TrajectoryPosition || kind == ChannelKind::TrajectoryDirection) {
+    if (uses_trajectory_offsets(db.schema().channels[c].kind)) {
       const std::uint32_t offset = db.schema().offset(c);
       for (std::uint32_t d = 0; d < db.schema().channels[c].dims(); ++d) trajectory[offset + d] = true;
     }

@@ -116,5 +116,27 @@ TEST(Normalization, RejectsAMatrixOfTheWrongShape) {
   EXPECT_FALSE(compute_normalization(schema, {}).ok());
 }
 
+// The table of modes: every entry is found by its name, in enum order, and
+// survives the schema's JSON form.
+TEST(Normalization, EveryModeInTheTableRoundTripsThroughJson) {
+  ASSERT_FALSE(normalization_modes().empty());
+  for (std::size_t i = 0; i < normalization_modes().size(); ++i) {
+    const NormalizationInfo& info = normalization_modes()[i];
+    SCOPED_TRACE(info.name);
+    EXPECT_EQ(static_cast<std::size_t>(info.mode), i);
+    EXPECT_EQ(&normalization_info(info.mode), &info);
+    EXPECT_EQ(find_normalization(info.name), &info);
+    EXPECT_EQ(normalization_name(info.mode), info.name);
+    EXPECT_FALSE(info.spread_name.empty());
+    EXPECT_NE(normalization_list().find('"' + std::string(info.name) + '"'), std::string::npos);
+    FeatureSchema schema;
+    schema.channels = {channel("c", info.mode, 1.0f)};
+    Result<FeatureSchema> parsed = parse_schema_json(schema_to_json(schema), "modes.json");
+    ASSERT_TRUE(parsed.ok()) << parsed.message();
+    EXPECT_EQ(parsed->channels[0].normalization, info.mode);
+  }
+  EXPECT_EQ(find_normalization("zscore"), nullptr);
+}
+
 }  // namespace
 }  // namespace mmvk

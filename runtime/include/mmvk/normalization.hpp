@@ -21,6 +21,8 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "mmvk/database.hpp"
@@ -41,6 +43,25 @@ struct DimStatistics {
 
 // Preconditions: values.size() == frames * dims.
 std::vector<DimStatistics> compute_statistics(std::span<const float> values, std::uint32_t dims);
+
+// The table of normalization modes: one entry per mode, with its JSON name
+// and its rule. Adding a mode is one enum value and one entry.
+struct NormalizationInfo {
+  Normalization mode;
+  std::string_view name;         // the JSON name, e.g. "group_std"
+  std::string_view spread_name;  // for error messages, e.g. "standard deviation"
+  bool one_spread_per_channel;   // the channel's spread is the mean of its dims' spreads
+  double (*offset)(const DimStatistics&);
+  double (*spread)(const DimStatistics&);
+};
+
+// Every mode, in Normalization order.
+std::span<const NormalizationInfo> normalization_modes();
+const NormalizationInfo& normalization_info(Normalization mode);
+// The mode with JSON name `name`, or nullptr.
+const NormalizationInfo* find_normalization(std::string_view name);
+// The JSON names, quoted and comma-separated, for error messages.
+std::string normalization_list();
 
 // Offsets and scales for `raw` ([frames x schema.dims()], frames >= 1).
 Result<std::vector<DimNormalization>> compute_normalization(const FeatureSchema& schema, std::span<const float> raw);

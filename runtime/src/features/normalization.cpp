@@ -1,10 +1,67 @@
 #include "mmvk/normalization.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <string>
 
 namespace mmvk {
+
+namespace {
+
+double mean(const DimStatistics& s) { return s.mean; }
+double std_dev(const DimStatistics& s) { return s.std; }
+double mean_abs_dev(const DimStatistics& s) { return s.mean_abs_dev; }
+double min(const DimStatistics& s) { return s.min; }
+double range(const DimStatistics& s) { return s.max - s.min; }
+
+// One entry per mode, in Normalization order.
+constexpr NormalizationInfo kModes[] = {
+    {Normalization::GroupStd, "group_std", "standard deviation", true, mean, std_dev},
+    {Normalization::PerDimStd, "per_dim_std", "standard deviation", false, mean, std_dev},
+    {Normalization::MeanAbsDev, "mean_abs_dev", "mean absolute deviation", false, mean, mean_abs_dev},
+    {Normalization::MinMax, "min_max", "max - min", false, min, range},
+};
+
+constexpr bool in_enum_order() {
+  for (std::size_t i = 0; i < std::size(kModes); ++i) {
+    if (static_cast<std::size_t>(kModes[i].mode) != i) return false;
+  }
+  return true;
+}
+static_assert(in_enum_order(), "kModes is indexed by Normalization");
+
+}  // namespace
+
+std::span<const NormalizationInfo> normalization_modes() { return kModes; }
+
+const NormalizationInfo& normalization_info(Normalization mode) {
+  const auto index = static_cast<std::size_t>(mode);
+  // A Normalization outside the enum is a caller's bug (JSON and database
+  // files are parsed by name).
+  assert(index < std::size(kModes));
+  return kModes[index];
+}
+
+const NormalizationInfo* find_normalization(std::string_view name) {
+  for (const NormalizationInfo& info : kModes) {
+    if (info.name == name) return &info;
+  }
+  return nullptr;
+}
+
+std::string normalization_list() {
+  std::string list;
+  for (const NormalizationInfo& info : kModes) {
+    list += std::string(list.empty() ? "" : ", ") + '"' + std::string(info.name) + '"';
+  }
+  return list;
+}
+
+std::string_view normalization_name(Normalization mode) {
+  const auto index = static_cast<std::size_t>(mode);
+  return index < std::size(kModes) ? kModes[index].name : std::string_view("?");
+}
 
 std::vector<DimStatistics> compute_statistics(std::span<const float> values, std::uint32_t dims) {
   std::vector<DimStatistics> stats(dims);
@@ -57,41 +114,32 @@ Result<std::vector<DimNormalization>> compute_normalization(const FeatureSchema&
   for (const FeatureChannel& channel : schema.channels) {
     const std::uint32_t n = channel.dims();
     const double weight = channel.weight;
-    if (channel.normalization == Normalization::GroupStd) {
+    const NormalizationInfo& mode = normalization_info(channel.normalization);
+    if (mode.one_spread_per_channel) {
       double spread = 0.0;
       double magnitude = 1.0;
       for (std::uint32_t d = first; d < first + n; ++d) {
-        spread += stats[d].std;
+        spread += mode.spread(stats[d]);
         magnitude = std::max({magnitude, std::abs(stats[d].min), std::abs(stats[d].max)});
       }
       spread /= n;
       if (!(spread > 1e-6 * magnitude) || !std::isfinite(spread)) {
         return make_error("normalization: channel '" + channel.name +
-                          "' has zero spread (every dimension is constant over the database; group std " +
-                          std::to_string(spread) + ")");
+                          "' has zero spread (every dimension is constant over the database; mean " +
+                          std::string(mode.spread_name) + " " + std::to_string(spread) + ")");
       }
       for (std::uint32_t d = first; d < first + n; ++d) {
-        result[d] = {static_cast<float>(stats[d].mean), static_cast<float>(spread / weight)};
+        result[d] = {static_cast<float>(mode.offset(stats[d])), static_cast<float>(spread / weight)};
       }
     } else {
       for (std::uint32_t d = first; d < first + n; ++d) {
         const DimStatistics& s = stats[d];
-        double offset = s.mean;
-        double spread = s.std;
-        const char* what = "standard deviation";
-        if (channel.normalization == Normalization::MeanAbsDev) {
-          spread = s.mean_abs_dev;
-          what = "mean absolute deviation";
-        } else if (channel.normalization == Normalization::MinMax) {
-          offset = s.min;
-          spread = s.max - s.min;
-          what = "max - min";
-        }
+        const double spread = mode.spread(s);
         if (too_small(spread, s)) {
           return make_error("normalization: channel '" + channel.name + "', dimension " + schema.dim_name(d) +
-                            " has zero spread (" + what + " " + std::to_string(spread) + ")");
+                            " has zero spread (" + std::string(mode.spread_name) + " " + std::to_string(spread) + ")");
         }
-        result[d] = {static_cast<float>(offset), static_cast<float>(spread / weight)};
+        result[d] = {static_cast<float>(mode.offset(s)), static_cast<float>(spread / weight)};
       }
     }
     for (std::uint32_t d = first; d < first + n; ++d) {

@@ -7,29 +7,13 @@
 
 #include "common/file_io.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/normalization.hpp"
 
 namespace mmvk {
 
 namespace {
 
 using Json = nlohmann::json;
-
-struct NormalizationName {
-  Normalization mode;
-  const char* name;
-};
-constexpr NormalizationName kModes[] = {
-    {Normalization::GroupStd, "group_std"},
-    {Normalization::PerDimStd, "per_dim_std"},
-    {Normalization::MeanAbsDev, "mean_abs_dev"},
-    {Normalization::MinMax, "min_max"},
-};
-
-std::string mode_list() {
-  std::string list;
-  for (const NormalizationName& m : kModes) list += std::string(list.empty() ? "" : ", ") + '"' + m.name + '"';
-  return list;
-}
 
 Result<float> finite_number(const Json& value, const std::string& where) {
   if (!value.is_number()) return make_error(where + ": expected a number");
@@ -100,28 +84,14 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
   }
   if (object.contains("normalization")) {
     const Json& mode = object["normalization"];
-    bool known = false;
-    if (mode.is_string()) {
-      for (const NormalizationName& m : kModes) {
-        if (mode.get<std::string>() == m.name) {
-          channel.normalization = m.mode;
-          known = true;
-        }
-      }
-    }
-    if (!known) return make_error(where + ".normalization: expected one of " + mode_list());
+    const NormalizationInfo* info = mode.is_string() ? find_normalization(mode.get<std::string>()) : nullptr;
+    if (info == nullptr) return make_error(where + ".normalization: expected one of " + normalization_list());
+    channel.normalization = info->mode;
   }
   return channel;
 }
 
 }  // namespace
-
-std::string_view normalization_name(Normalization mode) {
-  for (const NormalizationName& m : kModes) {
-    if (m.mode == mode) return m.name;
-  }
-  return "?";
-}
 
 Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source) {
   const std::string name(source.empty() ? std::string_view("schema") : source);
@@ -164,9 +134,7 @@ std::string schema_to_json(const FeatureSchema& schema) {
     if (has_field(info.fields, ChannelField::Offsets)) object["offsets_seconds"] = channel.offsets_seconds;
     if (has_field(info.fields, ChannelField::Dims)) object["dims"] = channel.custom_dims;
     object["weight"] = channel.weight;
-    for (const NormalizationName& m : kModes) {
-      if (m.mode == channel.normalization) object["normalization"] = m.name;
-    }
+    object["normalization"] = normalization_name(channel.normalization);
     channels.push_back(std::move(object));
   }
   Json root;

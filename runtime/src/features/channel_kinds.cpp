@@ -4,8 +4,8 @@
 #include "mmvk/channel_kinds.hpp"
 
 #include <algorithm>
-#include <cassert>
 
+#include "common/name_table.hpp"
 #include "features/channel_extraction.hpp"
 #include "mmvk/features.hpp"
 
@@ -124,44 +124,23 @@ constexpr ChannelKindInfo kKinds[] = {
      .extract = extract_custom},
 };
 
-constexpr bool in_enum_order() {
-  for (std::size_t i = 0; i < std::size(kKinds); ++i) {
-    if (static_cast<std::size_t>(kKinds[i].kind) != i) return false;
-  }
-  return true;
-}
-static_assert(in_enum_order(), "kKinds is indexed by ChannelKind");
+static_assert(detail::indexed_by(std::span<const ChannelKindInfo>(kKinds), &ChannelKindInfo::kind),
+              "kKinds is indexed by ChannelKind");
 
 }  // namespace
 
 std::span<const ChannelKindInfo> channel_kinds() { return kKinds; }
 
-const ChannelKindInfo& channel_kind_info(ChannelKind kind) {
-  const auto index = static_cast<std::size_t>(kind);
-  // A ChannelKind outside the enum is a caller's bug (it cannot come from
-  // JSON or a database file, which are parsed by name).
-  assert(index < std::size(kKinds));
-  return kKinds[index];
-}
+const ChannelKindInfo& channel_kind_info(ChannelKind kind) { return detail::entry_for(channel_kinds(), kind); }
 
 const ChannelKindInfo* find_channel_kind(std::string_view name) {
-  for (const ChannelKindInfo& info : kKinds) {
-    if (info.name == name) return &info;
-  }
-  return nullptr;
+  return detail::find_named(channel_kinds(), &ChannelKindInfo::name, name);
 }
 
-std::string channel_kind_list() {
-  std::string list;
-  for (const ChannelKindInfo& info : kKinds) {
-    list += std::string(list.empty() ? "" : ", ") + '"' + std::string(info.name) + '"';
-  }
-  return list;
-}
+std::string channel_kind_list() { return detail::name_list(channel_kinds(), &ChannelKindInfo::name, '"', true); }
 
 std::string_view channel_kind_name(ChannelKind kind) {
-  const auto index = static_cast<std::size_t>(kind);
-  return index < std::size(kKinds) ? kKinds[index].name : std::string_view("?");
+  return detail::name_for(channel_kinds(), &ChannelKindInfo::name, kind);
 }
 
 }  // namespace mmvk

@@ -1,9 +1,10 @@
 #include "mmvk/normalization.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <string>
+
+#include "common/name_table.hpp"
 
 namespace mmvk {
 
@@ -23,44 +24,25 @@ constexpr NormalizationInfo kModes[] = {
     {Normalization::MinMax, "min_max", "max - min", false, min, range},
 };
 
-constexpr bool in_enum_order() {
-  for (std::size_t i = 0; i < std::size(kModes); ++i) {
-    if (static_cast<std::size_t>(kModes[i].mode) != i) return false;
-  }
-  return true;
-}
-static_assert(in_enum_order(), "kModes is indexed by Normalization");
+static_assert(detail::indexed_by(std::span<const NormalizationInfo>(kModes), &NormalizationInfo::mode),
+              "kModes is indexed by Normalization");
 
 }  // namespace
 
 std::span<const NormalizationInfo> normalization_modes() { return kModes; }
 
-const NormalizationInfo& normalization_info(Normalization mode) {
-  const auto index = static_cast<std::size_t>(mode);
-  // A Normalization outside the enum is a caller's bug (JSON and database
-  // files are parsed by name).
-  assert(index < std::size(kModes));
-  return kModes[index];
-}
+const NormalizationInfo& normalization_info(Normalization mode) { return detail::entry_for(normalization_modes(), mode); }
 
 const NormalizationInfo* find_normalization(std::string_view name) {
-  for (const NormalizationInfo& info : kModes) {
-    if (info.name == name) return &info;
-  }
-  return nullptr;
+  return detail::find_named(normalization_modes(), &NormalizationInfo::name, name);
 }
 
 std::string normalization_list() {
-  std::string list;
-  for (const NormalizationInfo& info : kModes) {
-    list += std::string(list.empty() ? "" : ", ") + '"' + std::string(info.name) + '"';
-  }
-  return list;
+  return detail::name_list(normalization_modes(), &NormalizationInfo::name, '"', true);
 }
 
 std::string_view normalization_name(Normalization mode) {
-  const auto index = static_cast<std::size_t>(mode);
-  return index < std::size(kModes) ? kModes[index].name : std::string_view("?");
+  return detail::name_for(normalization_modes(), &NormalizationInfo::name, mode);
 }
 
 std::vector<DimStatistics> compute_statistics(std::span<const float> values, std::uint32_t dims) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "common/name_table.hpp"
 #include "mmvk/character.hpp"
 
 namespace mmvk {
@@ -99,20 +100,11 @@ int find_by_names(const Skeleton& skeleton, const RoleNames& role) {
 }
 
 const RoleNames* role_named(std::string_view role) {
-  for (const RoleNames& entry : kRoles) {
-    if (entry.role == role) return &entry;
-  }
-  return nullptr;
+  return detail::find_named(std::span<const RoleNames>(kRoles), &RoleNames::role, role);
 }
 
 std::string known_roles() {
-  std::string out;
-  for (const RoleNames& entry : kRoles) {
-    if (!out.empty()) out += ", ";
-    out += '@';
-    out += entry.role;
-  }
-  return out;
+  return detail::name_list(std::span<const RoleNames>(kRoles), &RoleNames::role, '@', false);
 }
 
 // Deepest joint that is an ancestor of (or equal to) both a and b.

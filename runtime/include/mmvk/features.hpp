@@ -4,7 +4,8 @@
 //
 // Character space of frame f: origin at the character root position (on the
 // ground), +Z along the root's facing, +Y up, +X to the character's left
-// (right-handed). Every channel kind is expressed in it:
+// (right-handed). Every channel kind is expressed in it (each kind's entry in
+// channel_kinds.hpp says what it reads; the built-in kinds):
 //   - BonePosition: global bone position minus the root position, rotated
 //     into character space, metres.
 //   - BoneVelocity / RootVelocity: the global bone velocity rotated into

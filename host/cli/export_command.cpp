@@ -1,15 +1,14 @@
 // mmvk export: the normalized feature matrix as raw float32 plus a JSON
 // sidecar describing its layout, for analysis and training outside mmvk.
-#include <bit>
 #include <cstdio>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include "../../runtime/src/common/file_io.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/file_io.hpp"
 
 namespace mmvk::cli {
 
@@ -24,15 +23,6 @@ constexpr const char* kExportUsage =
     "(raw = normalized * scale + offset; scale already includes 1 / weight), tag\n"
     "names, clip ranges and the per-frame flags (1 = do_not_use,\n"
     "2 = block_transition, 4 = edge_excluded).\n";
-
-std::string little_endian_floats(std::span<const float> values) {
-  std::string bytes(values.size() * 4, '\0');
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const std::uint32_t bits = std::bit_cast<std::uint32_t>(values[i]);
-    for (int b = 0; b < 4; ++b) bytes[4 * i + b] = static_cast<char>((bits >> (8 * b)) & 0xFF);
-  }
-  return bytes;
-}
 
 nlohmann::json sidecar(const Database& db, const std::string& source, const std::string& features_path) {
   const FeatureSchema& schema = db.schema();
@@ -109,9 +99,9 @@ int run_export(Args args) {
     std::fprintf(stderr, "mmvk export: %s\n", db.message().c_str());
     return 1;
   }
-  Status written = detail::write_file_atomically(*features, little_endian_floats(db->features()));
+  Status written = write_f32_rows(*features, db->features());
   if (written.ok()) {
-    written = detail::write_file_atomically(sidecar_path, sidecar(*db, parsed->positional[0], *features).dump(1) + "\n");
+    written = write_file_atomically(sidecar_path, sidecar(*db, parsed->positional[0], *features).dump(1) + "\n");
   }
   if (!written.ok()) {
     std::fprintf(stderr, "mmvk export: %s\n", written.message().c_str());

@@ -1,7 +1,6 @@
 // mmvk query: batched search from a file of query vectors, one result line
 // per query, so anyone can check the engine against their own brute force.
 #include <algorithm>
-#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -9,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include "../../runtime/src/common/file_io.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "mmvk/cluster_search.hpp"
@@ -17,6 +15,7 @@
 #include "mmvk/database_io.hpp"
 #include "mmvk/explain.hpp"
 #include "mmvk/fast_search.hpp"
+#include "mmvk/file_io.hpp"
 #include "mmvk/query_builder.hpp"
 #include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
@@ -91,23 +90,6 @@ std::optional<float> parse_float(std::string_view option, const std::string& tex
   std::fprintf(stderr, "mmvk query: %.*s expects a number, got '%s'\n", int(option.size()), option.data(),
                text.c_str());
   return std::nullopt;
-}
-
-Result<std::vector<float>> read_queries(const std::string& path, std::uint32_t dims) {
-  Result<std::string> bytes = detail::read_file(path);
-  if (!bytes) return bytes.status();
-  const std::size_t row_bytes = std::size_t{dims} * 4;
-  if (bytes->empty() || bytes->size() % row_bytes != 0) {
-    return make_error(path + ": " + std::to_string(bytes->size()) + " bytes is not a whole number of queries of " +
-                      std::to_string(dims) + " float32 dims (" + std::to_string(row_bytes) + " bytes each)");
-  }
-  std::vector<float> values(bytes->size() / 4);
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    std::uint32_t bits = 0;
-    for (int b = 0; b < 4; ++b) bits |= std::uint32_t(static_cast<unsigned char>((*bytes)[4 * i + b])) << (8 * b);
-    values[i] = std::bit_cast<float>(bits);
-  }
-  return values;
 }
 
 struct BackendHolder {
@@ -296,7 +278,7 @@ int run_query(Args args) {
   }
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db) return fail(db.message());
-  Result<std::vector<float>> features = read_queries(*queries_path, db->dims());
+  Result<std::vector<float>> features = read_f32_rows(*queries_path, db->dims());
   if (!features) return fail(features.message());
   const std::size_t count = features->size() / db->dims();
   if (!parsed->has("--normalized")) {
@@ -329,7 +311,7 @@ int run_query(Args args) {
                      "# query\tframe:cost ... (best first; none = no further candidate)\n";
   text += format_results(results, count, static_cast<std::uint32_t>(k));
   if (const auto out = parsed->value("--out")) {
-    if (Status written = detail::write_file_atomically(*out, text); !written) return fail(written.message());
+    if (Status written = write_file_atomically(*out, text); !written) return fail(written.message());
   } else {
     std::fputs(text.c_str(), stdout);
   }

@@ -20,7 +20,7 @@
 #include <cstring>
 #include <string>
 
-#include "common/file_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "common/hash.hpp"
 #include "mmvk/cluster_table.hpp"
 
@@ -101,11 +101,11 @@ Status save_cluster_table(const ClusterTable& t, const std::filesystem::path& pa
   detail::Hasher hasher;
   hasher.add_bytes(out.data(), out.size());
   put(out, hasher.digest());
-  return detail::write_file_atomically(path, out);
+  return write_file_atomically(path, out);
 }
 
 Result<ClusterTable> load_cluster_table(const std::filesystem::path& path) {
-  Result<std::string> file = detail::read_file(path);
+  Result<std::string> file = read_file(path);
   if (!file.ok()) return file.error();
   const std::string& bytes = *file;
   const std::string where = path.string() + ": ";

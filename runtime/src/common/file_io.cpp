@@ -1,14 +1,15 @@
-#include "common/file_io.hpp"
+#include "mmvk/file_io.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <bit>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
-namespace mmvk::detail {
+namespace mmvk {
 
 namespace {
 std::string describe_errno(const std::filesystem::path& path, const char* what) {
@@ -70,4 +71,57 @@ Status write_file_atomically(const std::filesystem::path& path, std::string_view
   return {};
 }
 
-}  // namespace mmvk::detail
+void append_f32_le(std::string& bytes, std::span<const float> values) {
+  const std::size_t start = bytes.size();
+  bytes.resize(start + values.size() * 4);
+  char* out = bytes.data() + start;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(out, values.data(), values.size_bytes());
+  } else {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const std::uint32_t bits = std::bit_cast<std::uint32_t>(values[i]);
+      for (int b = 0; b < 4; ++b) out[4 * i + b] = static_cast<char>((bits >> (8 * b)) & 0xFF);
+    }
+  }
+}
+
+void decode_f32_le(std::string_view bytes, std::span<float> values) {
+  const char* in = bytes.data();
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(values.data(), in, values.size_bytes());
+  } else {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      std::uint32_t bits = 0;
+      for (int b = 0; b < 4; ++b) bits |= std::uint32_t{static_cast<std::uint8_t>(in[4 * i + b])} << (8 * b);
+      values[i] = std::bit_cast<float>(bits);
+    }
+  }
+}
+
+Result<std::vector<float>> read_f32_rows(const std::filesystem::path& path, std::uint32_t cols,
+                                         std::optional<std::uint64_t> expected_rows) {
+  if (cols == 0) return make_error(path.string() + ": a float32 row file needs at least one value per row");
+  MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(path));
+  const std::size_t row_bytes = std::size_t{cols} * 4;
+  if (expected_rows && bytes.size() != *expected_rows * row_bytes) {
+    return make_error(path.string() + ": " + std::to_string(bytes.size()) + " bytes, expected " +
+                      std::to_string(*expected_rows) + " rows x " + std::to_string(cols) +
+                      " values x 4 bytes = " + std::to_string(*expected_rows * row_bytes) +
+                      " (raw little-endian float32)");
+  }
+  if (!expected_rows && (bytes.empty() || bytes.size() % row_bytes != 0)) {
+    return make_error(path.string() + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of rows of " +
+                      std::to_string(cols) + " float32 values (" + std::to_string(row_bytes) + " bytes each)");
+  }
+  std::vector<float> values(bytes.size() / 4);
+  decode_f32_le(bytes, values);
+  return values;
+}
+
+Status write_f32_rows(const std::filesystem::path& path, std::span<const float> values) {
+  std::string bytes;
+  append_f32_le(bytes, values);
+  return write_file_atomically(path, bytes);
+}
+
+}  // namespace mmvk

@@ -4,7 +4,7 @@
 #include <cstring>
 #include <span>
 
-#include "common/file_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "common/hash.hpp"
 
 namespace mmvk {
@@ -30,19 +30,7 @@ class Writer {
   }
   void raw(std::string_view s) { bytes_.append(s); }
   // Bulk form of f32 for the feature matrix (the bulk of the file).
-  void f32_array(std::span<const float> values) {
-    const std::size_t start = bytes_.size();
-    bytes_.resize(start + values.size() * 4);
-    char* out = bytes_.data() + start;
-    if constexpr (std::endian::native == std::endian::little) {
-      std::memcpy(out, values.data(), values.size_bytes());
-    } else {
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        const std::uint32_t bits = std::bit_cast<std::uint32_t>(values[i]);
-        for (int b = 0; b < 4; ++b) out[4 * i + b] = static_cast<char>((bits >> (8 * b)) & 0xFF);
-      }
-    }
-  }
+  void f32_array(std::span<const float> values) { append_f32_le(bytes_, values); }
   std::string& bytes() { return bytes_; }
 
  private:
@@ -85,16 +73,7 @@ class Reader {
   }
   // Precondition: 4 * values.size() <= left().
   void f32_array(std::span<float> values) {
-    const char* in = bytes_.data() + pos_;
-    if constexpr (std::endian::native == std::endian::little) {
-      std::memcpy(values.data(), in, values.size_bytes());
-    } else {
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        std::uint32_t bits = 0;
-        for (int b = 0; b < 4; ++b) bits |= std::uint32_t{static_cast<std::uint8_t>(in[4 * i + b])} << (8 * b);
-        values[i] = std::bit_cast<float>(bits);
-      }
-    }
+    decode_f32_le(bytes_.substr(pos_), values);
     pos_ += values.size_bytes();
   }
   bool str(std::string& s) {
@@ -268,11 +247,11 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
 }
 
 Status save_database(const Database& database, const std::filesystem::path& path) {
-  return detail::write_file_atomically(path, serialize_database(database));
+  return write_file_atomically(path, serialize_database(database));
 }
 
 Result<Database> load_database(const std::filesystem::path& path) {
-  Result<std::string> bytes = detail::read_file(path);
+  Result<std::string> bytes = read_file(path);
   if (!bytes.ok()) return bytes.error();
   return deserialize_database(*bytes, path.string());
 }

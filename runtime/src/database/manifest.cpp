@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/file_io.hpp"
+#include "mmvk/file_io.hpp"
 
 namespace mmvk {
 
@@ -221,7 +221,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
 #undef MMVK_READ
 
 Result<Manifest> load_manifest(const std::filesystem::path& path) {
-  Result<std::string> text = detail::read_file(path);
+  Result<std::string> text = read_file(path);
   if (!text.ok()) return text.error();
   return parse_manifest_json(*text, path.string(), path.parent_path());
 }

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "common/file_io.hpp"
 #include "features/channel_extraction.hpp"
+#include "mmvk/file_io.hpp"
 
 namespace mmvk {
 
@@ -139,23 +139,12 @@ std::filesystem::path custom_sidecar_path(const std::filesystem::path& bvh_path,
 Result<std::vector<float>> load_custom_sidecar(const std::filesystem::path& bvh_path, const FeatureChannel& channel,
                                                std::uint32_t frame_count) {
   const std::filesystem::path path = custom_sidecar_path(bvh_path, channel);
-  Result<std::string> bytes = detail::read_file(path);
-  if (!bytes.ok()) {
-    return make_error(bytes.message() + " (custom channel '" + channel.name + "' of " + bvh_path.string() + ")");
+  Result<std::vector<float>> values = read_f32_rows(path, channel.custom_dims, frame_count);
+  if (!values.ok()) {
+    return make_error(values.message() + " (custom channel '" + channel.name + "' of " + bvh_path.string() + ")");
   }
-  const std::size_t expected = std::size_t{frame_count} * channel.custom_dims * sizeof(float);
-  if (bytes->size() != expected) {
-    return make_error(path.string() + ": " + std::to_string(bytes->size()) + " bytes, expected " +
-                      std::to_string(frame_count) + " frames x " + std::to_string(channel.custom_dims) +
-                      " dims x 4 bytes = " + std::to_string(expected) + " (raw little-endian float32)");
-  }
-  std::vector<float> values(std::size_t{frame_count} * channel.custom_dims);
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes->data());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const std::uint32_t bits = std::uint32_t{data[4 * i]} | std::uint32_t{data[4 * i + 1]} << 8 |
-                               std::uint32_t{data[4 * i + 2]} << 16 | std::uint32_t{data[4 * i + 3]} << 24;
-    std::memcpy(&values[i], &bits, sizeof(float));
-    if (!std::isfinite(values[i])) {
+  for (std::size_t i = 0; i < values->size(); ++i) {
+    if (!std::isfinite((*values)[i])) {
       return make_error(path.string() + ": value " + std::to_string(i % channel.custom_dims) + " of frame " +
                         std::to_string(i / channel.custom_dims) + " is not finite");
     }

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/file_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/normalization.hpp"
 
@@ -117,7 +117,7 @@ Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_
 }
 
 Result<FeatureSchema> load_schema(const std::filesystem::path& path) {
-  Result<std::string> text = detail::read_file(path);
+  Result<std::string> text = read_file(path);
   if (!text.ok()) return text.error();
   return parse_schema_json(*text, path.string());
 }

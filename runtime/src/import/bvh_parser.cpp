@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "import/bvh_lexer.hpp"
-#include "common/file_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "mmvk/bvh.hpp"
 
 namespace mmvk {
@@ -373,7 +373,7 @@ Result<BvhFile> parse_bvh(std::string_view text, std::string_view source) {
 }
 
 Result<BvhFile> load_bvh(const std::filesystem::path& path, const BvhParseOptions& options) {
-  Result<std::string> text = detail::read_file(path);
+  Result<std::string> text = read_file(path);
   if (!text) return text.error();
   return parse_bvh(*text, path.string(), options);
 }

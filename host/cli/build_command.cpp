@@ -27,7 +27,7 @@ constexpr const char* kBuildUsage =
     "  --schema FILE          feature schema JSON (overrides the manifest's)\n"
     "  --mirror               also add a mirrored copy of every clip\n"
     "  --edge-rule RULE       exclude | clamp (overrides the manifest's)\n"
-    "  --threads N            threads loading clips (default: all cores)\n"
+    "  --threads N            threads loading clips (default 0: all cores)\n"
     "  --progress             show the progress bar even when stderr is not a terminal\n"
     "  --no-progress          never show it\n";
 
@@ -70,8 +70,8 @@ int run_build(Args args) {
     return 1;
   }
   if (auto fps = parsed->value("--fps")) {
-    const auto value = parse_positive("build", "--fps", *fps);
-    if (!value) return 2;
+    const Result<double> value = parse_positive("--fps", *fps);
+    if (!value) return report_error("build", value.message(), 2);
     manifest->fps = static_cast<float>(*value);
   }
   if (auto schema_path = parsed->value("--schema")) {
@@ -97,9 +97,9 @@ int run_build(Args args) {
   }
   unsigned threads = 0;
   if (auto text = parsed->value("--threads")) {
-    const auto value = parse_positive("build", "--threads", *text);
-    if (!value) return 2;
-    threads = static_cast<unsigned>(*value);
+    const Result<std::uint32_t> value = parse_u32("--threads", *text);
+    if (!value) return report_error("build", value.message(), 2);
+    threads = *value;
   }
 
   ThreadPool pool(threads);

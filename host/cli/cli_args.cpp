@@ -1,5 +1,6 @@
 #include "cli_args.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -50,15 +51,55 @@ std::optional<ParsedArgs> parse_args(std::string_view command, Args args, const 
   return parsed;
 }
 
-std::optional<double> parse_positive(std::string_view command, std::string_view option, const std::string& text) {
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || !(value > 0.0)) {
-    std::fprintf(stderr, "mmvk %.*s: %.*s expects a positive number, got '%s'\n", int(command.size()), command.data(),
-                 int(option.size()), option.data(), text.c_str());
-    return std::nullopt;
+namespace {
+std::string expected(std::string_view option, std::string_view what, std::string_view text) {
+  return std::string(option) + " expects " + std::string(what) + ", got '" + std::string(text) + "'";
+}
+}  // namespace
+
+Result<std::uint64_t> parse_integer(std::string_view option, std::string_view text, std::uint64_t min,
+                                    std::uint64_t max) {
+  const std::string range = max == std::numeric_limits<std::uint64_t>::max()
+                                ? (min == 0 ? "a non-negative integer" : "an integer >= " + std::to_string(min))
+                                : "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  std::uint64_t value = 0;
+  // from_chars takes no sign, no spaces and no base prefix: "-1", " 2" and
+  // "2.5" are errors instead of wrapping around or being cut short.
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc{} || end != text.data() + text.size() || value < min || value > max) {
+    return make_error(expected(option, range, text));
   }
   return value;
+}
+
+Result<std::uint32_t> parse_u32(std::string_view option, std::string_view text, std::uint32_t min, std::uint32_t max) {
+  MMVK_ASSIGN_OR_RETURN(const std::uint64_t value, parse_integer(option, text, min, max));
+  return static_cast<std::uint32_t>(value);
+}
+
+Result<float> parse_float(std::string_view option, std::string_view text) {
+  const std::string copy(text);
+  char* end = nullptr;
+  const float value = std::strtof(copy.c_str(), &end);
+  if (copy.empty() || end != copy.c_str() + copy.size() || !std::isfinite(value)) {
+    return make_error(expected(option, "a finite number", text));
+  }
+  return value;
+}
+
+Result<double> parse_positive(std::string_view option, std::string_view text) {
+  const std::string copy(text);
+  char* end = nullptr;
+  const double value = std::strtod(copy.c_str(), &end);
+  if (copy.empty() || end != copy.c_str() + copy.size() || !std::isfinite(value) || !(value > 0.0)) {
+    return make_error(expected(option, "a positive number", text));
+  }
+  return value;
+}
+
+int report_error(std::string_view command, std::string_view message, int exit_code) {
+  std::fprintf(stderr, "mmvk %.*s: %.*s\n", int(command.size()), command.data(), int(message.size()), message.data());
+  return exit_code;
 }
 
 std::string thousands(unsigned long long value) {

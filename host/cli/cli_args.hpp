@@ -1,6 +1,8 @@
 // Small shared helpers for the mmvk subcommands: option parsing and output.
 #pragma once
 
+#include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "mmvk/status.hpp"
 
 namespace mmvk::cli {
 
@@ -28,8 +31,20 @@ struct ParsedArgs {
 std::optional<ParsedArgs> parse_args(std::string_view command, Args args, const std::set<std::string_view>& with_value,
                                      const std::set<std::string_view>& without_value);
 
-// Parses a positive finite number, or prints an error naming the option.
-std::optional<double> parse_positive(std::string_view command, std::string_view option, const std::string& text);
+// Number parsing for every command, in one place: the whole text must be
+// the number, and the error message names the option and what it expects
+// ("--k expects an integer in [1, 16], got 'x'").
+Result<std::uint64_t> parse_integer(std::string_view option, std::string_view text, std::uint64_t min = 0,
+                                    std::uint64_t max = std::numeric_limits<std::uint64_t>::max());
+Result<std::uint32_t> parse_u32(std::string_view option, std::string_view text, std::uint32_t min = 0,
+                                std::uint32_t max = std::numeric_limits<std::uint32_t>::max());
+// A finite float.
+Result<float> parse_float(std::string_view option, std::string_view text);
+// A finite number > 0.
+Result<double> parse_positive(std::string_view option, std::string_view text);
+
+// Prints "mmvk <command>: <message>" to stderr and returns `exit_code`.
+int report_error(std::string_view command, std::string_view message, int exit_code);
 
 // "1,234,567"
 std::string thousands(unsigned long long value);

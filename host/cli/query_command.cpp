@@ -68,30 +68,6 @@ std::vector<std::string> split_list(const std::string& text) {
   return items;
 }
 
-std::optional<std::uint64_t> parse_unsigned(std::string_view option, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const unsigned long long value = std::stoull(text, &used);
-    if (used == text.size() && text.find('-') == std::string::npos) return value;
-  } catch (...) {
-  }
-  std::fprintf(stderr, "mmvk query: %.*s expects a non-negative integer, got '%s'\n", int(option.size()),
-               option.data(), text.c_str());
-  return std::nullopt;
-}
-
-std::optional<float> parse_float(std::string_view option, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const float value = std::stof(text, &used);
-    if (used == text.size()) return value;
-  } catch (...) {
-  }
-  std::fprintf(stderr, "mmvk query: %.*s expects a number, got '%s'\n", int(option.size()), option.data(),
-               text.c_str());
-  return std::nullopt;
-}
-
 struct BackendHolder {
   ThreadPool pool;
   ClusterTable table;
@@ -119,9 +95,7 @@ Status load_or_train_clusters(BackendHolder& holder, const Database& db, const P
 Result<std::uint32_t> nprobe_option(const ParsedArgs& args) {
   std::uint32_t nprobe = 4;
   if (const auto text = args.value("--nprobe")) {
-    const auto value = parse_unsigned("--nprobe", *text);
-    if (!value || *value == 0) return make_error("--nprobe must be a positive integer");
-    nprobe = static_cast<std::uint32_t>(*value);
+    MMVK_ASSIGN_OR_RETURN(nprobe, parse_u32("--nprobe", *text, 1));
   }
   return nprobe;
 }
@@ -189,19 +163,13 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
 Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
   QueryParams params;
   if (const auto text = args.value("--continuing")) {
-    const auto frame = parse_unsigned("--continuing", *text);
-    if (!frame) return make_error("bad --continuing");
-    params.continuing_frame = static_cast<std::uint32_t>(*frame);
+    MMVK_ASSIGN_OR_RETURN(params.continuing_frame, parse_u32("--continuing", *text));
   }
   if (const auto text = args.value("--continuing-bias")) {
-    const auto bias = parse_float("--continuing-bias", *text);
-    if (!bias) return make_error("bad --continuing-bias");
-    params.continuing_bias = *bias;
+    MMVK_ASSIGN_OR_RETURN(params.continuing_bias, parse_float("--continuing-bias", *text));
   }
   if (const auto text = args.value("--exclusion-window")) {
-    const auto window = parse_unsigned("--exclusion-window", *text);
-    if (!window) return make_error("bad --exclusion-window");
-    params.exclusion_window = static_cast<std::uint32_t>(*window);
+    MMVK_ASSIGN_OR_RETURN(params.exclusion_window, parse_u32("--exclusion-window", *text));
   }
   for (const auto& [option, mask] : {std::pair{"--require", &params.require_all}, std::pair{"--exclude", &params.exclude_any}}) {
     if (const auto text = args.value(option)) {
@@ -214,9 +182,8 @@ Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
     for (const std::string& item : split_list(*text)) {
       const std::size_t equals = item.find('=');
       if (equals == std::string::npos) return make_error("--weights: expected CHANNEL=WEIGHT, got '" + item + "'");
-      const auto weight = parse_float("--weights", item.substr(equals + 1));
-      if (!weight) return make_error("bad --weights");
-      MMVK_TRY(set_channel_weight(db.schema(), params, item.substr(0, equals), *weight));
+      MMVK_ASSIGN_OR_RETURN(const float weight, parse_float("--weights", item.substr(equals + 1)));
+      MMVK_TRY(set_channel_weight(db.schema(), params, item.substr(0, equals), weight));
     }
   }
   return params;
@@ -259,21 +226,17 @@ int run_query(Args args) {
     std::fputs(kQueryUsage, stderr);
     return 2;
   }
-  auto fail = [](const std::string& message) {
-    std::fprintf(stderr, "mmvk query: %s\n", message.c_str());
-    return 1;
-  };
-  std::uint64_t k = 1;
+  auto fail = [](const std::string& message) { return report_error("query", message, 1); };
+  std::uint32_t k = 1;
   if (const auto text = parsed->value("--k")) {
-    const auto value = parse_unsigned("--k", *text);
-    if (!value) return 2;
+    const Result<std::uint32_t> value = parse_u32("--k", *text, 1, kMaxK);
+    if (!value) return report_error("query", value.message(), 2);
     k = *value;
   }
-  if (k < 1 || k > kMaxK) return fail("--k " + std::to_string(k) + " is out of range [1, " + std::to_string(kMaxK) + "]");
-  std::uint64_t threads = 0;
+  std::uint32_t threads = 0;
   if (const auto text = parsed->value("--threads")) {
-    const auto value = parse_unsigned("--threads", *text);
-    if (!value) return 2;
+    const Result<std::uint32_t> value = parse_u32("--threads", *text);
+    if (!value) return report_error("query", value.message(), 2);
     threads = *value;
   }
   Result<Database> db = load_database(parsed->positional[0]);
@@ -292,14 +255,14 @@ int run_query(Args args) {
   if (!params) return fail(params.message());
   const std::vector<QueryParams> all_params(count, *params);
 
-  BackendHolder holder(static_cast<unsigned>(threads));
+  BackendHolder holder(threads);
   const std::string backend_name = parsed->value("--backend").value_or("fast");
-  const Status made = make_backend(holder, *db, backend_name, *parsed, count, static_cast<std::uint32_t>(k));
+  const Status made = make_backend(holder, *db, backend_name, *parsed, count, k);
   if (!made) return fail(made.message());
   std::vector<Match> results(count * k);
   const auto start = std::chrono::steady_clock::now();
   const Status searched =
-      holder.backend->search(QueryBatch{*features, all_params, count}, static_cast<std::uint32_t>(k), results);
+      holder.backend->search(QueryBatch{*features, all_params, count}, k, results);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!searched) return fail(searched.message());
   std::fprintf(stderr, "mmvk query: %zu queries, backend %s, %.3f ms (%.0f queries/s), %.2f%% of rows evaluated\n",
@@ -309,7 +272,7 @@ int run_query(Args args) {
   std::string text = "# mmvk query: " + parsed->positional[0] + ", backend " + std::string(holder.backend->name()) +
                      ", k " + std::to_string(k) + ", " + std::to_string(count) + " queries\n" +
                      "# query\tframe:cost ... (best first; none = no further candidate)\n";
-  text += format_results(results, count, static_cast<std::uint32_t>(k));
+  text += format_results(results, count, k);
   if (const auto out = parsed->value("--out")) {
     if (Status written = write_file_atomically(*out, text); !written) return fail(written.message());
   } else {
@@ -321,13 +284,13 @@ int run_query(Args args) {
     const auto list = parsed->value("--frames") ? parsed->value("--frames") : parsed->value("--frame");
     if (list) {
       for (const std::string& item : split_list(*list)) {
-        const auto frame = parse_unsigned("--frames", item);
-        if (!frame) return 2;
-        frames.push_back(static_cast<std::uint32_t>(*frame));
+        const Result<std::uint32_t> frame = parse_u32("--frames", item);
+        if (!frame) return report_error("query", frame.message(), 2);
+        frames.push_back(*frame);
       }
     }
     Result<Explanation> explanation = explain_query(*db, std::span<const float>(*features).first(db->dims()),
-                                                    all_params[0], frames, static_cast<std::uint32_t>(k));
+                                                    all_params[0], frames, k);
     if (!explanation) return fail(explanation.message());
     std::fputs(("explain, query 0:\n" + format_explanation(*db, *explanation)).c_str(), stderr);
   }

@@ -134,3 +134,38 @@ TEST_F(QueryCli, BadQueryFilesAreNamed) {
 
 }  // namespace
 }  // namespace mmvk
+
+namespace mmvk {
+namespace {
+
+// Every command parses its numbers through the same helpers (cli_args.hpp):
+// the whole text must be a number of the right kind, and the error names
+// the option. `build --threads 2.5` used to be taken as 2.
+TEST_F(QueryCli, NumbersAreParsedStrictlyAndNamed) {
+  const std::string query = mmvk_ + " query " + db_ + " --queries " + write_queries(2, 27).string() + " --normalized";
+  const std::pair<const char*, const char*> bad[] = {
+      {"--k", "2.5"},        {"--k", "0"},        {"--threads", "-1"},          {"--threads", "2x"},
+      {"--continuing", "1e3"}, {"--continuing-bias", "nan"}, {"--exclusion-window", ""},
+      {"--frames", "4,x"}};
+  for (const auto& [option, value] : bad) {
+    std::string command = query + " " + option + "='" + value + "'";
+    if (std::string(option) == "--frames") command += " --explain";
+    const CommandResult result = run(command);
+    EXPECT_NE(result.exit_code, 0) << command;
+    EXPECT_NE(result.output.find(std::string(option) + " expects"), std::string::npos) << command << "\n" << result.output;
+  }
+  for (const char* threads : {"2.5", "-2", "many"}) {
+    const CommandResult built =
+        run(mmvk_ + " build " + (dir_ / "m.json").string() + " -o " + (dir_ / "t.mmdb").string() + " --threads " + threads);
+    EXPECT_NE(built.exit_code, 0) << threads;
+    EXPECT_NE(built.output.find("--threads expects"), std::string::npos) << built.output;
+    EXPECT_FALSE(fs::exists(dir_ / "t.mmdb"));
+  }
+  const CommandResult fps = run(mmvk_ + " build " + (dir_ / "m.json").string() + " -o " + (dir_ / "t.mmdb").string() +
+                                " --fps 0");
+  EXPECT_NE(fps.exit_code, 0);
+  EXPECT_NE(fps.output.find("--fps expects a positive number"), std::string::npos) << fps.output;
+}
+
+}  // namespace
+}  // namespace mmvk

@@ -1,5 +1,5 @@
 // Cluster-table benchmarks: queries/s of the cluster-pruned backend (exact
-// and nprobe 1/4/16) beside the fast exact brute force and box-pruned
+// and clusters-nprobe 1/4/16) beside the fast exact brute force and box-pruned
 // backends, with the fraction of rows evaluated and recall@1 against the
 // exact answers, for B in {1, 64, 1024}, and k-means training time.
 //
@@ -31,10 +31,10 @@
 #include <string>
 #include <vector>
 
+#include "mmvk/backends.hpp"
 #include "mmvk/cluster_search.hpp"
 #include "mmvk/database_build.hpp"
 #include "mmvk/manifest.hpp"
-#include "mmvk/fast_search.hpp"
 
 namespace mmvk::bench {
 namespace {
@@ -42,6 +42,26 @@ namespace {
 constexpr std::size_t kStreamQueries = 1024;
 const char* const kStreams[] = {"continue", "transition", "random"};
 constexpr std::uint32_t kBatchSizes[] = {1, 64, 1024};
+
+// The rows: registry backends (mmvk/backends.hpp) by name with the nprobe
+// and, to measure which bound helps, the bounds of the exact walk.
+struct Variant {
+  const char* label;
+  const char* backend;
+  std::uint32_t nprobe = 0;
+  bool box_bound = true;
+  bool radius_bound = false;
+};
+constexpr Variant kVariants[] = {
+    {"fast-brute", "fast-brute"},
+    {"fast-box", "fast-box"},
+    {"clusters", "clusters"},
+    {"clusters+radius", "clusters", 0, true, true},
+    {"clusters-radius", "clusters", 0, false, true},
+    {"clusters-nprobe1", "clusters-nprobe", 1},
+    {"clusters-nprobe4", "clusters-nprobe", 4},
+    {"clusters-nprobe16", "clusters-nprobe", 16},
+};
 
 double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 double gauss(std::mt19937_64& rng) {
@@ -158,23 +178,19 @@ Setup& setup_for(const std::string& label, const std::function<const Database*()
     return s;
   }
   s.table = std::move(table).value();
-  s.backends["fast-brute"] = std::make_unique<FastSearch>(*s.db, s.pool, FastSearchOptions{.prune = false});
-  s.backends["fast-box"] = std::make_unique<FastSearch>(*s.db, s.pool, FastSearchOptions{.prune = true});
-  const std::pair<const char*, std::uint32_t> cluster_variants[] = {
-      {"clusters", 0}, {"nprobe1", 1}, {"nprobe4", 4}, {"nprobe16", 16}};
-  for (const auto& [name, nprobe] : cluster_variants) {
-    auto backend = ClusterSearch::create(*s.db, s.table, s.pool, {.nprobe = nprobe});
+  const BackendRegistry registry = cpu_backends();
+  for (const Variant& variant : kVariants) {
+    BackendSpec spec{.name = variant.backend, .pool = &s.pool, .clusters = &s.table};
+    spec.nprobe = variant.nprobe;
+    spec.cluster.box_bound = variant.box_bound;
+    spec.cluster.radius_bound = variant.radius_bound;
+    auto backend = registry.make(spec, *s.db);
     if (!backend.ok()) {
       std::fprintf(stderr, "cluster_bench: %s\n", backend.message().c_str());
       std::abort();
     }
-    s.backends[name] = std::move(backend).value();
+    s.backends[variant.label] = std::move(backend).value();
   }
-  // Bound variants, to measure which bound helps.
-  s.backends["clusters+radius"] =
-      std::move(ClusterSearch::create(*s.db, s.table, s.pool, {.nprobe = 0, .box_bound = true, .radius_bound = true}).value());
-  s.backends["clusters-radius"] =
-      std::move(ClusterSearch::create(*s.db, s.table, s.pool, {.nprobe = 0, .box_bound = false, .radius_bound = true}).value());
   for (const char* stream : kStreams) {
     s.queries[stream] = make_stream(*s.db, stream);
     std::vector<Match> out(kStreamQueries);
@@ -241,8 +257,8 @@ void register_cluster_benchmarks(const std::string& label, std::function<const D
     state.counters["frames"] = s.db ? s.db->frame_count() : 0;
   })->Iterations(1);
   for (const char* stream : kStreams) {
-    for (const char* backend : {"fast-brute", "fast-box", "clusters", "clusters+radius", "clusters-radius", "nprobe1",
-                                "nprobe4", "nprobe16"}) {
+    for (const Variant& variant : kVariants) {
+      const std::string backend = variant.label;
       for (std::uint32_t batch : kBatchSizes) {
         const std::string name = "clusters/" + label + "/" + stream + "/" + backend + "/B:" + std::to_string(batch);
         benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& state) {

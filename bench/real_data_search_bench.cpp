@@ -19,32 +19,33 @@
 #include <vector>
 
 #include "bench_data.hpp"
+#include "mmvk/backends.hpp"
 #include "mmvk/cluster_search.hpp"
 #include "mmvk/cluster_table.hpp"
-#include "mmvk/fast_search.hpp"
-#include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "query_streams.hpp"
 
 namespace mmvk::bench {
 namespace {
 
-enum class Backend { Reference, FastBrute, FastPruned, ClustersExact, Nprobe1, Nprobe4, Nprobe8, Nprobe16, Nprobe32, Nprobe64 };
+// The rows: a registry backend (mmvk/backends.hpp) and, for the nprobe
+// rows, the nprobe; the row's label is the backend's name plus the nprobe.
+struct Variant {
+  std::string label;
+  std::string backend;
+  std::uint32_t nprobe = 0;
+};
 
-const char* backend_name(Backend backend) {
-  switch (backend) {
-    case Backend::Reference: return "reference";
-    case Backend::FastBrute: return "fast-brute";
-    case Backend::FastPruned: return "fast-box";
-    case Backend::ClustersExact: return "clusters";
-    case Backend::Nprobe1: return "nprobe1";
-    case Backend::Nprobe4: return "nprobe4";
-    case Backend::Nprobe8: return "nprobe8";
-    case Backend::Nprobe16: return "nprobe16";
-    case Backend::Nprobe32: return "nprobe32";
-    case Backend::Nprobe64: return "nprobe64";
-  }
-  return "?";
+const std::vector<Variant>& variants() {
+  static const std::vector<Variant> all = [] {
+    std::vector<Variant> v = {{"reference", "reference"}, {"fast-brute", "fast-brute"}, {"fast-box", "fast-box"},
+                              {"clusters", "clusters"}};
+    for (const std::uint32_t nprobe : {1u, 4u, 8u, 16u, 32u, 64u}) {
+      v.push_back({"clusters-nprobe" + std::to_string(nprobe), "clusters-nprobe", nprobe});
+    }
+    return v;
+  }();
+  return all;
 }
 
 // Everything built for one database, once per process.
@@ -52,7 +53,7 @@ struct Fixture {
   const Database* db = nullptr;
   ThreadPool pool;  // all cores
   ClusterTable table;
-  std::map<Backend, std::unique_ptr<SearchBackend>> backends;
+  std::map<std::string, std::unique_ptr<SearchBackend>> backends;  // by Variant::label
   // Exact top-1 per (stream, batch), for recall.
   std::map<std::pair<QueryStream, std::size_t>, std::vector<Match>> truth;
 };
@@ -82,28 +83,28 @@ Fixture* fixture(DataSet set) {
       f->db = nullptr;
     } else {
       f->table = std::move(table.value());
-      f->backends[Backend::Reference] = std::make_unique<ReferenceSearch>(*f->db);
-      f->backends[Backend::FastBrute] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = false});
-      f->backends[Backend::FastPruned] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = true});
-      for (auto [backend, nprobe] :
-           {std::pair{Backend::ClustersExact, 0u}, std::pair{Backend::Nprobe1, 1u}, std::pair{Backend::Nprobe4, 4u},
-            std::pair{Backend::Nprobe8, 8u}, std::pair{Backend::Nprobe16, 16u}, std::pair{Backend::Nprobe32, 32u},
-            std::pair{Backend::Nprobe64, 64u}}) {
-        ClusterSearchOptions options{.nprobe = nprobe};
+      const BackendRegistry registry = cpu_backends();
+      for (const Variant& variant : variants()) {
+        BackendSpec spec{.name = variant.backend, .pool = &f->pool, .clusters = &f->table};
+        spec.nprobe = variant.nprobe;
         // Tuning switches (MMVK_BENCH_PROBE_BY_BOUND=1, MMVK_BENCH_NO_SEED=1).
-        options.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
-        options.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
-        auto made = ClusterSearch::create(*f->db, f->table, f->pool, options);
-        if (made) f->backends[backend] = std::move(made.value());
+        spec.cluster.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
+        spec.cluster.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
+        Result<std::unique_ptr<SearchBackend>> made = registry.make(spec, *f->db);
+        if (made) {
+          f->backends[variant.label] = std::move(made.value());
+        } else {
+          std::fprintf(stderr, "bench: %s: %s\n", variant.label.c_str(), made.message().c_str());
+        }
       }
     }
   }
   return fixtures.emplace(set, std::move(f)).first->second.get();
 }
 
-void run(benchmark::State& state, DataSet set, QueryStream stream, Backend which) {
+void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& which) {
   Fixture* f = fixture(set);
-  if (!f->db || !f->backends.count(which)) {
+  if (!f->db || !f->backends.count(which) || !f->backends.count("fast-brute")) {
     state.SkipWithError("database or backend unavailable (see stderr)");
     return;
   }
@@ -113,12 +114,12 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, Backend which
   std::vector<Match>& truth = f->truth[{stream, batch}];
   if (truth.empty()) {
     truth.resize(batch);
-    if (!f->backends[Backend::FastBrute]->search(query_batch, 1, truth).ok()) {
+    if (!f->backends.at("fast-brute")->search(query_batch, 1, truth).ok()) {
       state.SkipWithError("exact search failed");
       return;
     }
   }
-  SearchBackend& backend = *f->backends[which];
+  SearchBackend& backend = *f->backends.at(which);
   std::vector<Match> results(batch);
   backend.reset_stats();
   for (auto _ : state) {
@@ -145,14 +146,12 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, Backend which
 const bool registered = [] {
   for (DataSet set : {DataSet::Locomotion, DataSet::Volume, DataSet::VolumeMirrored}) {
     for (QueryStream stream : {QueryStream::Transition, QueryStream::Continue, QueryStream::Uniform}) {
-      for (Backend which : {Backend::Reference, Backend::FastBrute, Backend::FastPruned, Backend::ClustersExact,
-                            Backend::Nprobe1, Backend::Nprobe4, Backend::Nprobe8, Backend::Nprobe16, Backend::Nprobe32,
-                            Backend::Nprobe64}) {
+      for (const Variant& variant : variants()) {
         const std::string name = std::string("real/") + std::string(data_set_name(set)) + "/" +
-                                 std::string(query_stream_name(stream)) + "/" + backend_name(which);
-        auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, which);
+                                 std::string(query_stream_name(stream)) + "/" + variant.label;
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, variant.label);
         b->ArgName("B")->Arg(1)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
-        if (which == Backend::Reference && set != DataSet::Locomotion) b->Iterations(1);
+        if (variant.backend == "reference" && set != DataSet::Locomotion) b->Iterations(1);
       }
     }
   }

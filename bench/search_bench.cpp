@@ -13,6 +13,7 @@
 // The reference runs one iteration at B = 1024 and at the large size.
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <memory>
@@ -20,8 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "mmvk/backends.hpp"
 #include "mmvk/fast_search.hpp"
-#include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "query_streams.hpp"
 
@@ -71,25 +72,24 @@ Database synthetic_motion_database(std::uint32_t frames, std::uint64_t seed) {
   return std::move(Database::create(std::move(parts)).value());
 }
 
-// FastBrute1 runs on a one-thread pool: its CPU time is the single-core
-// kernel throughput, which a loaded machine disturbs less than wall time.
-enum class Backend { Reference, FastBrute, FastPruned, FastBrute1 };
-
-const char* backend_name(Backend backend) {
-  switch (backend) {
-    case Backend::Reference: return "reference";
-    case Backend::FastBrute: return "fast-brute";
-    case Backend::FastPruned: return "fast-pruned";
-    case Backend::FastBrute1: return "fast-brute-1thread";
-  }
-  return "?";
-}
+// The rows: registry backends (mmvk/backends.hpp) by name, on the
+// all-cores pool, plus fast-brute on a one-thread pool ("-1thread"): its CPU
+// time is the single-core kernel throughput, which a loaded machine disturbs
+// less than wall time.
+struct Variant {
+  const char* label;
+  const char* backend;
+  bool single_thread = false;
+};
+constexpr Variant kVariants[] = {
+    {"reference", "reference"}, {"fast-brute", "fast-brute"}, {"fast-box", "fast-box"},
+    {"fast-brute-1thread", "fast-brute", true}};
 
 struct Fixture {
   const Database* db = nullptr;
   ThreadPool pool;  // all cores
   ThreadPool single{1};
-  std::map<Backend, std::unique_ptr<SearchBackend>> backends;
+  std::map<std::string, std::unique_ptr<SearchBackend>> backends;  // by Variant::label
 };
 
 Fixture& fixture(const std::string& label, const DatabaseProvider& provider) {
@@ -99,26 +99,32 @@ Fixture& fixture(const std::string& label, const DatabaseProvider& provider) {
     f = std::make_unique<Fixture>();
     f->db = provider();
     if (f->db) {
-      f->backends[Backend::Reference] = std::make_unique<ReferenceSearch>(*f->db);
-      f->backends[Backend::FastBrute] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = false});
-      f->backends[Backend::FastPruned] = std::make_unique<FastSearch>(*f->db, f->pool, FastSearchOptions{.prune = true});
-      f->backends[Backend::FastBrute1] = std::make_unique<FastSearch>(*f->db, f->single, FastSearchOptions{.prune = false});
+      const BackendRegistry registry = cpu_backends();
+      for (const Variant& variant : kVariants) {
+        const BackendSpec spec{.name = variant.backend, .pool = variant.single_thread ? &f->single : &f->pool};
+        Result<std::unique_ptr<SearchBackend>> made = registry.make(spec, *f->db);
+        if (made) {
+          f->backends[variant.label] = std::move(made.value());
+        } else {
+          std::fprintf(stderr, "bench: %s: %s\n", variant.label, made.message().c_str());
+        }
+      }
     }
   }
   return *f;
 }
 
 void run(benchmark::State& state, const std::string& label, const DatabaseProvider& provider, QueryStream stream,
-         Backend which) {
+         const Variant& which) {
   Fixture& f = fixture(label, provider);
-  if (!f.db) {
+  if (!f.db || !f.backends.count(which.label)) {
     state.SkipWithError("database unavailable (see stderr)");
     return;
   }
   const std::size_t batch = static_cast<std::size_t>(state.range(0));
   const std::vector<float> queries = make_queries(*f.db, stream, batch);
   const QueryBatch query_batch{.features = queries, .params = {}, .size = batch};
-  SearchBackend& backend = *f.backends.at(which);
+  SearchBackend& backend = *f.backends.at(which.label);
   std::vector<Match> results(batch);
   backend.reset_stats();
   for (auto _ : state) {
@@ -143,11 +149,11 @@ void run(benchmark::State& state, const std::string& label, const DatabaseProvid
 // is called once, on first use; nullptr marks the data as unavailable.
 void register_search_benchmarks(const std::string& label, DatabaseProvider provider, bool large) {
   for (QueryStream stream : {QueryStream::Continue, QueryStream::Transition, QueryStream::Uniform}) {
-    for (Backend which : {Backend::Reference, Backend::FastBrute, Backend::FastPruned, Backend::FastBrute1}) {
-      const std::string name = "search/" + label + "/" + std::string(query_stream_name(stream)) + "/" + backend_name(which);
+    for (const Variant& which : kVariants) {
+      const std::string name = "search/" + label + "/" + std::string(query_stream_name(stream)) + "/" + which.label;
       auto* b = benchmark::RegisterBenchmark(name.c_str(), run, label, provider, stream, which);
       b->ArgName("B")->Arg(1)->Arg(64)->Arg(1024)->Unit(benchmark::kMicrosecond)->UseRealTime();
-      if (which == Backend::Reference && large) b->Iterations(1);
+      if (std::string_view(which.backend) == "reference" && large) b->Iterations(1);
     }
   }
 }

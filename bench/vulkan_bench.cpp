@@ -24,12 +24,12 @@
 #include <vector>
 
 #include "bench_data.hpp"
+#include "mmvk/backends.hpp"
 #include "mmvk/database.hpp"
-#include "mmvk/fast_search.hpp"
-#include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
+#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #endif
 
@@ -127,17 +127,24 @@ void run_cpu(benchmark::State& state, SearchBackend& backend, std::size_t batch)
   state.counters["rows_fraction"] = backend.stats().rows_fraction(db.frame_count());
 }
 
+void run_cpu_backend(benchmark::State& state, const BackendSpec& spec, const Database& db, std::size_t batch) {
+  Result<std::unique_ptr<SearchBackend>> backend = make_backend(spec, db);
+  if (!backend) {
+    state.SkipWithError(backend.message().c_str());
+    return;
+  }
+  run_cpu(state, **backend, batch);
+}
+
 void BM_Reference(benchmark::State& state) {
   const Database& db = database_for(std::uint32_t(state.range(0)), std::uint32_t(state.range(1)));
-  ReferenceSearch reference(db);
-  run_cpu(state, reference, std::size_t(state.range(2)));
+  run_cpu_backend(state, BackendSpec{.name = "reference"}, db, std::size_t(state.range(2)));
 }
 
 void BM_FastBrute(benchmark::State& state) {
   const Database& db = database_for(std::uint32_t(state.range(0)), std::uint32_t(state.range(1)));
   ThreadPool pool(2);
-  FastSearch fast(db, pool, FastSearchOptions{.prune = false});
-  run_cpu(state, fast, std::size_t(state.range(2)));
+  run_cpu_backend(state, BackendSpec{.name = "fast-brute", .pool = &pool}, db, std::size_t(state.range(2)));
 }
 
 #if defined(MMVK_HAS_VULKAN)
@@ -169,28 +176,32 @@ void run_vulkan(benchmark::State& state, const Database& db, std::size_t batch, 
     state.SkipWithError(("no Vulkan device: " + vk.error).c_str());
     return;
   }
-  vulkan::VulkanSearchOptions options;
-  options.max_batch = std::uint32_t(batch);
-  options.max_k = 1;
-  options.max_tile = max_tile;
-  Result<std::unique_ptr<vulkan::VulkanSearch>> search = vulkan::VulkanSearch::create(*vk.context, db, options);
-  if (!search) {
-    state.SkipWithError(search.message().c_str());
+  BackendRegistry registry;
+  if (Status added = vulkan::add_backends(registry, *vk.context); !added) {
+    state.SkipWithError(added.message().c_str());
     return;
   }
+  const BackendSpec spec{.name = "vulkan-brute", .max_batch = std::uint32_t(batch), .max_k = 1, .max_tile = max_tile};
+  Result<std::unique_ptr<SearchBackend>> made = registry.make(spec, db);
+  if (!made) {
+    state.SkipWithError(made.message().c_str());
+    return;
+  }
+  // The registry makes a VulkanSearch; its kernel timestamps are Vulkan's own.
+  auto* search = static_cast<vulkan::VulkanSearch*>(made->get());
   const std::vector<float> queries = make_queries(db, batch);
   std::vector<Match> out(batch);
   double kernel_seconds = 0.0;
   const double cpu_start = process_cpu_seconds();
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
-    const Status status = (*search)->search(QueryBatch{queries, {}, batch}, 1, out);
+    const Status status = search->search(QueryBatch{queries, {}, batch}, 1, out);
     const auto end = std::chrono::steady_clock::now();
     if (!status) {
       state.SkipWithError(status.message().c_str());
       break;
     }
-    const double kernel = (*search)->last_kernel_seconds().value_or(std::chrono::duration<double>(end - start).count());
+    const double kernel = search->last_kernel_seconds().value_or(std::chrono::duration<double>(end - start).count());
     kernel_seconds += kernel;
     if (kernel_time) state.SetIterationTime(kernel);
   }
@@ -199,7 +210,7 @@ void run_vulkan(benchmark::State& state, const Database& db, std::size_t batch, 
   state.counters["G_rowdims_per_cpu_s"] =
       double(state.iterations()) * double(batch) * db.frame_count() * db.dims() * 1e-9 / cpu_seconds;
   state.counters["kernel_ms"] = benchmark::Counter(kernel_seconds * 1e3 / double(std::max<std::int64_t>(state.iterations(), 1)));
-  state.counters["rows_fraction"] = (*search)->stats().rows_fraction(db.frame_count());
+  state.counters["rows_fraction"] = search->stats().rows_fraction(db.frame_count());
 }
 
 void run_vulkan_synthetic(benchmark::State& state, bool kernel_time) {
@@ -246,8 +257,7 @@ void BM_RealFastBrute(benchmark::State& state) {
     return;
   }
   ThreadPool pool(2);
-  FastSearch fast(*db, pool, FastSearchOptions{.prune = false});
-  run_cpu(state, fast, std::size_t(state.range(1)));
+  run_cpu_backend(state, BackendSpec{.name = "fast-brute", .pool = &pool}, *db, std::size_t(state.range(1)));
 }
 
 BENCHMARK(BM_RealFastBrute)

@@ -1,5 +1,5 @@
-// The Vulkan cluster modes (ClustersExact, NProbe 4/16) beside the Vulkan
-// brute force, the CPU ClusterSearch and the fast CPU brute force, on the
+// The Vulkan cluster backends (vulkan-clusters, vulkan-nprobe 4/16) beside
+// vulkan-brute, the CPU clusters and fast-brute, on the
 // real databases of bench_data.hpp, with the cluster table trained by
 // train_cluster_table(db, KMeansParams{}) (round(sqrt(N)) clusters).
 //
@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/fast_search.hpp"
+#include "mmvk/backends.hpp"
 #include "mmvk/thread_pool.hpp"
+#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "query_streams.hpp"
 
@@ -33,8 +33,16 @@ constexpr std::size_t kQueries = 1024;
 constexpr QueryStream kStreams[] = {QueryStream::Continue, QueryStream::Transition, QueryStream::Uniform};
 constexpr DataSet kSets[] = {DataSet::Locomotion, DataSet::Volume, DataSet::VolumeMirrored};
 constexpr std::uint32_t kBatches[] = {1, 64, 1024};
-const char* const kBackends[] = {"fast-brute",      "cpu-clusters",   "vulkan-brute",
-                                 "vulkan-clusters", "vulkan-nprobe4", "vulkan-nprobe16"};
+// The rows: registry backends (mmvk/backends.hpp) by name, with the nprobe
+// of the *-nprobe ones in the label.
+struct Variant {
+  const char* label;
+  const char* backend;
+  std::uint32_t nprobe = 4;
+};
+constexpr Variant kVariants[] = {{"fast-brute", "fast-brute"},           {"clusters", "clusters"},
+                                 {"vulkan-brute", "vulkan-brute"},       {"vulkan-clusters", "vulkan-clusters"},
+                                 {"vulkan-nprobe4", "vulkan-nprobe", 4}, {"vulkan-nprobe16", "vulkan-nprobe", 16}};
 
 vulkan::Context* shared_context() {
   static std::unique_ptr<vulkan::Context> context;
@@ -80,50 +88,38 @@ Setup* setup_for(DataSet set) {
     return nullptr;
   }
   s.table = std::move(table).value();
-  FastSearch exact(*db, s.pool, FastSearchOptions{.prune = false});
+  Result<std::unique_ptr<SearchBackend>> exact = make_backend(BackendSpec{.name = "fast-brute", .pool = &s.pool}, *db);
+  if (!exact.ok()) return nullptr;
   for (const QueryStream stream : kStreams) {
     s.queries[stream] = make_queries(*db, stream, kQueries);
     std::vector<Match> out(kQueries);
-    if (!exact.search({s.queries[stream], {}, kQueries}, 1, out).ok()) return nullptr;
+    if (!(*exact)->search({s.queries[stream], {}, kQueries}, 1, out).ok()) return nullptr;
     for (const Match& m : out) s.truth[stream].push_back(m.frame);
   }
   s.db = db;
   return &s;
 }
 
-Result<std::unique_ptr<SearchBackend>> make_backend(Setup& s, const std::string& name) {
-  if (name == "fast-brute") {
-    return std::unique_ptr<SearchBackend>(std::make_unique<FastSearch>(*s.db, s.pool, FastSearchOptions{.prune = false}));
-  }
-  if (name == "cpu-clusters") {
-    Result<std::unique_ptr<ClusterSearch>> backend = ClusterSearch::create(*s.db, s.table, s.pool);
-    if (!backend.ok()) return backend.error();
-    return std::unique_ptr<SearchBackend>(std::move(backend).value());
-  }
+Result<std::unique_ptr<SearchBackend>> make_variant(Setup& s, const Variant& variant) {
+  BackendRegistry registry = cpu_backends();
   vulkan::Context* context = shared_context();
-  if (context == nullptr) return make_error("no Vulkan device");
-  vulkan::VulkanSearchOptions options;
-  options.max_batch = kQueries;
-  options.max_k = 1;
-  if (name == "vulkan-clusters") options.mode = vulkan::SearchMode::ClustersExact;
-  if (name == "vulkan-nprobe4" || name == "vulkan-nprobe16") {
-    options.mode = vulkan::SearchMode::NProbe;
-    options.nprobe = name == "vulkan-nprobe4" ? 4 : 16;
-  }
-  Result<std::unique_ptr<vulkan::VulkanSearch>> backend = vulkan::VulkanSearch::create(*context, *s.db, options, &s.table);
-  if (!backend.ok()) return backend.error();
-  return std::unique_ptr<SearchBackend>(std::move(backend).value());
+  if (context != nullptr) MMVK_TRY(vulkan::add_backends(registry, *context));
+  BackendSpec spec{.name = variant.backend, .pool = &s.pool, .clusters = &s.table};
+  spec.nprobe = variant.nprobe;
+  spec.max_batch = kQueries;
+  spec.max_k = 1;
+  return registry.make(spec, *s.db);
 }
 
-void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& name, std::uint32_t batch) {
+void run(benchmark::State& state, DataSet set, QueryStream stream, const Variant& variant, std::uint32_t batch) {
   Setup* s = setup_for(set);
   if (s == nullptr) {
     state.SkipWithError("database unavailable");
     return;
   }
-  std::unique_ptr<SearchBackend>& backend = s->backends[name];
+  std::unique_ptr<SearchBackend>& backend = s->backends[variant.label];
   if (!backend) {
-    Result<std::unique_ptr<SearchBackend>> made = make_backend(*s, name);
+    Result<std::unique_ptr<SearchBackend>> made = make_variant(*s, variant);
     if (!made.ok()) {
       state.SkipWithError(made.message().c_str());
       return;
@@ -159,13 +155,13 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, const std::st
 const bool registered = [] {
   for (const DataSet set : kSets) {
     for (const QueryStream stream : kStreams) {
-      for (const char* backend : kBackends) {
+      for (const Variant& variant : kVariants) {
         for (const std::uint32_t batch : kBatches) {
           const std::string name = "vclusters/" + std::string(data_set_name(set)) + "/" +
-                                   std::string(query_stream_name(stream)) + "/" + backend + "/B:" +
+                                   std::string(query_stream_name(stream)) + "/" + variant.label + "/B:" +
                                    std::to_string(batch);
           benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& state) {
-            run(state, set, stream, backend, batch);
+            run(state, set, stream, variant, batch);
           })->UseRealTime()->MinTime(0.3);
         }
       }

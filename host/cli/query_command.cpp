@@ -10,19 +10,17 @@
 
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "mmvk/cluster_search.hpp"
+#include "mmvk/backends.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/explain.hpp"
-#include "mmvk/fast_search.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/query_builder.hpp"
-#include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
+#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/context.hpp"
-#include "mmvk/vulkan/vulkan_search.hpp"
 #endif
 
 namespace mmvk::cli {
@@ -39,12 +37,12 @@ constexpr const char* kQueryUsage =
     "the database's offsets and scales, or already normalized with --normalized.\n"
     "(--features is a synonym of --queries.)\n"
     "\n"
-    "backends: reference (the CPU oracle), fast (exact, box-pruned, default),\n"
-    "  fast-brute (exact brute force), clusters (exact, k-means cluster-pruned),\n"
-    "  nprobe (approximate: --nprobe N nearest clusters, default 4), and on the\n"
-    "  GPU vulkan (exact brute force), vulkan-clusters, vulkan-nprobe.\n"
+    "--backend NAME, one of:\n";
+
+constexpr const char* kQueryUsageOptions =
     "  The cluster backends load --clusters table.mmkc when given, else train the\n"
-    "  tables with the default k-means parameters.\n"
+    "  tables with the default k-means parameters. --nprobe N: clusters searched\n"
+    "  per query by the *-nprobe backends (default 4).\n"
     "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores.\n"
     "\n"
     "query options (applied to every query):\n"
@@ -68,95 +66,74 @@ std::vector<std::string> split_list(const std::string& text) {
   return items;
 }
 
+#if defined(MMVK_HAS_VULKAN)
+using ContextHolder = std::unique_ptr<vulkan::Context>;
+#else
+struct ContextHolder {};
+#endif
+
+// Everything a backend borrows, declared before it so that it outlives it.
 struct BackendHolder {
   ThreadPool pool;
-  ClusterTable table;
-#if defined(MMVK_HAS_VULKAN)
-  std::unique_ptr<vulkan::Context> context;  // declared before the backend that uses it
-#endif
+  std::optional<ClusterTable> table;
+  ContextHolder context;  // created when a Vulkan backend is made
   std::unique_ptr<SearchBackend> backend;
   explicit BackendHolder(unsigned threads) : pool(threads) {}
 };
 
-Status load_or_train_clusters(BackendHolder& holder, const Database& db, const ParsedArgs& args) {
-  if (const auto path = args.value("--clusters")) {
-    Result<ClusterTable> table = load_cluster_table(*path);
-    if (!table) return table.status();
-    holder.table = std::move(table.value());
-    return {};
-  }
-  std::fputs("mmvk query: training k-means cluster tables (default parameters; pass --clusters to reuse)\n", stderr);
-  Result<ClusterTable> table = train_cluster_table(db, KMeansParams{});
-  if (!table) return table.status();
-  holder.table = std::move(table.value());
-  return {};
-}
-
-Result<std::uint32_t> nprobe_option(const ParsedArgs& args) {
-  std::uint32_t nprobe = 4;
-  if (const auto text = args.value("--nprobe")) {
-    MMVK_ASSIGN_OR_RETURN(nprobe, parse_u32("--nprobe", *text, 1));
-  }
-  return nprobe;
-}
-
+// The CPU backends, and the Vulkan ones when built with Vulkan. The Vulkan
+// context is created into `context` only when one of them is made, so
+// listing them (--help) needs no device.
+BackendRegistry query_backends([[maybe_unused]] ContextHolder& context) {
+  BackendRegistry registry = cpu_backends();
 #if defined(MMVK_HAS_VULKAN)
-Status make_vulkan_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args,
-                           std::size_t batch, std::uint32_t k) {
-  vulkan::VulkanSearchOptions options;
-  options.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
-  options.max_k = k;
-  // One search per run: warming up every kernel variant would compile (on
-  // lavapipe, for seconds) kernels this run never uses.
-  options.warm_up = false;
-  const ClusterTable* clusters = nullptr;
-  if (name != "vulkan") {
-    MMVK_TRY(load_or_train_clusters(holder, db, args));
-    clusters = &holder.table;
-    options.mode = name == "vulkan-clusters" ? vulkan::SearchMode::ClustersExact : vulkan::SearchMode::NProbe;
-    Result<std::uint32_t> nprobe = nprobe_option(args);
-    if (!nprobe) return nprobe.status();
-    options.nprobe = *nprobe;
-  }
-  Result<std::unique_ptr<vulkan::Context>> context = vulkan::Context::create();
-  if (!context) return context.status();
-  holder.context = std::move(context.value());
-  Result<std::unique_ptr<vulkan::VulkanSearch>> made = vulkan::VulkanSearch::create(*holder.context, db, options, clusters);
-  if (!made) return made.status();
-  holder.backend = std::move(made.value());
-  return {};
-}
+  const Status added = vulkan::add_backends(registry, [&context]() -> Result<vulkan::Context*> {
+    if (!context) {
+      MMVK_ASSIGN_OR_RETURN(context, vulkan::Context::create());
+    }
+    return context.get();
+  });
+  // The CPU and Vulkan names are distinct; a clash is a bug in mmvk itself.
+  if (!added) std::fprintf(stderr, "mmvk query: %s\n", added.message().c_str());
 #endif
+  return registry;
+}
+
+std::string usage_text() {
+  ContextHolder unused;
+  std::string text = kQueryUsage;
+  const BackendRegistry registry = query_backends(unused);
+  for (const BackendEntry& entry : registry.entries()) {
+    text += "  " + entry.name + std::string(entry.name.size() < 17 ? 17 - entry.name.size() : 1, ' ') +
+            entry.description + "\n";
+  }
+  return text + "  (default " + BackendSpec{}.name + ")\n" + kQueryUsageOptions;
+}
 
 Status make_backend(BackendHolder& holder, const Database& db, const std::string& name, const ParsedArgs& args,
                     std::size_t batch, std::uint32_t k) {
-  if (name == "reference") {
-    holder.backend = std::make_unique<ReferenceSearch>(db);
-  } else if (name == "fast" || name == "fast-brute") {
-    holder.backend = std::make_unique<FastSearch>(db, holder.pool, FastSearchOptions{.prune = name == "fast"});
-  } else if (name == "clusters" || name == "nprobe") {
-    MMVK_TRY(load_or_train_clusters(holder, db, args));
-    ClusterSearchOptions options;
-    if (name == "nprobe") {
-      Result<std::uint32_t> nprobe = nprobe_option(args);
-      if (!nprobe) return nprobe.status();
-      options.nprobe = *nprobe;
-    }
-    Result<std::unique_ptr<ClusterSearch>> made = ClusterSearch::create(db, holder.table, holder.pool, options);
-    if (!made) return made.status();
-    holder.backend = std::move(made.value());
-  } else if (name == "vulkan" || name == "vulkan-clusters" || name == "vulkan-nprobe") {
-#if defined(MMVK_HAS_VULKAN)
-    return make_vulkan_backend(holder, db, name, args, batch, k);
-#else
-    (void)batch;
-    (void)k;
-    return make_error("backend '" + name + "': this mmvk was built without Vulkan (MMVK_BUILD_VULKAN=OFF)");
-#endif
-  } else {
-    return make_error("unknown backend '" + name +
-                      "' (reference, fast, fast-brute, clusters, nprobe, vulkan, vulkan-clusters, vulkan-nprobe)");
+  const BackendRegistry registry = query_backends(holder.context);
+  BackendSpec spec;
+  spec.name = name;
+  spec.pool = &holder.pool;
+  spec.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
+  spec.max_k = k;
+  // One search per run: warming up every kernel variant would compile (on
+  // lavapipe, for seconds) kernels this run never uses.
+  spec.warm_up = false;
+  if (const auto text = args.value("--nprobe")) {
+    MMVK_ASSIGN_OR_RETURN(spec.nprobe, parse_u32("--nprobe", *text, 1));
   }
+  const BackendEntry* entry = registry.find(name);
+  if (entry != nullptr && entry->uses_cluster_table) {
+    if (const auto path = args.value("--clusters")) {
+      MMVK_ASSIGN_OR_RETURN(holder.table, load_cluster_table(*path));
+      spec.clusters = &*holder.table;
+    } else {
+      std::fputs("mmvk query: training k-means cluster tables (default parameters; pass --clusters to reuse)\n", stderr);
+    }
+  }
+  MMVK_ASSIGN_OR_RETURN(holder.backend, registry.make(spec, db));
   return {};
 }
 
@@ -218,12 +195,12 @@ int run_query(Args args) {
                                  {"--normalized", "--explain", "--help", "-h"});
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
-    std::fputs(kQueryUsage, stdout);
+    std::fputs(usage_text().c_str(), stdout);
     return 0;
   }
   const auto queries_path = parsed->value("--queries") ? parsed->value("--queries") : parsed->value("--features");
   if (parsed->positional.size() != 1 || !queries_path) {
-    std::fputs(kQueryUsage, stderr);
+    std::fputs(usage_text().c_str(), stderr);
     return 2;
   }
   auto fail = [](const std::string& message) { return report_error("query", message, 1); };
@@ -256,7 +233,7 @@ int run_query(Args args) {
   const std::vector<QueryParams> all_params(count, *params);
 
   BackendHolder holder(threads);
-  const std::string backend_name = parsed->value("--backend").value_or("fast");
+  const std::string backend_name = parsed->value("--backend").value_or(BackendSpec{}.name);
   const Status made = make_backend(holder, *db, backend_name, *parsed, count, k);
   if (!made) return fail(made.message());
   std::vector<Match> results(count * k);

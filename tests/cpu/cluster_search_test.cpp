@@ -266,8 +266,9 @@ TEST(ClusterSearch, PicksTheSameKernelsAsFastSearch) {
   for (bool baseline : {false, true}) {
     auto clusters = ClusterSearch::create(db, table, pool, {.baseline_kernels = baseline});
     ASSERT_TRUE(clusters.ok());
-    FastSearch fast(db, pool, {.baseline_kernels = baseline});
-    EXPECT_EQ((*clusters)->kernel_name(), fast.kernel_name());
+    auto fast = FastSearch::create(db, pool, {.baseline_kernels = baseline});
+    ASSERT_TRUE(fast.ok());
+    EXPECT_EQ((*clusters)->kernel_name(), (*fast)->kernel_name());
     std::string expected = "generic";
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
     __builtin_cpu_init();

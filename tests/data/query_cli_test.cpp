@@ -103,10 +103,10 @@ TEST_F(QueryCli, ExactBackendsWriteTheReferenceResults) {
   ASSERT_EQ(reference.exit_code, 0) << reference.output;
   const std::string expected = result_lines(dir_ / "reference.tsv");
   ASSERT_EQ(std::count(expected.begin(), expected.end(), '\n'), 23);
-  std::vector<std::string> backends = {"fast", "fast-brute", "clusters"};
+  std::vector<std::string> backends = {"fast-box", "fast-brute", "clusters"};
   // CI sets MMVK_REQUIRE_VULKAN=1; elsewhere a machine may have no device.
   const char* require_vulkan = std::getenv("MMVK_REQUIRE_VULKAN");
-  if (require_vulkan && std::string(require_vulkan) == "1") backends.push_back("vulkan");
+  if (require_vulkan && std::string(require_vulkan) == "1") backends.push_back("vulkan-brute");
   for (const std::string& backend : backends) {
     const fs::path out = dir_ / (backend + ".tsv");
     const CommandResult result = run(common + " --backend " + backend + " --out " + out.string());
@@ -132,6 +132,26 @@ TEST_F(QueryCli, BadQueryFilesAreNamed) {
   EXPECT_NE(bad_backend.output.find("unknown backend 'nonsense'"), std::string::npos) << bad_backend.output;
 }
 
+// --help lists the backend registry itself: every name a --backend accepts.
+TEST_F(QueryCli, HelpListsTheRegistry) {
+  const CommandResult help = run(mmvk_ + " query --help");
+  ASSERT_EQ(help.exit_code, 0) << help.output;
+  for (const char* name : {"reference", "fast-brute", "fast-box", "clusters", "clusters-nprobe"}) {
+    EXPECT_NE(help.output.find(std::string("\n  ") + name + " "), std::string::npos) << name << "\n" << help.output;
+  }
+  const char* require_vulkan = std::getenv("MMVK_REQUIRE_VULKAN");
+  if (require_vulkan && std::string(require_vulkan) == "1") {
+    for (const char* name : {"vulkan-brute", "vulkan-clusters", "vulkan-nprobe"}) {
+      EXPECT_NE(help.output.find(std::string("\n  ") + name + " "), std::string::npos) << name;
+    }
+  }
+  // The old names are gone: one name per backend.
+  const CommandResult old = run(mmvk_ + " query " + db_ + " --queries " + write_queries(1, 27).string() +
+                                " --backend nprobe");
+  EXPECT_NE(old.exit_code, 0);
+  EXPECT_NE(old.output.find("clusters-nprobe"), std::string::npos) << old.output;
+}
+
 }  // namespace
 }  // namespace mmvk
 
@@ -145,10 +165,11 @@ TEST_F(QueryCli, NumbersAreParsedStrictlyAndNamed) {
   const std::string query = mmvk_ + " query " + db_ + " --queries " + write_queries(2, 27).string() + " --normalized";
   const std::pair<const char*, const char*> bad[] = {
       {"--k", "2.5"},        {"--k", "0"},        {"--threads", "-1"},          {"--threads", "2x"},
-      {"--continuing", "1e3"}, {"--continuing-bias", "nan"}, {"--exclusion-window", ""},
+      {"--nprobe", "0"},     {"--continuing", "1e3"}, {"--continuing-bias", "nan"}, {"--exclusion-window", ""},
       {"--frames", "4,x"}};
   for (const auto& [option, value] : bad) {
     std::string command = query + " " + option + "='" + value + "'";
+    if (std::string(option) == "--nprobe") command += " --backend clusters-nprobe";
     if (std::string(option) == "--frames") command += " --explain";
     const CommandResult result = run(command);
     EXPECT_NE(result.exit_code, 0) << command;

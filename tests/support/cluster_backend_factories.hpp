@@ -1,41 +1,30 @@
 // Factories of the cluster-pruned CPU backend for the typed backend suites
-// (backend_suite.hpp, backend_data_suite.hpp). Each trains a table per
-// database with round(sqrt(frames)) clusters.
+// (backend_suite.hpp, backend_data_suite.hpp), made through the backend
+// registry. Each trains a table per database with round(sqrt(frames))
+// clusters (cluster_table_cache.hpp).
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <memory>
 
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/backends.hpp"
+#include "support/cluster_table_cache.hpp"
 
 namespace mmvk::test {
 
+// NProbe 0: exact ("clusters"); else "clusters-nprobe" with that nprobe.
 template <std::uint32_t NProbe, bool Box = true, bool Radius = false>
 struct ClusterFactory {
-  // The table must outlive the backend: the factory owns both its pool and
-  // the tables it trained, one per database (tests make many backends over
-  // the same database; training dominates in sanitizer builds).
-  ThreadPool pool{2};
-  std::map<std::uint64_t, std::unique_ptr<ClusterTable>> tables;
+  // The cache owns the pool the backends run on and the tables.
+  ClusterTableCache tables;
 
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
-    std::unique_ptr<ClusterTable>& table = tables[db.content_hash()];
-    if (!table) {
-      KMeansParams params;
-      params.iterations = 10;  // exactness does not depend on the clustering's quality
-      Result<ClusterTable> trained = train_cluster_table(db, params, pool);
-      if (!trained.ok()) return trained.error();
-      table = std::make_unique<ClusterTable>(std::move(trained).value());
-    }
-    ClusterSearchOptions options;
-    options.nprobe = NProbe;
-    options.box_bound = Box;
-    options.radius_bound = Radius;
-    Result<std::unique_ptr<ClusterSearch>> backend = ClusterSearch::create(db, *table, pool, options);
-    if (!backend.ok()) return backend.error();
-    return std::unique_ptr<SearchBackend>(std::move(backend).value());
+    BackendSpec spec{.name = NProbe == 0 ? "clusters" : "clusters-nprobe", .pool = &tables.pool};
+    MMVK_ASSIGN_OR_RETURN(spec.clusters, tables.table_for(db));
+    spec.nprobe = NProbe;
+    spec.cluster.box_bound = Box;
+    spec.cluster.radius_bound = Radius;
+    return cpu_backends().make(spec, db);
   }
 };
 

@@ -1,18 +1,18 @@
 // Factories of the CPU backends for the typed backend suites
-// (backend_suite.hpp, backend_data_suite.hpp).
+// (backend_suite.hpp, backend_data_suite.hpp), made through the backend
+// registry (mmvk/backends.hpp) like every other user makes them.
 #pragma once
 
 #include <memory>
 
-#include "mmvk/fast_search.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/backends.hpp"
 #include "mmvk/thread_pool.hpp"
 
 namespace mmvk::test {
 
 struct ReferenceFactory {
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
-    return std::unique_ptr<SearchBackend>(std::make_unique<ReferenceSearch>(db));
+    return cpu_backends().make(BackendSpec{.name = "reference"}, db);
   }
 };
 
@@ -20,11 +20,10 @@ template <bool Prune, unsigned Threads, bool Baseline = false>
 struct FastFactory {
   ThreadPool pool{Threads};
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
-    FastSearchOptions options;
-    options.prune = Prune;
-    options.rows_per_block = 512;  // several cache blocks even on small test data
-    options.baseline_kernels = Baseline;
-    return std::unique_ptr<SearchBackend>(std::make_unique<FastSearch>(db, pool, options));
+    BackendSpec spec{.name = Prune ? "fast-box" : "fast-brute", .pool = &pool};
+    spec.fast.rows_per_block = 512;  // several cache blocks even on small test data
+    spec.fast.baseline_kernels = Baseline;
+    return cpu_backends().make(spec, db);
   }
 };
 

@@ -3,7 +3,8 @@
 // which must report zero messages.
 #include <memory>
 
-#include "mmvk/vulkan/vulkan_search.hpp"
+#include "mmvk/backends.hpp"
+#include "mmvk/vulkan/backends.hpp"
 #include "support/backend_suite.hpp"
 #include "vulkan_test_env.hpp"
 
@@ -13,12 +14,16 @@ namespace {
 template <bool Validation>
 struct VulkanFactory {
   std::unique_ptr<vulkan::Context> context;
+  BackendRegistry registry;  // made through the backend registry
   std::string error;
 
   VulkanFactory() {
     vulkan::ContextOptions options;
     options.validation = Validation;
     context = make_test_context(error, options);
+    if (context) {
+      if (Status added = vulkan::add_backends(registry, *context); !added) error = added.message();
+    }
   }
   ~VulkanFactory() {
     if (context && Validation) {
@@ -38,11 +43,8 @@ struct VulkanFactory {
 
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
     if (!context) return make_error(error);
-    vulkan::VulkanSearchOptions options;
-    options.warm_up = false;  // compile only the variants a test uses
-    Result<std::unique_ptr<vulkan::VulkanSearch>> search = vulkan::VulkanSearch::create(*context, db, options);
-    if (!search) return search.error();
-    return std::unique_ptr<SearchBackend>(std::move(search).value());
+    // warm_up off: compile only the variants a test uses.
+    return registry.make(BackendSpec{.name = "vulkan-brute", .warm_up = false}, db);
   }
 };
 

@@ -7,42 +7,33 @@
 #include <map>
 #include <memory>
 
+#include "mmvk/backends.hpp"
 #include "mmvk/cluster_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/backend_data_suite.hpp"
 #include "support/backend_suite.hpp"
+#include "support/cluster_table_cache.hpp"
 #include "vulkan_test_env.hpp"
 
 namespace mmvk::test {
 namespace {
 
-// Trains one table per database (10 Lloyd iterations: exactness does not
-// depend on the clustering's quality) and keeps it alive with the context.
-struct TableCache {
-  ThreadPool pool{2};
-  std::map<std::uint64_t, std::unique_ptr<ClusterTable>> tables;
-
-  Result<const ClusterTable*> table_for(const Database& db) {
-    std::unique_ptr<ClusterTable>& table = tables[db.content_hash()];
-    if (!table) {
-      KMeansParams params;
-      params.iterations = 10;
-      Result<ClusterTable> trained = train_cluster_table(db, params, pool);
-      if (!trained.ok()) return trained.error();
-      table = std::make_unique<ClusterTable>(std::move(trained).value());
-    }
-    return table.get();
-  }
-};
-
-template <vulkan::SearchMode Mode, std::uint32_t NProbe>
+// Made through the backend registry (mmvk::vulkan::add_backends); the
+// cache keeps one table per database alive with the context.
+template <bool Exact, std::uint32_t NProbe>
 struct VulkanClusterFactory {
-  TableCache tables;
+  ClusterTableCache tables;
   std::unique_ptr<vulkan::Context> context;
+  BackendRegistry registry;
   std::string error;
 
-  VulkanClusterFactory() { context = make_test_context(error); }
+  VulkanClusterFactory() {
+    context = make_test_context(error);
+    if (context) {
+      if (Status added = vulkan::add_backends(registry, *context); !added) error = added.message();
+    }
+  }
 
   std::string skip_reason() {
     if (context) return {};
@@ -55,20 +46,16 @@ struct VulkanClusterFactory {
 
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
     if (!context) return make_error(error);
-    Result<const ClusterTable*> table = tables.table_for(db);
-    if (!table) return table.error();
-    vulkan::VulkanSearchOptions options;
-    options.warm_up = false;  // compile only the variants a test uses
-    options.mode = Mode;
-    options.nprobe = NProbe;
-    Result<std::unique_ptr<vulkan::VulkanSearch>> search = vulkan::VulkanSearch::create(*context, db, options, *table);
-    if (!search) return search.error();
-    return std::unique_ptr<SearchBackend>(std::move(search).value());
+    BackendSpec spec{.name = Exact ? "vulkan-clusters" : "vulkan-nprobe"};
+    MMVK_ASSIGN_OR_RETURN(spec.clusters, tables.table_for(db));
+    spec.nprobe = NProbe;
+    spec.warm_up = false;  // compile only the variants a test uses
+    return registry.make(spec, db);
   }
 };
 
-using VulkanClustersExact = VulkanClusterFactory<vulkan::SearchMode::ClustersExact, 0>;
-using VulkanProbeAll = VulkanClusterFactory<vulkan::SearchMode::NProbe, 0xFFFFFFFFu>;
+using VulkanClustersExact = VulkanClusterFactory<true, 0>;
+using VulkanProbeAll = VulkanClusterFactory<false, 0xFFFFFFFFu>;
 using VulkanClusterBackends = ::testing::Types<VulkanClustersExact, VulkanProbeAll>;
 INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendSuite, VulkanClusterBackends);
 INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendDataSuite, VulkanClusterBackends);
@@ -79,7 +66,7 @@ INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendDataSuite, VulkanClusterBa
 TEST(VulkanClusterSearch, NProbeEqualsCpuNProbe) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 3000, .seed = 51, .constraints = true});
-  TableCache tables;
+  ClusterTableCache tables;
   Result<const ClusterTable*> table = tables.table_for(db);
   ASSERT_TRUE(table.ok()) << table.message();
   const std::vector<float> queries = synthetic_queries(db, 64, 52);
@@ -116,7 +103,7 @@ TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
   context_options.validation = true;
   MMVK_VULKAN_CONTEXT(context, context_options);
   const Database db = synthetic_database({.frames = 4000, .seed = 55, .constraints = true});
-  TableCache tables;
+  ClusterTableCache tables;
   Result<const ClusterTable*> table = tables.table_for(db);
   ASSERT_TRUE(table.ok()) << table.message();
   vulkan::VulkanSearchOptions options;
@@ -142,7 +129,7 @@ TEST(VulkanClusterSearch, CreationErrors) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 1000, .seed = 59});
   const Database other = synthetic_database({.frames = 1000, .seed = 60});
-  TableCache tables;
+  ClusterTableCache tables;
   Result<const ClusterTable*> table = tables.table_for(db);
   ASSERT_TRUE(table.ok()) << table.message();
   vulkan::VulkanSearchOptions options;

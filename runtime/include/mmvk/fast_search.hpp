@@ -43,13 +43,15 @@ struct FastSearchOptions {
 
 class FastSearch final : public SearchBackend {
  public:
-  // `database` and `pool` must outlive the backend; the pool may be shared
-  // with other work but serves one search() at a time. search() itself is
-  // not reentrant (it reuses per-thread scratch): one call at a time.
-  FastSearch(const Database& database, ThreadPool& pool, FastSearchOptions options = {});
+  // Copies the features into the tiled layout. `database` and `pool` must
+  // outlive the backend; the pool may be shared with other work but serves
+  // one search() at a time. search() itself is not reentrant (it reuses
+  // per-thread scratch): one call at a time.
+  static Result<std::unique_ptr<FastSearch>> create(const Database& database, ThreadPool& pool,
+                                                    FastSearchOptions options = {});
   ~FastSearch() override;
 
-  std::string_view name() const override { return options_.prune ? "fast" : "fast-brute"; }
+  std::string_view name() const override { return options_.prune ? "fast-box" : "fast-brute"; }
   const Database& database() const override { return *database_; }
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
   SearchStats stats() const override;
@@ -63,6 +65,7 @@ class FastSearch final : public SearchBackend {
   struct Workspace;  // per-thread scratch, allocated once (fast_search.cpp)
 
  private:
+  FastSearch(const Database& database, ThreadPool& pool, FastSearchOptions options);
   void search_range(const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
                     std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best, unsigned thread);
 

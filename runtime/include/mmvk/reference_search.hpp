@@ -3,13 +3,20 @@
 // obviously right, not fast.
 #pragma once
 
+#include <memory>
+
 #include "mmvk/search.hpp"
 
 namespace mmvk {
 
 class ReferenceSearch final : public SearchBackend {
  public:
+  // `database` must outlive the backend. Never fails; create() is the form
+  // the backend registry uses, like every other backend's.
   explicit ReferenceSearch(const Database& database) : database_(&database) {}
+  static Result<std::unique_ptr<ReferenceSearch>> create(const Database& database) {
+    return std::make_unique<ReferenceSearch>(database);
+  }
 
   std::string_view name() const override { return "reference"; }
   const Database& database() const override { return *database_; }

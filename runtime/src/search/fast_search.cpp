@@ -43,6 +43,13 @@ FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOpt
   for (Workspace::Thread& thread : workspace_->threads) thread.group_order.reserve(layout_->groups);
 }
 
+Result<std::unique_ptr<FastSearch>> FastSearch::create(const Database& database, ThreadPool& pool,
+                                                       FastSearchOptions options) {
+  // Every option value is usable (rows_per_block rounds up to a group), so
+  // there is nothing to refuse yet; the Result keeps one way to make backends.
+  return std::unique_ptr<FastSearch>(new FastSearch(database, pool, options));
+}
+
 FastSearch::~FastSearch() = default;
 
 SearchStats FastSearch::stats() const { return stats_; }

@@ -291,7 +291,7 @@ std::string_view VulkanSearch::name() const {
     case SearchMode::NProbe: return "vulkan-nprobe";
     case SearchMode::BruteForce: break;
   }
-  return "vulkan-brute-force";
+  return "vulkan-brute";
 }
 const Database& VulkanSearch::database() const { return *impl_->database; }
 SearchStats VulkanSearch::stats() const { return impl_->stats; }

@@ -102,11 +102,7 @@ BackendRegistry query_backends([[maybe_unused]] ContextHolder& context) {
 std::string usage_text() {
   ContextHolder unused;
   std::string text = kQueryUsage;
-  const BackendRegistry registry = query_backends(unused);
-  for (const BackendEntry& entry : registry.entries()) {
-    text += "  " + entry.name + std::string(entry.name.size() < 17 ? 17 - entry.name.size() : 1, ' ') +
-            entry.description + "\n";
-  }
+  text += query_backends(unused).help();
   return text + "  (default " + BackendSpec{}.name + ")\n" + kQueryUsageOptions;
 }
 

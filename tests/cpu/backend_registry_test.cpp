@@ -4,6 +4,7 @@
 // duplicate entry) are errors, not crashes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <set>
 #include <string>
@@ -41,6 +42,11 @@ TEST(BackendRegistry, EveryCpuNameRoundTripsThroughName) {
   }
   EXPECT_EQ(names, expected);
   EXPECT_EQ(registry.names(), "reference, fast-brute, fast-box, clusters, clusters-nprobe");
+  // help(): one padded line per entry, in order.
+  const std::string help = registry.help("  ");
+  EXPECT_EQ(std::count(help.begin(), help.end(), '\n'), 5);
+  EXPECT_EQ(help.find("  reference        " + registry.find("reference")->description + "\n"), 0u) << help;
+  EXPECT_NE(help.find("\n  clusters-nprobe  "), std::string::npos) << help;
 }
 
 TEST(BackendRegistry, UnknownNameListsTheKnownOnes) {

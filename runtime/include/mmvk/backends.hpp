@@ -81,6 +81,9 @@ class BackendRegistry {
   const BackendEntry* find(std::string_view name) const;
   // "reference, fast-brute, ..." in order.
   std::string names() const;
+  // One line per backend, "<indent><name>  <description>\n", names padded
+  // to one column: the list a host's --help prints.
+  std::string help(std::string_view indent = "  ") const;
 
   // Makes spec.name over `database`; an unknown name is an error that lists
   // the known ones.

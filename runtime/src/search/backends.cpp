@@ -1,5 +1,6 @@
 #include "mmvk/backends.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "mmvk/reference_search.hpp"
@@ -64,6 +65,17 @@ const BackendEntry* BackendRegistry::find(std::string_view name) const {
 std::string BackendRegistry::names() const {
   std::string text;
   for (const BackendEntry& entry : entries_) text += (text.empty() ? "" : ", ") + entry.name;
+  return text;
+}
+
+std::string BackendRegistry::help(std::string_view indent) const {
+  std::size_t width = 0;
+  for (const BackendEntry& entry : entries_) width = std::max(width, entry.name.size());
+  std::string text;
+  for (const BackendEntry& entry : entries_) {
+    text.append(indent).append(entry.name).append(width + 2 - entry.name.size(), ' ');
+    text.append(entry.description).append("\n");
+  }
   return text;
 }
 

@@ -17,10 +17,11 @@ inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\f' || c ==
 inline bool is_line_break(char c) { return c == '\n' || c == '\r'; }
 inline bool is_space(char c) { return is_blank(c) || is_line_break(c); }
 
-// Parses a whole token as a finite float. Accepts what strtof accepts for
-// decimal numbers (".0083333", "-2.47945e-15", "1.", a leading '+'), but not
-// "inf", "nan" or hexadecimal floats.
-inline std::optional<float> parse_float(std::string_view token) {
+// Parses a whole token as a finite float or double. Accepts what strtof
+// accepts for decimal numbers (".0083333", "-2.47945e-15", "1.", a leading
+// '+'), but not "inf", "nan" or hexadecimal floats.
+template <class Real>
+std::optional<Real> parse_real(std::string_view token) {
   const char* first = token.data();
   const char* last = token.data() + token.size();
   const bool plus = first != last && *first == '+';
@@ -28,25 +29,14 @@ inline std::optional<float> parse_float(std::string_view token) {
   if (first == last) return std::nullopt;
   const char lead = !plus && *first == '-' && first + 1 != last ? first[1] : *first;
   if (!((lead >= '0' && lead <= '9') || lead == '.')) return std::nullopt;  // rejects inf/nan
-  float value = 0.0f;
+  Real value = 0;
   const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
   if (error != std::errc{} || end != last || !std::isfinite(value)) return std::nullopt;
   return value;
 }
 
-inline std::optional<double> parse_double(std::string_view token) {
-  const char* first = token.data();
-  const char* last = token.data() + token.size();
-  const bool plus = first != last && *first == '+';
-  if (plus) ++first;
-  if (first == last) return std::nullopt;
-  const char lead = !plus && *first == '-' && first + 1 != last ? first[1] : *first;
-  if (!((lead >= '0' && lead <= '9') || lead == '.')) return std::nullopt;
-  double value = 0.0;
-  const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
-  if (error != std::errc{} || end != last || !std::isfinite(value)) return std::nullopt;
-  return value;
-}
+inline std::optional<float> parse_float(std::string_view token) { return parse_real<float>(token); }
+inline std::optional<double> parse_double(std::string_view token) { return parse_real<double>(token); }
 
 // Clinger's fast path for the common case: a plain decimal ("-375.227000",
 // no exponent) with at most 7 significant digits (trailing fraction zeros do

@@ -28,6 +28,8 @@ constexpr const char* kBuildUsage =
     "  --mirror               also add a mirrored copy of every clip\n"
     "  --edge-rule RULE       exclude | clamp (overrides the manifest's)\n"
     "  --threads N            threads loading clips (default 0: all cores)\n"
+    "  --no-animation         store features only (no skeleton, poses, root motion or contacts)\n"
+    "  --quantize-rotations   store joint rotations as 16-bit integers (8 instead of 16 bytes per joint)\n"
     "  --progress             show the progress bar even when stderr is not a terminal\n"
     "  --no-progress          never show it\n";
 
@@ -52,7 +54,7 @@ void draw_progress(const BuildProgress& progress) {
 
 int run_build(Args args) {
   const auto parsed = parse_args("build", args, {"-o", "--output", "--fps", "--schema", "--edge-rule", "--threads"},
-                                 {"--mirror", "--progress", "--no-progress", "--help", "-h"});
+                                 {"--mirror", "--progress", "--no-progress", "--no-animation", "--quantize-rotations", "--help", "-h"});
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
     std::fputs(kBuildUsage, stdout);
@@ -105,6 +107,8 @@ int run_build(Args args) {
   ThreadPool pool(threads);
   BuildOptions options;
   options.pool = &pool;
+  options.animation.enabled = !parsed->has("--no-animation");
+  if (parsed->has("--quantize-rotations")) options.animation.encoding = RotationEncoding::Quantized16;
   const bool show_progress =
       !parsed->has("--no-progress") && (parsed->has("--progress") || stderr_is_terminal());
   if (show_progress) options.progress = draw_progress;

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/normalization.hpp"
+#include "animation_report.hpp"
 
 namespace mmvk::cli {
 
@@ -114,6 +115,7 @@ int run_inspect(Args args) {
       }
       out["channels"].push_back(std::move(ch));
     }
+    out["animation"] = animation_json(db);
     out["clips"] = nlohmann::json::array();
     for (const Clip& clip : db.clips()) {
       out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
@@ -129,6 +131,7 @@ int run_inspect(Args args) {
               thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()), db.clips().size(), mirrored,
               looping, db.dims(), double(db.fps()));
   std::printf("content hash: %016" PRIx64 "\n", db.content_hash());
+  print_animation(db);
   std::printf("frame flags: %s do_not_use, %s block_transition, %s edge_excluded; %s candidate frames\n",
               thousands(do_not_use).c_str(), thousands(block).c_str(), thousands(edge).c_str(),
               thousands(candidates).c_str());

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "mmvk/animation_data.hpp"
 #include "mmvk/database.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/motion.hpp"
@@ -43,12 +44,21 @@ struct BuildProgress {
   std::uint64_t frames_done = 0;  // database frames produced so far (mirrored copies included)
 };
 
+// The animation section (animation_data.hpp): on by default. It needs one
+// skeleton (joint names and parents) across all clips.
+struct AnimationBuildOptions {
+  bool enabled = true;  // false = features only (mmvk build --no-animation)
+  FootContactParams contacts;
+  RotationEncoding encoding = RotationEncoding::Float32;  // how the .mmdb file keeps rotations
+};
+
 struct BuildOptions {
   // Called after each manifest clip is processed. Calls are serialized but
   // may come from the pool's worker threads.
   std::function<void(const BuildProgress&)> progress;
   // Clips are loaded and featurized in parallel on this pool when given.
   ThreadPool* pool = nullptr;
+  AnimationBuildOptions animation;
 };
 
 Result<Database> build_database(const Manifest& manifest, const BuildOptions& options = {});
@@ -68,6 +78,7 @@ struct MotionBuildSettings {
   FeatureSchema schema = default_schema();
   CharacterRootOptions character_root;
   EdgeRule edge_rule = EdgeRule::Exclude;
+  AnimationBuildOptions animation;
 };
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings);

@@ -15,6 +15,20 @@
 //                              f32 cost bias, u32 first frame, u32 frame count
 //                         u32  frames, then frames x u32 frame flags
 //                         f32  features [frames x dims], row-major, normalized
+//                         u8   1 when the animation section follows, else 0 (version 2)
+//                         the animation section (version 2, animation_data.hpp):
+//                              u32 joints, then per joint: str name, i32 parent,
+//                              f32 x3 rest offset, i32 mirror partner;
+//                              u32 T, then T x u32 translated joints;
+//                              i32 left, i32 right contact joint, str left bone,
+//                              str right bone, f32 max height, f32 max speed,
+//                              f32 ankle height extra;
+//                              u8 rotation encoding (0 float32, 1 quantized16);
+//                              u32 frames, then rotations [frames x joints]
+//                              (x, y, z, w as f32, or as i16 / 32767 with w >= 0),
+//                              f32 x3 translations [frames x T],
+//                              f32 x2 root (x, z) [frames], f32 root yaw [frames],
+//                              u8 contacts [frames]
 //                       (str = u32 byte length + UTF-8 bytes)
 //   24 + P     u64      FNV-1a 64 of bytes [0, 24 + P)
 // Loading checks, in order: the length covers the header, the magic, the
@@ -33,7 +47,9 @@
 
 namespace mmvk {
 
-inline constexpr std::uint32_t kDatabaseFormatVersion = 1;
+// Version 2 adds the optional animation section; version 1 files still load
+// (features only, Database::animation() null).
+inline constexpr std::uint32_t kDatabaseFormatVersion = 2;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 
 // The file's bytes.

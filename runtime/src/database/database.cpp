@@ -75,6 +75,10 @@ Status validate_parts(const DatabaseParts& parts) {
                         " of frame " + std::to_string(i / dims) + " is not finite");
     }
   }
+  if (parts.animation) {
+    Status animation = parts.animation->validate(static_cast<std::uint32_t>(frames));
+    if (!animation.ok()) return make_error("database: " + animation.message());
+  }
   return {};
 }
 

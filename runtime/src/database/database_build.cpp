@@ -10,6 +10,7 @@
 #include "mmvk/character.hpp"
 #include "mmvk/features.hpp"
 #include "mmvk/normalization.hpp"
+#include "database/animation_build.hpp"
 
 namespace mmvk {
 
@@ -22,6 +23,7 @@ struct ProcessedClip {
   RawFeatures raw;
   std::vector<std::uint32_t> flags;  // [frames]
   float fps = 0.0f;
+  detail::ClipAnimation animation;   // empty when the build stores no animation
 };
 
 void flag_ranges(std::span<const TimeRange> ranges, float fps, std::uint32_t flag, std::vector<std::uint32_t>& flags) {
@@ -66,6 +68,12 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   flag_ranges(meta.do_not_use, motion.fps, kFrameDoNotUse, out.flags);
   flag_ranges(meta.block_transition, motion.fps, kFrameBlockTransition, out.flags);
   out.raw = std::move(*raw);
+  if (settings.animation.enabled) {
+    Result<detail::ClipAnimation> animation =
+        detail::extract_clip_animation(motion, *root, settings.animation.contacts, source);
+    if (!animation.ok()) return animation.error();
+    out.animation = std::move(*animation);
+  }
   return out;
 }
 
@@ -73,7 +81,7 @@ bool same_rate(float a, float b) { return std::abs(a - b) <= 1e-3f * std::max(a,
 
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
-                          const std::string& source) {
+                          const AnimationBuildOptions& animation, const std::string& source) {
   if (clips.empty()) return make_error(source + ": no clips");
   DatabaseParts parts;
   parts.schema = schema;
@@ -84,6 +92,14 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
   if (frames > 0xFFFFFFF0u) return make_error(source + ": too many frames (" + std::to_string(frames) + ")");
   parts.features.reserve(frames * dims);
   parts.frame_flags.reserve(frames);
+  if (animation.enabled) {
+    std::vector<detail::ClipAnimation> animations;
+    animations.reserve(clips.size());
+    for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
+    Result<AnimationData> data = detail::assemble_animation(animations, animation.contacts, animation.encoding);
+    if (!data.ok()) return make_error(source + ": " + data.message());
+    parts.animation = std::move(*data);
+  }
   for (ProcessedClip& processed : clips) {
     Clip clip = processed.clip;
     clip.first_frame = static_cast<std::uint32_t>(parts.frame_flags.size());
@@ -122,7 +138,7 @@ struct LoadedClip {
   std::vector<ProcessedClip> clips;
 };
 
-LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta) {
+LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const AnimationBuildOptions& animation) {
   LoadedClip out;
   auto fail = [&](std::string message) {
     out.error = make_error(std::move(message));
@@ -154,7 +170,7 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta) {
     }
     motion = std::move(resampled);
   }
-  const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule};
+  const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation};
   Result<ProcessedClip> processed = process_motion(meta, *motion, custom, false, settings);
   if (!processed.ok()) return fail(processed.message());
   out.clips.push_back(std::move(*processed));
@@ -187,7 +203,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
   // chunks would leave a thread idle.
   auto worker = [&](std::size_t, std::size_t, unsigned) {
     for (std::size_t i = next++; i < count; i = next++) {
-      loaded[i] = load_clip(manifest, manifest.clips[i]);
+      loaded[i] = load_clip(manifest, manifest.clips[i], options.animation);
       if (options.progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
         ++progress.clips_done;
@@ -220,7 +236,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     for (ProcessedClip& processed : clip.clips) clips.push_back(std::move(processed));
     clip.clips.clear();
   }
-  return assemble(clips, manifest.schema, fps, source);
+  return assemble(clips, manifest.schema, fps, options.animation, source);
 }
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings) {
@@ -237,7 +253,7 @@ Result<Database> build_database_from_motions(std::span<const MotionClip> clips, 
     if (!one.ok()) return one.error();
     processed.push_back(std::move(*one));
   }
-  return assemble(processed, settings.schema, fps, "build_database_from_motions");
+  return assemble(processed, settings.schema, fps, settings.animation, "build_database_from_motions");
 }
 
 }  // namespace mmvk

@@ -1,6 +1,8 @@
 #include "mmvk/database_io.hpp"
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <span>
 
@@ -24,6 +26,11 @@ class Writer {
     for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
   }
   void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
+  void i16(std::int16_t v) {
+    const auto bits = static_cast<std::uint16_t>(v);
+    bytes_.push_back(static_cast<char>(bits & 0xFF));
+    bytes_.push_back(static_cast<char>(bits >> 8));
+  }
   void str(std::string_view s) {
     u32(static_cast<std::uint32_t>(s.size()));
     bytes_.append(s);
@@ -71,6 +78,14 @@ class Reader {
     v = std::bit_cast<float>(bits);
     return true;
   }
+  bool i16(std::int16_t& v) {
+    if (left() < 2) return false;
+    const auto lo = static_cast<std::uint8_t>(bytes_[pos_]);
+    const auto hi = static_cast<std::uint8_t>(bytes_[pos_ + 1]);
+    v = static_cast<std::int16_t>(static_cast<std::uint16_t>(lo | (hi << 8)));
+    pos_ += 2;
+    return true;
+  }
   // Precondition: 4 * values.size() <= left().
   void f32_array(std::span<float> values) {
     decode_f32_le(bytes_.substr(pos_), values);
@@ -100,6 +115,123 @@ std::uint32_t read_u32_at(std::string_view bytes, std::size_t at) {
   std::uint32_t v = 0;
   for (int i = 0; i < 4; ++i) v |= std::uint32_t{static_cast<std::uint8_t>(bytes[at + i])} << (8 * i);
   return v;
+}
+
+// Quantized16 rotations: each component of the unit quaternion (sign made
+// w >= 0) times 32767, rounded; renormalized on load. The worst-case angle
+// error is about 4e-3 degree (tests/cpu/animation_io_test.cpp measures it).
+std::int16_t quantize(float c) { return static_cast<std::int16_t>(std::lround(std::clamp(c, -1.0f, 1.0f) * 32767.0f)); }
+
+void write_animation(Writer& file, const AnimationData& a) {
+  file.u32(static_cast<std::uint32_t>(a.joint_count()));
+  for (std::size_t j = 0; j < a.joint_count(); ++j) {
+    file.str(a.skeleton.names[j]);
+    file.u32(static_cast<std::uint32_t>(a.skeleton.parents[j]));
+    file.f32(a.skeleton.rest_offsets[j].x);
+    file.f32(a.skeleton.rest_offsets[j].y);
+    file.f32(a.skeleton.rest_offsets[j].z);
+    file.u32(static_cast<std::uint32_t>(a.mirror_pairs[j]));
+  }
+  file.u32(static_cast<std::uint32_t>(a.translated_joints.size()));
+  for (std::uint32_t j : a.translated_joints) file.u32(j);
+  file.u32(static_cast<std::uint32_t>(a.contact_joints[0]));
+  file.u32(static_cast<std::uint32_t>(a.contact_joints[1]));
+  file.str(a.contact_params.left_bone);
+  file.str(a.contact_params.right_bone);
+  file.f32(a.contact_params.max_height);
+  file.f32(a.contact_params.max_speed);
+  file.f32(a.contact_params.ankle_height_extra);
+  file.u8(static_cast<std::uint8_t>(a.encoding));
+  file.u32(a.frame_count);
+  for (const glm::quat& q : a.local_rotations) {
+    const float s = q.w < 0.0f ? -1.0f : 1.0f;
+    if (a.encoding == RotationEncoding::Quantized16) {
+      for (float c : {q.x, q.y, q.z, q.w}) file.i16(quantize(s * c));
+    } else {
+      for (float c : {q.x, q.y, q.z, q.w}) file.f32(c);
+    }
+  }
+  for (const glm::vec3& t : a.local_translations) {
+    file.f32(t.x);
+    file.f32(t.y);
+    file.f32(t.z);
+  }
+  for (const glm::vec3& p : a.root_positions) {
+    file.f32(p.x);
+    file.f32(p.z);
+  }
+  file.f32_array(a.root_yaws);
+  for (std::uint8_t c : a.contacts) file.u8(c);
+}
+
+// Reads the section; sizes are checked against what is left before any
+// allocation. Returns an empty string on success, else what is corrupt.
+std::string read_animation(Reader& in, AnimationData& a) {
+  std::uint32_t joints = 0;
+  if (!in.u32(joints) || std::uint64_t{joints} * 24 > in.left()) return "animation joint count";
+  a.skeleton.names.resize(joints);
+  a.skeleton.parents.resize(joints);
+  a.skeleton.rest_offsets.resize(joints);
+  a.mirror_pairs.resize(joints);
+  for (std::uint32_t j = 0; j < joints; ++j) {
+    std::uint32_t parent = 0;
+    std::uint32_t pair = 0;
+    glm::vec3& r = a.skeleton.rest_offsets[j];
+    if (!in.str(a.skeleton.names[j]) || !in.u32(parent) || !in.f32(r.x) || !in.f32(r.y) || !in.f32(r.z) ||
+        !in.u32(pair)) {
+      return "animation joint";
+    }
+    a.skeleton.parents[j] = static_cast<int>(parent);
+    a.mirror_pairs[j] = static_cast<int>(pair);
+  }
+  std::uint32_t translated = 0;
+  if (!in.u32(translated) || std::uint64_t{translated} * 4 > in.left()) return "translated joint count";
+  a.translated_joints.resize(translated);
+  for (std::uint32_t& j : a.translated_joints) {
+    if (!in.u32(j)) return "translated joints";
+  }
+  std::uint32_t left = 0;
+  std::uint32_t right = 0;
+  std::uint8_t encoding = 0;
+  FootContactParams& c = a.contact_params;
+  if (!in.u32(left) || !in.u32(right) || !in.str(c.left_bone) || !in.str(c.right_bone) || !in.f32(c.max_height) ||
+      !in.f32(c.max_speed) || !in.f32(c.ankle_height_extra) || !in.u8(encoding) || !in.u32(a.frame_count)) {
+    return "animation contacts and encoding";
+  }
+  if (encoding > static_cast<std::uint8_t>(RotationEncoding::Quantized16)) return "rotation encoding";
+  a.contact_joints = {static_cast<int>(left), static_cast<int>(right)};
+  a.encoding = static_cast<RotationEncoding>(encoding);
+  const std::uint64_t frames = a.frame_count;
+  const std::uint64_t rotation_bytes = a.encoding == RotationEncoding::Float32 ? 16 : 8;
+  const std::uint64_t need = frames * (joints * rotation_bytes + translated * 12 + 8 + 4 + 1);
+  if (need != in.left()) {
+    return "animation of " + std::to_string(frames) + " frames needs " + std::to_string(need) + " bytes, " +
+           std::to_string(in.left()) + " are left";
+  }
+  a.local_rotations.resize(frames * joints);
+  for (glm::quat& q : a.local_rotations) {
+    if (a.encoding == RotationEncoding::Quantized16) {
+      std::int16_t v[4] = {};
+      for (std::int16_t& x : v) (void)in.i16(x);
+      q = glm::quat(float(v[3]), float(v[0]), float(v[1]), float(v[2]));
+      const float norm = glm::length(q);
+      q = norm > 0.0f ? q / norm : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    } else {
+      (void)(in.f32(q.x) && in.f32(q.y) && in.f32(q.z) && in.f32(q.w));
+    }
+  }
+  a.local_translations.resize(frames * translated);
+  for (glm::vec3& t : a.local_translations) (void)(in.f32(t.x) && in.f32(t.y) && in.f32(t.z));
+  a.root_positions.resize(frames);
+  for (glm::vec3& p : a.root_positions) {
+    p.y = 0.0f;
+    (void)(in.f32(p.x) && in.f32(p.z));
+  }
+  a.root_yaws.resize(frames);
+  in.f32_array(a.root_yaws);
+  a.contacts.resize(frames);
+  for (std::uint8_t& x : a.contacts) (void)in.u8(x);
+  return {};
 }
 
 }  // namespace
@@ -137,6 +269,8 @@ std::string serialize_database(const Database& database) {
   file.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
   for (std::uint32_t flags : parts.frame_flags) file.u32(flags);
   file.f32_array(parts.features);
+  file.u8(parts.animation ? 1 : 0);
+  if (parts.animation) write_animation(file, *parts.animation);
 
   std::string& bytes = file.bytes();
   const std::uint64_t payload_size = bytes.size() - kDatabaseHeaderBytes;
@@ -161,8 +295,8 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
                       std::to_string(kDatabaseHeaderBytes + 8) + ")");
   }
   const std::uint32_t version = read_u32_at(bytes, 8);
-  if (version != kDatabaseFormatVersion) {
-    return make_error(source + ": unsupported mmvk database version " + std::to_string(version) + " (this build reads version " +
+  if (version != kDatabaseFormatVersion && version != 1) {
+    return make_error(source + ": unsupported mmvk database version " + std::to_string(version) + " (this build reads versions 1 to " +
                       std::to_string(kDatabaseFormatVersion) + ")");
   }
   if (read_u32_at(bytes, 12) != 0) return make_error(source + ": corrupt mmvk database header (reserved field is not 0)");
@@ -235,12 +369,25 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
     if (!in.u32(flags)) return corrupt("frame flags");
   }
   const std::uint64_t values = std::uint64_t{frames} * dims;
-  if (values * 4 != in.left()) {
+  // Version 1 ends with the features; version 2 adds a presence byte and
+  // the optional animation section.
+  const std::uint64_t after = version == 1 ? 0 : 1;
+  if (values * 4 + after > in.left() || (version == 1 && values * 4 != in.left())) {
     return corrupt("feature matrix of " + std::to_string(frames) + " x " + std::to_string(dims) + " floats needs " +
                    std::to_string(values * 4) + " bytes, " + std::to_string(in.left()) + " are left");
   }
   parts.features.resize(values);
   in.f32_array(parts.features);
+  if (version >= 2) {
+    std::uint8_t has_animation = 0;
+    if (!in.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");
+    if (has_animation) {
+      parts.animation.emplace();
+      if (std::string what = read_animation(in, *parts.animation); !what.empty()) return corrupt(what);
+    } else if (in.left() != 0) {
+      return corrupt(std::to_string(in.left()) + " bytes after the features");
+    }
+  }
   Result<Database> database = Database::create(std::move(parts));
   if (!database.ok()) return make_error(source + ": invalid mmvk database: " + database.message());
   return database;

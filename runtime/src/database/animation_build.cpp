@@ -1,0 +1,190 @@
+#include "database/animation_build.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "mmvk/character.hpp"
+
+namespace mmvk::detail {
+
+namespace {
+
+// Joint translations within this distance (metres, per component) of a
+// clip's first frame count as constant, and constants within it of the
+// first clip's as shared. Rounding of resampling stays far below it; the FK
+// error it can add over a chain of ten joints stays below the 1e-4 m the
+// tests hold the stored poses to.
+constexpr float kConstantTolerance = 5e-6f;
+
+bool near(const glm::vec3& a, const glm::vec3& b) {
+  return std::abs(a.x - b.x) <= kConstantTolerance && std::abs(a.y - b.y) <= kConstantTolerance &&
+         std::abs(a.z - b.z) <= kConstantTolerance;
+}
+
+// The contact bone of one side: the configured bone, else the ankle with a
+// raised height threshold.
+struct ContactBone {
+  int joint = -1;
+  float max_height = 0.0f;
+};
+
+ContactBone resolve_contact_bone(const Skeleton& skeleton, const std::string& bone, const char* ankle,
+                                 const FootContactParams& params) {
+  if (Result<int> joint = find_bone(skeleton, bone); joint.ok()) return {*joint, params.max_height};
+  if (Result<int> joint = find_bone(skeleton, ankle); joint.ok()) {
+    return {*joint, params.max_height + params.ankle_height_extra};
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<ClipAnimation> extract_clip_animation(const Motion& motion, const CharacterRoot& root,
+                                             const FootContactParams& params, std::string source) {
+  const std::size_t joints = motion.joint_count();
+  const std::uint32_t frames = motion.frame_count;
+  if (root.positions.size() != frames || root.facings.size() != frames) {
+    return make_error(source + ": character root is not sized to the clip");
+  }
+  ClipAnimation out;
+  out.skeleton = motion.skeleton;
+  out.source = std::move(source);
+  out.frame_count = frames;
+  out.rotations.resize(std::size_t{frames} * joints);
+  out.root_positions.resize(frames);
+  out.root_yaws.resize(frames);
+  out.contacts.assign(frames, 0);
+
+  // Top-level joints are re-expressed relative to the character root, so a
+  // pose can be placed anywhere by the root alone.
+  std::vector<glm::vec3> translations(std::size_t{frames} * joints);
+  const glm::vec3 up(0.0f, 1.0f, 0.0f);
+  for (std::uint32_t f = 0; f < frames; ++f) {
+    const glm::vec3 facing = root.facings[f];
+    const float yaw = std::atan2(facing.x, facing.z);
+    const glm::quat to_character = glm::angleAxis(-yaw, up);
+    out.root_positions[f] = glm::vec3(root.positions[f].x, 0.0f, root.positions[f].z);
+    out.root_yaws[f] = yaw;
+    for (std::size_t j = 0; j < joints; ++j) {
+      const std::size_t i = motion.index(f, j);
+      glm::quat q = motion.local_rotations[i];
+      glm::vec3 t = motion.local_positions[i];
+      if (motion.skeleton.parents[j] < 0) {
+        q = to_character * q;
+        t = to_character * (t - out.root_positions[f]);
+      }
+      out.rotations[i] = glm::normalize(q);
+      translations[i] = t;
+    }
+  }
+  out.constant.resize(joints);
+  for (std::size_t j = 0; j < joints; ++j) {
+    out.constant[j] = frames > 0 ? translations[j] : motion.skeleton.rest_offsets[j];
+    for (std::uint32_t f = 1; f < frames; ++f) {
+      if (!near(translations[f * joints + j], out.constant[j])) {
+        out.varying.push_back(static_cast<std::uint32_t>(j));
+        break;
+      }
+    }
+  }
+  out.translations.resize(std::size_t{frames} * out.varying.size());
+  for (std::uint32_t f = 0; f < frames; ++f) {
+    for (std::size_t v = 0; v < out.varying.size(); ++v) {
+      out.translations[f * out.varying.size() + v] = translations[f * joints + out.varying[v]];
+    }
+  }
+
+  // Contacts from the model-space bone trajectory: low and slow.
+  const ContactBone sides[2] = {resolve_contact_bone(motion.skeleton, params.left_bone, "@left_foot", params),
+                                resolve_contact_bone(motion.skeleton, params.right_bone, "@right_foot", params)};
+  if (frames > 0 && sides[0].joint >= 0 && sides[1].joint >= 0) {
+    std::vector<glm::vec3> positions(std::size_t{frames} * joints);
+    std::vector<glm::quat> rotations(std::size_t{frames} * joints);
+    forward_kinematics_clip(motion, positions, rotations);
+    for (int s = 0; s < 2; ++s) {
+      const std::size_t j = static_cast<std::size_t>(sides[s].joint);
+      out.contact_joints[static_cast<std::size_t>(s)] = sides[s].joint;
+      for (std::uint32_t f = 0; f < frames; ++f) {
+        const std::uint32_t a = f > 0 ? f - 1 : f;
+        const std::uint32_t b = f + 1 < frames ? f + 1 : f;
+        const float speed =
+            b > a ? glm::length(positions[b * joints + j] - positions[a * joints + j]) * motion.fps / float(b - a) : 0.0f;
+        const float height = positions[f * joints + j].y;
+        if (height < sides[s].max_height && speed < params.max_speed) {
+          out.contacts[f] |= s == 0 ? kContactLeft : kContactRight;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, const FootContactParams& contacts,
+                                         RotationEncoding encoding) {
+  if (clips.empty()) return make_error("animation: no clips");
+  const ClipAnimation& first = clips[0];
+  const std::size_t joints = first.skeleton.size();
+  std::uint64_t frames = 0;
+  for (const ClipAnimation& clip : clips) {
+    if (clip.skeleton.names != first.skeleton.names || clip.skeleton.parents != first.skeleton.parents) {
+      return make_error("animation: " + clip.source + " and " + first.source +
+                        " have different skeletons (joint names or parents); the animation section holds one "
+                        "skeleton: build with --no-animation to store features only");
+    }
+    frames += clip.frame_count;
+  }
+  AnimationData out;
+  out.skeleton = first.skeleton;
+  out.mirror_pairs = mirror_pairs(out.skeleton);
+  out.contact_params = contacts;
+  out.encoding = encoding;
+  out.contact_joints = first.contact_joints;
+  out.frame_count = static_cast<std::uint32_t>(frames);
+
+  // A joint needs per-frame translations when it varies in some clip or
+  // its constant differs between clips; otherwise the shared constant is
+  // its rest offset (the effective translation, which for BVH joints with
+  // position channels may differ from the file's OFFSET).
+  std::vector<std::uint8_t> translated(joints, 0);
+  for (const ClipAnimation& clip : clips) {
+    for (std::uint32_t j : clip.varying) translated[j] = 1;
+    for (std::size_t j = 0; j < joints; ++j) {
+      if (!near(clip.constant[j], first.constant[j])) translated[j] = 1;
+    }
+  }
+  for (std::size_t j = 0; j < joints; ++j) {
+    if (translated[j]) {
+      out.translated_joints.push_back(static_cast<std::uint32_t>(j));
+    } else {
+      out.skeleton.rest_offsets[j] = first.constant[j];
+    }
+  }
+  const std::size_t count = out.translated_joints.size();
+  out.local_rotations.reserve(frames * joints);
+  out.local_translations.resize(frames * count);
+  out.root_positions.reserve(frames);
+  out.root_yaws.reserve(frames);
+  out.contacts.reserve(frames);
+  std::size_t base = 0;
+  for (const ClipAnimation& clip : clips) {
+    out.local_rotations.insert(out.local_rotations.end(), clip.rotations.begin(), clip.rotations.end());
+    out.root_positions.insert(out.root_positions.end(), clip.root_positions.begin(), clip.root_positions.end());
+    out.root_yaws.insert(out.root_yaws.end(), clip.root_yaws.begin(), clip.root_yaws.end());
+    out.contacts.insert(out.contacts.end(), clip.contacts.begin(), clip.contacts.end());
+    for (std::size_t t = 0; t < count; ++t) {
+      const std::uint32_t j = out.translated_joints[t];
+      const auto it = std::find(clip.varying.begin(), clip.varying.end(), j);
+      const std::size_t v = static_cast<std::size_t>(it - clip.varying.begin());
+      for (std::uint32_t f = 0; f < clip.frame_count; ++f) {
+        out.local_translations[(base + f) * count + t] =
+            it == clip.varying.end() ? clip.constant[j] : clip.translations[f * clip.varying.size() + v];
+      }
+    }
+    base += clip.frame_count;
+  }
+  return out;
+}
+
+}  // namespace mmvk::detail

@@ -180,10 +180,17 @@ class CrowdController {
 
  private:
   CrowdController() = default;
-  struct Scratch;
-  Status begin(float dt, const CrowdInput& input, ThreadPool& pool);
-  void apply(std::span<const Match> matches, ThreadPool& pool);
-  void finish(float dt, ThreadPool& pool);
+  Status check_input(float dt, const CrowdInput& input) const;
+  // Steps 1-3 and the blend, for every character; fills due_.
+  void begin(float dt, const CrowdInput& input, ThreadPool& pool);
+  // Step 4 for due_.
+  void assemble(ThreadPool& pool);
+  // Step 6: matches [count] for characters[count] whose queries continued
+  // continuing[count]; updates last_.
+  void apply(std::span<const Match> matches, std::span<const std::uint32_t> characters,
+             std::span<const std::uint32_t> continuing, ThreadPool& pool);
+  void jump(std::uint32_t b, std::uint32_t to, unsigned thread);
+  void ensure_scratch(unsigned threads);
 
   const Database* database_ = nullptr;
   const AnimationData* animation_ = nullptr;
@@ -192,6 +199,7 @@ class CrowdController {
   Inertializer inertializer_;
   std::uint32_t characters_ = 0;
   std::uint32_t joints_ = 0;
+  std::uint32_t trajectory_size_ = 0;
   std::uint64_t ticks_ = 0;
   TickStats last_, totals_;
 
@@ -199,11 +207,14 @@ class CrowdController {
   std::vector<std::uint32_t> frames_;
   std::vector<float> frame_time_;        // fraction of a frame played past frames_
   std::vector<float> search_timer_;      // seconds to the next regular search
-  std::vector<std::uint8_t> force_;      // forced search pending
+  std::vector<std::uint8_t> force_;      // forced search pending (placed, first tick)
+  std::vector<std::uint8_t> due_flag_;   // 0 no search, 1 regular, 2 forced
   std::vector<std::uint8_t> searched_, jumped_, contacts_;
   std::vector<float> match_cost_;
   std::vector<glm::vec3> root_pos_;
   std::vector<float> root_yaw_;
+  std::vector<glm::vec3> played_velocity_;  // root velocity of the played frames, character space, m/s
+  std::vector<float> played_yaw_rate_;      // rad/s
   std::vector<SimulationState> sim_;
   std::vector<glm::vec3> desired_velocity_, searched_velocity_;
   std::vector<float> desired_yaw_, searched_yaw_;
@@ -215,15 +226,21 @@ class CrowdController {
 
   // The batch, [B] capacity.
   std::vector<std::uint32_t> due_;       // characters in the batch, ascending
-  std::vector<std::uint32_t> due_frames_;
+  std::vector<std::uint32_t> continuing_;  // their continuing frames
   std::vector<QueryFrame> due_refs_;
   std::vector<float> queries_;           // [B x dims]
   std::vector<QueryParams> batch_params_;
   std::vector<Match> matches_;
   std::uint32_t due_count_ = 0;
-  std::uint32_t pending_count_ = 0;      // deferred: queries in flight
-  std::vector<std::uint32_t> pending_;   // deferred: their characters
-  std::vector<std::uint32_t> pending_continuing_;
+  // Deferred: the batch in flight (copies of due_ and continuing_).
+  std::vector<std::uint32_t> pending_, pending_continuing_;
+  std::uint32_t pending_count_ = 0;
+  // Per pool thread: a destination pose and velocities for jumps.
+  struct JumpScratch {
+    std::vector<glm::quat> rotations;
+    std::vector<glm::vec3> translations, angular, velocities, source_angular, source_velocities;
+  };
+  std::vector<JumpScratch> scratch_;
 };
 
 }  // namespace mmvk

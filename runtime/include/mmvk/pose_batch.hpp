@@ -78,6 +78,12 @@ class Inertializer {
   // translation offsets [translated joints].
   std::span<const glm::vec3> rotation_offsets(std::uint32_t b) const;
   std::span<const glm::vec3> translation_offsets(std::uint32_t b) const;
+  // Their rates of change: angular velocities [joints] (rad/s) and
+  // translation velocities [translated joints] (m/s); and the root's
+  // current velocity and yaw-rate offsets.
+  std::span<const glm::vec3> rotation_offset_velocities(std::uint32_t b) const;
+  std::span<const glm::vec3> translation_offset_velocities(std::uint32_t b) const;
+  RootOffset root_offset(std::uint32_t b) const { return {root_vel_offset_[b], yaw_rate_offset_[b]}; }
   void reset(std::uint32_t b);
 
  private:

@@ -71,7 +71,7 @@ class QueryAssembler {
   std::vector<float> offsets_;
   std::vector<Slot> slots_;
   std::vector<Copy> copies_;
-  std::vector<float> inv_scale_;  // [dims]
+  std::vector<float> scale_;      // [dims]
   std::vector<float> offset_;     // [dims]
 };
 

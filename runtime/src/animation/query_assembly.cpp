@@ -1,0 +1,117 @@
+// Batched query assembly (query_assembly.hpp): the schema is turned once into
+// copy runs and trajectory slots.
+#include "mmvk/query_assembly.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace mmvk {
+
+Result<QueryAssembler> QueryAssembler::create(const Database& database) {
+  const FeatureSchema& schema = database.schema();
+  QueryAssembler out;
+  out.database_ = &database;
+  out.dims_ = database.dims();
+  bool has_positions = false;
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& channel = schema.channels[c];
+    const std::uint32_t first = schema.offset(c);
+    bool trajectory = false;
+    switch (channel.kind) {
+      case ChannelKind::TrajectoryPosition:
+        has_positions = true;
+        trajectory = true;
+        break;
+      case ChannelKind::TrajectoryDirection:
+        trajectory = true;
+        break;
+      case ChannelKind::BonePosition:
+      case ChannelKind::BoneVelocity:
+      case ChannelKind::RootVelocity:
+      case ChannelKind::Custom:
+        break;
+    }
+    if (!trajectory) {
+      // Adjacent pose channels merge into one copy run.
+      if (!out.copies_.empty() && out.copies_.back().begin + out.copies_.back().count == first) {
+        out.copies_.back().count += channel.dims();
+      } else {
+        out.copies_.push_back({first, channel.dims()});
+      }
+      continue;
+    }
+    for (float t : channel.offsets_seconds) {
+      if (!(t > 0.0f)) {
+        return make_error("query assembly: channel '" + channel.name + "' has trajectory offset " + std::to_string(t) +
+                          " s; the predictor fills future offsets (> 0) only");
+      }
+      if (std::find(out.offsets_.begin(), out.offsets_.end(), t) == out.offsets_.end()) out.offsets_.push_back(t);
+    }
+  }
+  if (!has_positions) {
+    return make_error("query assembly: the database's schema has no trajectory_position channel, which the "
+                      "controller's trajectory predictor fills; rebuild with a schema that has one (the default "
+                      "schema does)");
+  }
+  std::sort(out.offsets_.begin(), out.offsets_.end());
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& channel = schema.channels[c];
+    if (channel.kind != ChannelKind::TrajectoryPosition && channel.kind != ChannelKind::TrajectoryDirection) continue;
+    std::uint32_t dim = schema.offset(c);
+    for (float t : channel.offsets_seconds) {
+      const auto index = static_cast<std::uint32_t>(std::find(out.offsets_.begin(), out.offsets_.end(), t) -
+                                                    out.offsets_.begin());
+      out.slots_.push_back({dim, index, channel.kind == ChannelKind::TrajectoryDirection});
+      dim += 2;
+    }
+  }
+  out.scale_.resize(out.dims_);
+  out.offset_.resize(out.dims_);
+  for (std::uint32_t d = 0; d < out.dims_; ++d) {
+    out.scale_[d] = database.normalization()[d].scale;
+    out.offset_[d] = database.normalization()[d].offset;
+  }
+  return out;
+}
+
+void QueryAssembler::assemble(std::uint32_t frame, const QueryFrame& reference, std::span<const glm::vec3> positions,
+                              std::span<const float> yaws, std::span<float> out) const {
+  assert(out.size() >= dims_ && positions.size() >= offsets_.size() && yaws.size() >= offsets_.size());
+  const float* row = database_->features().data() + std::size_t{frame} * dims_;
+  for (const Copy& copy : copies_) std::copy_n(row + copy.begin, copy.count, out.data() + copy.begin);
+  // Character space of the reference: the inverse yaw rotation.
+  const float c = std::cos(reference.root_yaw);
+  const float s = std::sin(reference.root_yaw);
+  for (const Slot& slot : slots_) {
+    float x = 0.0f;
+    float z = 0.0f;
+    if (slot.direction) {
+      const float relative = yaws[slot.offset_index] - reference.root_yaw;
+      x = std::sin(relative);
+      z = std::cos(relative);
+    } else {
+      const glm::vec3 d = positions[slot.offset_index] - reference.root_position;
+      x = d.x * c - d.z * s;
+      z = d.x * s + d.z * c;
+    }
+    const std::uint32_t i = slot.dim;
+    // Divided, not multiplied by an inverse: the same bits as Database::normalize.
+    out[i] = (x - offset_[i]) / scale_[i];
+    out[i + 1] = (z - offset_[i + 1]) / scale_[i + 1];
+  }
+}
+
+void QueryAssembler::assemble_batch(std::span<const std::uint32_t> frames, std::span<const QueryFrame> references,
+                                    std::span<const glm::vec3> positions, std::span<const float> yaws,
+                                    std::span<float> out) const {
+  const std::size_t t = offsets_.size();
+  assert(references.size() >= frames.size() && positions.size() >= frames.size() * t &&
+         yaws.size() >= frames.size() * t && out.size() >= frames.size() * dims_);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    assemble(frames[i], references[i], positions.subspan(i * t, t), yaws.subspan(i * t, t),
+             out.subspan(i * dims_, dims_));
+  }
+}
+
+}  // namespace mmvk

@@ -4,14 +4,17 @@
 // Optional: a database built with --no-animation, or loaded from a format 1
 // file, has features only (Database::animation() is null).
 //
-// Spaces. The pose is stored in character space: every top-level joint
-// (parent -1) has its local rotation and translation expressed relative to
-// the frame's character root (origin = root position, +Z = root facing,
-// +Y up), the other joints relative to their parents as imported. Forward
-// kinematics of a stored pose therefore gives joint positions relative to
-// the character, and placing them at a root position p and yaw a gives
-// world = p + R_y(a) * q. The import's model-space positions are recovered
-// with the frame's own root_positions and root_yaws.
+// Spaces. The pose is stored in character space (origin = the frame's
+// character root position, +Z = its facing, +Y up). Joints above the hips
+// (static scene roots such as Bandai's joint_Root) are the identity at the
+// character root; every joint whose parent is such a joint, or which has no
+// parent (the hips), stores its model-space rotation and translation
+// re-expressed in character space; all other joints keep their local
+// transforms relative to their parents as imported. Forward kinematics of a
+// stored pose therefore gives joint positions relative to the character, and
+// placing them at a root position p and yaw a gives world = p + R_y(a) * q.
+// The import's model-space positions (of every joint from the hips down) are
+// recovered with the frame's own root_positions and root_yaws.
 //
 // Yaw: radians about +Y; yaw 0 faces +Z, and facing = (sin yaw, 0, cos yaw).
 #pragma once
@@ -62,16 +65,16 @@ enum class RotationEncoding : std::uint8_t {
 struct AnimationData {
   Skeleton skeleton;                 // names, parents (parents[i] < i), rest offsets (metres)
   std::vector<int> mirror_pairs;     // [joints] each joint's mirror partner (itself when none)
-  // Joints whose local translation varies between frames (the hips, and any
-  // top-level joint, which is stored in character space), ascending. Every
-  // other joint uses skeleton.rest_offsets.
+  // Joints whose local translation varies between frames (the hips, stored
+  // in character space), ascending. Every other joint uses
+  // skeleton.rest_offsets, which hold the effective constant translation.
   std::vector<std::uint32_t> translated_joints;
   std::array<int, 2> contact_joints{-1, -1};  // left, right bone used for contacts
   FootContactParams contact_params;           // the thresholds the contacts were detected with
   RotationEncoding encoding = RotationEncoding::Float32;
 
   std::uint32_t frame_count = 0;                 // = Database::frame_count()
-  std::vector<glm::quat> local_rotations;        // [frames x joints], unit, character space for top-level joints
+  std::vector<glm::quat> local_rotations;        // [frames x joints], unit (hips: character space)
   std::vector<glm::vec3> local_translations;     // [frames x translated_joints.size()], metres
   std::vector<glm::vec3> root_positions;         // [frames], the clip's world space, y = 0, metres
   std::vector<float> root_yaws;                  // [frames], radians

@@ -331,9 +331,9 @@ void CrowdController::begin(float dt, const CrowdInput& input, ThreadPool& pool)
           ((frame_flags & kFrameBlockTransition) != 0 && (previous_flags & kFrameBlockTransition) == 0) ||
           glm::length(desired_velocity_[b] - searched_velocity_[b]) > params_.force_search_velocity_change ||
           std::abs(wrap_angle(desired_yaw_[b] - searched_yaw_[b])) > params_.force_search_yaw_change;
-      // A forced search restarts the regular schedule, so it is not followed
-      // by a regular one a tick later.
-      if (forced) search_timer_[b] = params_.search_interval;
+      // A forced search leaves the regular schedule alone: resetting the
+      // timer would bunch characters forced together (all of them on the
+      // first tick) onto the same later ticks.
       due_flag_[b] = forced ? 2 : regular ? 1 : 0;
       force_[b] = 0;
     }

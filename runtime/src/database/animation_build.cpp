@@ -42,7 +42,8 @@ ContactBone resolve_contact_bone(const Skeleton& skeleton, const std::string& bo
 }  // namespace
 
 Result<ClipAnimation> extract_clip_animation(const Motion& motion, const CharacterRoot& root,
-                                             const FootContactParams& params, std::string source) {
+                                             const std::string& hips_bone, const FootContactParams& params,
+                                             std::string source) {
   const std::size_t joints = motion.joint_count();
   const std::uint32_t frames = motion.frame_count;
   if (root.positions.size() != frames || root.facings.size() != frames) {
@@ -57,8 +58,24 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
   out.root_yaws.resize(frames);
   out.contacts.assign(frames, 0);
 
-  // Top-level joints are re-expressed relative to the character root, so a
-  // pose can be placed anywhere by the root alone.
+  // Model-space transforms, for the character-space re-expression and the
+  // contacts.
+  std::vector<glm::vec3> positions(std::size_t{frames} * joints);
+  std::vector<glm::quat> globals(std::size_t{frames} * joints);
+  forward_kinematics_clip(motion, positions, globals);
+
+  // The pose is stored relative to the character root. Strict ancestors of
+  // the hips (static scene roots such as Bandai's joint_Root) become the
+  // identity at the character root, and every joint hanging directly off
+  // them (or off nothing) stores its model-space transform re-expressed in
+  // character space. So the hips carry a short translation (about 1 m up)
+  // and no far-away scene origin acts as a lever arm when poses are blended.
+  std::vector<std::uint8_t> collapsed(joints, 0);
+  if (Result<int> hips = find_bone(motion.skeleton, hips_bone); hips.ok()) {
+    for (int p = motion.skeleton.parents[static_cast<std::size_t>(*hips)]; p >= 0; p = motion.skeleton.parents[static_cast<std::size_t>(p)]) {
+      collapsed[static_cast<std::size_t>(p)] = 1;
+    }
+  }
   std::vector<glm::vec3> translations(std::size_t{frames} * joints);
   const glm::vec3 up(0.0f, 1.0f, 0.0f);
   for (std::uint32_t f = 0; f < frames; ++f) {
@@ -69,11 +86,15 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
     out.root_yaws[f] = yaw;
     for (std::size_t j = 0; j < joints; ++j) {
       const std::size_t i = motion.index(f, j);
+      const int parent = motion.skeleton.parents[j];
       glm::quat q = motion.local_rotations[i];
       glm::vec3 t = motion.local_positions[i];
-      if (motion.skeleton.parents[j] < 0) {
-        q = to_character * q;
-        t = to_character * (t - out.root_positions[f]);
+      if (collapsed[j]) {
+        q = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+        t = glm::vec3(0.0f);
+      } else if (parent < 0 || collapsed[static_cast<std::size_t>(parent)]) {
+        q = to_character * globals[i];
+        t = to_character * (positions[i] - out.root_positions[f]);
       }
       out.rotations[i] = glm::normalize(q);
       translations[i] = t;
@@ -100,9 +121,6 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
   const ContactBone sides[2] = {resolve_contact_bone(motion.skeleton, params.left_bone, "@left_foot", params),
                                 resolve_contact_bone(motion.skeleton, params.right_bone, "@right_foot", params)};
   if (frames > 0 && sides[0].joint >= 0 && sides[1].joint >= 0) {
-    std::vector<glm::vec3> positions(std::size_t{frames} * joints);
-    std::vector<glm::quat> rotations(std::size_t{frames} * joints);
-    forward_kinematics_clip(motion, positions, rotations);
     for (int s = 0; s < 2; ++s) {
       const std::size_t j = static_cast<std::size_t>(sides[s].joint);
       out.contact_joints[static_cast<std::size_t>(s)] = sides[s].joint;

@@ -31,8 +31,11 @@ struct ClipAnimation {
   std::vector<std::uint8_t> contacts;         // [frames]
 };
 
+// `hips_bone` (the character root's source bone) decides which joints are
+// re-expressed in character space (animation_build.cpp).
 Result<ClipAnimation> extract_clip_animation(const Motion& motion, const CharacterRoot& root,
-                                             const FootContactParams& contacts, std::string source);
+                                             const std::string& hips_bone, const FootContactParams& contacts,
+                                             std::string source);
 
 // Concatenates the clips in order. Errors: clips with different skeletons
 // (names or parents), naming both files and the way out (--no-animation).

@@ -70,7 +70,8 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   out.raw = std::move(*raw);
   if (settings.animation.enabled) {
     Result<detail::ClipAnimation> animation =
-        detail::extract_clip_animation(motion, *root, settings.animation.contacts, source);
+        detail::extract_clip_animation(motion, *root, settings.character_root.source_bone,
+                                       settings.animation.contacts, source);
     if (!animation.ok()) return animation.error();
     out.animation = std::move(*animation);
   }

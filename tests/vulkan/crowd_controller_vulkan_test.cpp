@@ -1,0 +1,81 @@
+// The crowd controller on Vulkan (lavapipe in CI) against the reference
+// backend on Bandai locomotion: 50 characters, 2 s at 30 Hz, identical
+// chosen frames every tick, synchronously and on the deferred (async) path,
+// with batches split over more chunks than the search has slots.
+#include <gtest/gtest.h>
+
+#include "mmvk/reference_search.hpp"
+#include "mmvk/vulkan/vulkan_async_search.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#include "support/crowd_scenario.hpp"
+#include "support/test_data.hpp"
+#include "vulkan_test_env.hpp"
+
+namespace mmvk {
+namespace {
+
+test::CrowdRun run_sync(const Database& db, SearchBackend& backend, std::uint32_t max_batch) {
+  ThreadPool pool(2);
+  ControllerParams params;
+  params.max_batch = max_batch;
+  Result<CrowdController> controller = CrowdController::create(db, test::kCrowdCharacters, params);
+  EXPECT_TRUE(controller.ok()) << controller.message();
+  Result<test::CrowdRun> run = test::run_crowd(
+      *controller, [&](CrowdController& c, const CrowdInput& in) { return c.tick(test::kCrowdDt, in, backend, pool); });
+  EXPECT_TRUE(run.ok()) << run.message();
+  return std::move(run).value();
+}
+
+test::CrowdRun run_deferred(const Database& db, AsyncSearch& search) {
+  ThreadPool pool(2);
+  Result<CrowdController> controller = CrowdController::create(db, test::kCrowdCharacters);
+  EXPECT_TRUE(controller.ok()) << controller.message();
+  Result<test::CrowdRun> run = test::run_crowd(
+      *controller, [&](CrowdController& c, const CrowdInput& in) { return c.tick(test::kCrowdDt, in, search, pool); });
+  EXPECT_TRUE(run.ok()) << run.message();
+  return std::move(run).value();
+}
+
+// The first tick where two runs chose differently, for the failure message.
+std::string first_difference(const test::CrowdRun& a, const test::CrowdRun& b) {
+  for (std::size_t i = 0; i < std::min(a.frames.size(), b.frames.size()); ++i) {
+    if (a.frames[i] != b.frames[i]) {
+      return "tick " + std::to_string(i / test::kCrowdCharacters) + ", character " +
+             std::to_string(i % test::kCrowdCharacters) + ": " + std::to_string(a.frames[i]) + " vs " +
+             std::to_string(b.frames[i]);
+    }
+  }
+  return "sizes differ";
+}
+
+TEST(CrowdControllerVulkan, SameFramesAsTheReferenceEveryTick) {
+  MMVK_REQUIRE_DATA_DIR(dir);
+  MMVK_VULKAN_CONTEXT(context, {});
+  Result<Database> db = test::build_locomotion(dir);
+  ASSERT_TRUE(db.ok()) << db.message();
+  ReferenceSearch reference(*db);
+  vulkan::VulkanSearchOptions options;
+  options.max_k = 1;
+  options.max_batch = 16;  // the first tick's 50 forced searches take 4 chunks, 2 slots
+  Result<std::unique_ptr<vulkan::VulkanSearch>> gpu = vulkan::VulkanSearch::create(*context, *db, options);
+  ASSERT_TRUE(gpu.ok()) << gpu.message();
+
+  const test::CrowdRun expected = run_sync(*db, reference, 1024);
+  const test::CrowdRun actual = run_sync(*db, **gpu, 16);
+  EXPECT_EQ(expected.totals.no_candidate, 0u);
+  EXPECT_EQ(actual.totals.no_candidate, 0u);
+  EXPECT_GT(actual.totals.jumps, 50u);
+  EXPECT_TRUE(expected.frames == actual.frames) << first_difference(expected, actual);
+  EXPECT_EQ(expected.searched, actual.searched);
+
+  // The deferred path: the GPU search overlaps the next tick.
+  DeferredSearch later(reference, 1024, test::kCrowdCharacters);
+  vulkan::VulkanAsyncSearch async(**gpu, test::kCrowdCharacters);
+  const test::CrowdRun expected_deferred = run_deferred(*db, later);
+  const test::CrowdRun actual_deferred = run_deferred(*db, async);
+  EXPECT_EQ(actual_deferred.totals.no_candidate, 0u);
+  EXPECT_TRUE(expected_deferred.frames == actual_deferred.frames) << first_difference(expected_deferred, actual_deferred);
+}
+
+}  // namespace
+}  // namespace mmvk

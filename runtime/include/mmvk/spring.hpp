@@ -22,6 +22,7 @@ inline float spring_rate(float half_life) { return 2.0f * kLn2 / half_life; }
 
 // Wraps an angle to [-pi, pi].
 inline float wrap_angle(float a) {
+  if (a >= -kPi && a <= kPi) return a;  // the usual case, without fmod
   a = std::fmod(a + kPi, 2.0f * kPi);
   if (a < 0.0f) a += 2.0f * kPi;
   return a - kPi;

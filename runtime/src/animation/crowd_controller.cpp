@@ -197,6 +197,17 @@ std::pair<std::uint32_t, std::uint32_t> difference_frames(const Database& databa
   return {frame, frame};
 }
 
+// The rotation vector of one frame's rotation step. Steps are small (under
+// 0.2 rad at 30 fps for human motion), where 2 v / w (the tangent of the half
+// angle) is within 0.4% of the angle and needs no atan; larger steps take
+// the exact map.
+glm::vec3 frame_rotation_vector(const glm::quat& q_in) {
+  const glm::quat q = q_in.w < 0.0f ? -q_in : q_in;
+  const float s2 = q.x * q.x + q.y * q.y + q.z * q.z;
+  if (s2 < 0.01f) return glm::vec3(q.x, q.y, q.z) * (2.0f / q.w);
+  return quat_to_rotation_vector(q);
+}
+
 // Local angular velocities (rad/s) and joint velocities (m/s) of the stored
 // animation at `frame`; only translated joints get a velocity.
 void pose_velocity(const Database& database, const AnimationData& animation, std::uint32_t frame,
@@ -207,7 +218,7 @@ void pose_velocity(const Database& database, const AnimationData& animation, std
   const glm::quat* qa = animation.local_rotations.data() + std::size_t{a} * joints;
   const glm::quat* qb = animation.local_rotations.data() + std::size_t{b} * joints;
   for (std::size_t j = 0; j < joints; ++j) {
-    angular[j] = a == b ? glm::vec3(0.0f) : quat_to_rotation_vector(qb[j] * glm::inverse(qa[j])) * fps;
+    angular[j] = a == b ? glm::vec3(0.0f) : frame_rotation_vector(qb[j] * glm::inverse(qa[j])) * fps;
     velocities[j] = glm::vec3(0.0f);
   }
   const std::size_t count = animation.translated_joints.size();

@@ -1,8 +1,10 @@
 #include "animation_report.hpp"
 
+#include <bit>
 #include <cstdio>
 #include <string>
 
+#include "mmvk/file_io.hpp"
 #include "cli_args.hpp"
 
 namespace mmvk::cli {
@@ -71,6 +73,69 @@ nlohmann::json animation_json(const Database& database) {
           {"contact_max_height", a->contact_params.max_height},
           {"contact_max_speed", a->contact_params.max_speed},
           {"contact_frames", {left, right}}};
+}
+
+Status export_animation(const Database& database, const std::string& source, const std::filesystem::path& values,
+                        const std::filesystem::path& sidecar) {
+  const AnimationData* a = database.animation();
+  if (a == nullptr) return missing_animation_error("mmvk export --animation");
+  const std::size_t joints = a->joint_count();
+  const std::size_t translated = a->translated_joints.size();
+  // Columns: rotations (x, y, z, w per joint), translations (x, y, z per
+  // translated joint), root x, root z, root yaw, contact bits.
+  const std::size_t columns = joints * 4 + translated * 3 + 4;
+  std::string bytes;
+  bytes.reserve(std::size_t{a->frame_count} * columns * 4);
+  auto put = [&](float v) {
+    const std::uint32_t bits = std::bit_cast<std::uint32_t>(v);
+    for (int b = 0; b < 4; ++b) bytes.push_back(static_cast<char>((bits >> (8 * b)) & 0xFF));
+  };
+  for (std::uint32_t f = 0; f < a->frame_count; ++f) {
+    for (std::size_t j = 0; j < joints; ++j) {
+      const glm::quat& q = a->local_rotations[f * joints + j];
+      put(q.x);
+      put(q.y);
+      put(q.z);
+      put(q.w);
+    }
+    for (std::size_t t = 0; t < translated; ++t) {
+      const glm::vec3& v = a->local_translations[f * translated + t];
+      put(v.x);
+      put(v.y);
+      put(v.z);
+    }
+    put(a->root_positions[f].x);
+    put(a->root_positions[f].z);
+    put(a->root_yaws[f]);
+    put(float(a->contacts[f]));
+  }
+  nlohmann::json names = nlohmann::json::array();
+  for (std::size_t j = 0; j < joints; ++j) {
+    for (const char* c : {"x", "y", "z", "w"}) names.push_back("rotation." + a->skeleton.names[j] + "." + c);
+  }
+  for (std::uint32_t j : a->translated_joints) {
+    for (const char* c : {"x", "y", "z"}) names.push_back("translation." + a->skeleton.names[j] + "." + c);
+  }
+  for (const char* c : {"root.x", "root.z", "root.yaw", "contacts"}) names.push_back(c);
+  nlohmann::json out = animation_json(database);
+  out["format"] = "float32 little-endian, row-major [frames x columns], one row per database frame";
+  out["values"] = values.filename().string();
+  out["source"] = source;
+  out["frames"] = a->frame_count;
+  out["fps"] = database.fps();
+  out["columns"] = names;
+  out["conventions"] =
+      "metres, radians, Y up; rotations are local quaternions (x, y, z, w) relative to the parent, except that "
+      "joints above the hips are the identity and the hips (and any joint without a parent) are relative to the "
+      "character root; root.x/root.z/root.yaw place the character root in its clip's world (yaw 0 faces +Z, "
+      "facing = (sin yaw, 0, cos yaw)); untranslated joints use rest_offset; contacts: bit 0 left, bit 1 right";
+  out["clips"] = nlohmann::json::array();
+  for (const Clip& clip : database.clips()) {
+    out["clips"].push_back({{"name", clip.name}, {"first_frame", clip.first_frame}, {"frame_count", clip.frame_count},
+                            {"loop", clip.loop}, {"mirrored", clip.mirrored}});
+  }
+  MMVK_TRY(write_file_atomically(values, bytes));
+  return write_file_atomically(sidecar, out.dump(1) + "\n");
 }
 
 }  // namespace mmvk::cli

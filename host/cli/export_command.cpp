@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "animation_report.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/file_io.hpp"
@@ -15,14 +16,18 @@ namespace mmvk::cli {
 namespace {
 
 constexpr const char* kExportUsage =
-    "usage: mmvk export db.mmdb --features out.f32 [--sidecar out.f32.json]\n"
+    "usage: mmvk export db.mmdb --features out.f32 [--sidecar out.f32.json] [--animation anim.f32]\n"
     "\n"
     "Writes the normalized feature matrix as raw little-endian float32, row-major\n"
     "[frames x dims], and a JSON sidecar (default: <out>.json) with dims, fps,\n"
     "channel names and groups, per-dimension names, offsets, scales and weights\n"
     "(raw = normalized * scale + offset; scale already includes 1 / weight), tag\n"
     "names, clip ranges and the per-frame flags (1 = do_not_use,\n"
-    "2 = block_transition, 4 = edge_excluded).\n";
+    "2 = block_transition, 4 = edge_excluded).\n"
+    "\n"
+    "--animation anim.f32 writes the animation section the same way (float32\n"
+    "[frames x columns] and anim.f32.json naming the columns, the skeleton and\n"
+    "the clips); either --features or --animation may be given alone.\n";
 
 nlohmann::json sidecar(const Database& db, const std::string& source, const std::string& features_path) {
   const FeatureSchema& schema = db.schema();
@@ -82,23 +87,32 @@ nlohmann::json sidecar(const Database& db, const std::string& source, const std:
 }  // namespace
 
 int run_export(Args args) {
-  const auto parsed = parse_args("export", args, {"--features", "--sidecar"}, {"--help", "-h"});
+  const auto parsed = parse_args("export", args, {"--features", "--sidecar", "--animation"}, {"--help", "-h"});
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
     std::fputs(kExportUsage, stdout);
     return 0;
   }
   const std::optional<std::string> features = parsed->value("--features");
-  if (parsed->positional.size() != 1 || !features) {
+  const std::optional<std::string> animation = parsed->value("--animation");
+  if (parsed->positional.size() != 1 || (!features && !animation)) {
     std::fputs(kExportUsage, stderr);
     return 2;
   }
-  const std::string sidecar_path = parsed->value("--sidecar").value_or(*features + ".json");
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db.ok()) {
     std::fprintf(stderr, "mmvk export: %s\n", db.message().c_str());
     return 1;
   }
+  if (animation) {
+    if (Status written = export_animation(*db, parsed->positional[0], *animation, *animation + ".json"); !written.ok()) {
+      std::fprintf(stderr, "mmvk export: %s\n", written.message().c_str());
+      return 1;
+    }
+    std::printf("wrote %s (%u frames, float32) and %s.json\n", animation->c_str(), db->frame_count(), animation->c_str());
+    if (!features) return 0;
+  }
+  const std::string sidecar_path = parsed->value("--sidecar").value_or(*features + ".json");
   Status written = write_f32_rows(*features, db->features());
   if (written.ok()) {
     written = write_file_atomically(sidecar_path, sidecar(*db, parsed->positional[0], *features).dump(1) + "\n");

@@ -6,7 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
@@ -235,6 +239,65 @@ TEST_F(AnimationData_, SurvivesTheFileAndLeavesFeaturesAlone) {
   EXPECT_EQ(plain->animation(), nullptr);
   EXPECT_EQ(plain->content_hash(), database_->content_hash());
   EXPECT_LT(serialize_database(*plain).size() + a.frame_count * a.bytes_per_frame_in_file(), bytes.size() + 1);
+}
+
+int run(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()); }
+
+TEST(AnimationCommandLine, BuildInspectExport) {
+  MMVK_REQUIRE_DATA_DIR(data);
+  const auto cli = test::cli_binary();
+  if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
+  const std::string mmvk = cli->string();
+  const auto dir = test::make_temp_dir();
+  const std::string walk = (data / kLocomotion / "dataset-2_walk_normal_003.bvh").string();
+  std::ofstream(dir / "m.json") << R"({"clips": [{"file": ")" << walk << R"("}]})";
+  const std::string db = (dir / "db.mmdb").string();
+  const std::string plain = (dir / "plain.mmdb").string();
+  const std::string quantized = (dir / "q.mmdb").string();
+  const std::string manifest = (dir / "m.json").string();
+  ASSERT_EQ(run(mmvk + " build " + manifest + " -o " + db + " --no-progress"), 0);
+  ASSERT_EQ(run(mmvk + " build " + manifest + " -o " + plain + " --no-animation --no-progress"), 0);
+  ASSERT_EQ(run(mmvk + " build " + manifest + " -o " + quantized + " --quantize-rotations --no-progress"), 0);
+  Result<Database> loaded = load_database(db);
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  ASSERT_NE(loaded->animation(), nullptr);
+  const AnimationData& a = *loaded->animation();
+  Result<Database> loaded_plain = load_database(plain);
+  ASSERT_TRUE(loaded_plain.ok());
+  EXPECT_EQ(loaded_plain->animation(), nullptr);
+  // The section costs its bytes per frame plus a skeleton header of under 2 KB.
+  const std::uintmax_t section = std::filesystem::file_size(db) - std::filesystem::file_size(plain);
+  EXPECT_GE(section, std::uintmax_t{a.frame_count} * a.bytes_per_frame_in_file());
+  EXPECT_LT(section, std::uintmax_t{a.frame_count} * a.bytes_per_frame_in_file() + 2048);
+  Result<Database> loaded_quantized = load_database(quantized);
+  ASSERT_TRUE(loaded_quantized.ok());
+  EXPECT_EQ(loaded_quantized->animation()->encoding, RotationEncoding::Quantized16);
+
+  ASSERT_EQ(std::system((mmvk + " inspect --json " + db + " > " + (dir / "i.json").string()).c_str()), 0);
+  const nlohmann::json inspect = nlohmann::json::parse(std::ifstream(dir / "i.json"));
+  EXPECT_EQ(inspect["animation"]["present"], true);
+  EXPECT_EQ(inspect["animation"]["joints"].size(), 22u);
+  EXPECT_EQ(inspect["animation"]["joints"][1]["name"], "Hips");
+  EXPECT_EQ(inspect["animation"]["bytes_per_frame_file"], a.bytes_per_frame_in_file());
+  ASSERT_EQ(std::system((mmvk + " inspect --json " + plain + " > " + (dir / "p.json").string()).c_str()), 0);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "p.json"))["animation"]["present"], false);
+
+  const std::string out = (dir / "anim.f32").string();
+  ASSERT_EQ(run(mmvk + " export " + db + " --animation " + out), 0);
+  const nlohmann::json sidecar = nlohmann::json::parse(std::ifstream(out + ".json"));
+  const std::size_t columns = sidecar["columns"].size();
+  EXPECT_EQ(columns, 22u * 4 + a.translated_joints.size() * 3 + 4);
+  EXPECT_EQ(sidecar["frames"], a.frame_count);
+  ASSERT_EQ(std::filesystem::file_size(out), std::size_t{a.frame_count} * columns * 4);
+  std::ifstream in(out, std::ios::binary);
+  std::vector<float> values(std::size_t{a.frame_count} * columns);
+  in.read(reinterpret_cast<char*>(values.data()), static_cast<std::streamsize>(values.size() * 4));  // little-endian host
+  const std::size_t f = 17;
+  EXPECT_EQ(values[f * columns + 4 * 5 + 3], a.local_rotations[f * 22 + 5].w);
+  EXPECT_EQ(values[f * columns + columns - 2], a.root_yaws[f]);
+  EXPECT_EQ(values[f * columns + columns - 1], float(a.contacts[f]));
+  // Without animation: a non-zero exit naming the fix.
+  EXPECT_NE(run(mmvk + " export " + plain + " --animation " + out), 0);
 }
 
 }  // namespace

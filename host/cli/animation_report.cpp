@@ -45,10 +45,11 @@ void print_animation(const Database& database) {
               a->joint_count(), a->translated_joints.size(), encoding_name(a->encoding), a->bytes_per_frame_in_file(),
               a->bytes_per_frame_in_memory(),
               thousands(static_cast<unsigned long long>(a->bytes_per_frame_in_file()) * a->frame_count).c_str());
-  std::printf("contacts: %s %.0f%% of frames, %s %.0f%% (height < %g m, speed < %g m/s)\n",
+  std::printf("contacts: %s %.0f%% of frames, %s %.0f%% (height < %s%g m, speed < %g m/s)\n",
               joint_name(*a, a->contact_joints[0]).c_str(), 100.0 * double(left) / frames,
               joint_name(*a, a->contact_joints[1]).c_str(), 100.0 * double(right) / frames,
-              double(a->contact_params.max_height), double(a->contact_params.max_speed));
+              a->contact_params.height_above_clip_floor ? "clip floor + " : "", double(a->contact_params.max_height),
+              double(a->contact_params.max_speed));
 }
 
 nlohmann::json animation_json(const Database& database) {
@@ -71,6 +72,8 @@ nlohmann::json animation_json(const Database& database) {
           {"bytes_per_frame_memory", a->bytes_per_frame_in_memory()},
           {"contact_joints", {joint_name(*a, a->contact_joints[0]), joint_name(*a, a->contact_joints[1])}},
           {"contact_max_height", a->contact_params.max_height},
+          {"contact_height_above_clip_floor", a->contact_params.height_above_clip_floor},
+          {"contact_floor_percentile", a->contact_params.floor_percentile},
           {"contact_max_speed", a->contact_params.max_speed},
           {"contact_frames", {left, right}}};
 }

@@ -22,7 +22,8 @@
 //                              u32 T, then T x u32 translated joints;
 //                              i32 left, i32 right contact joint, str left bone,
 //                              str right bone, f32 max height, f32 max speed,
-//                              f32 ankle height extra;
+//                              f32 ankle height extra, u8 height above clip floor,
+//                              f32 floor percentile;
 //                              u8 rotation encoding (0 float32, 1 quantized16);
 //                              u32 frames, then rotations [frames x joints]
 //                              (x, y, z, w as f32, or as i16 / 32767 with w >= 0),

@@ -141,6 +141,8 @@ void write_animation(Writer& file, const AnimationData& a) {
   file.f32(a.contact_params.max_height);
   file.f32(a.contact_params.max_speed);
   file.f32(a.contact_params.ankle_height_extra);
+  file.u8(a.contact_params.height_above_clip_floor ? 1 : 0);
+  file.f32(a.contact_params.floor_percentile);
   file.u8(static_cast<std::uint8_t>(a.encoding));
   file.u32(a.frame_count);
   for (const glm::quat& q : a.local_rotations) {
@@ -193,11 +195,15 @@ std::string read_animation(Reader& in, AnimationData& a) {
   std::uint32_t left = 0;
   std::uint32_t right = 0;
   std::uint8_t encoding = 0;
+  std::uint8_t above_floor = 0;
   FootContactParams& c = a.contact_params;
   if (!in.u32(left) || !in.u32(right) || !in.str(c.left_bone) || !in.str(c.right_bone) || !in.f32(c.max_height) ||
-      !in.f32(c.max_speed) || !in.f32(c.ankle_height_extra) || !in.u8(encoding) || !in.u32(a.frame_count)) {
+      !in.f32(c.max_speed) || !in.f32(c.ankle_height_extra) || !in.u8(above_floor) || !in.f32(c.floor_percentile) ||
+      !in.u8(encoding) || !in.u32(a.frame_count)) {
     return "animation contacts and encoding";
   }
+  if (above_floor > 1) return "contact height mode";
+  c.height_above_clip_floor = above_floor != 0;
   if (encoding > static_cast<std::uint8_t>(RotationEncoding::Quantized16)) return "rotation encoding";
   a.contact_joints = {static_cast<int>(left), static_cast<int>(right)};
   a.encoding = static_cast<RotationEncoding>(encoding);

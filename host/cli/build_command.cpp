@@ -108,6 +108,9 @@ int run_build(Args args) {
   BuildOptions options;
   options.pool = &pool;
   options.animation.enabled = !parsed->has("--no-animation");
+  options.animation.warning = [](const std::string& message) {
+    std::fprintf(stderr, "mmvk build: warning: %s\n", message.c_str());
+  };
   if (parsed->has("--quantize-rotations")) options.animation.encoding = RotationEncoding::Quantized16;
   const bool show_progress =
       !parsed->has("--no-progress") && (parsed->has("--progress") || stderr_is_terminal());

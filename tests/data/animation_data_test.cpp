@@ -241,6 +241,25 @@ TEST_F(AnimationData_, SurvivesTheFileAndLeavesFeaturesAlone) {
   EXPECT_LT(serialize_database(*plain).size() + a.frame_count * a.bytes_per_frame_in_file(), bytes.size() + 1);
 }
 
+TEST(AnimationBuild, MixedSkeletonsBuildWithoutTheSectionAndSayWhy) {
+  MMVK_REQUIRE_DATA_DIR(data);
+  Manifest mixed;
+  mixed.source = "mixed";
+  mixed.fps = 30.0f;
+  mixed.clips.resize(2);
+  mixed.clips[0].file = data / kLocomotion / "dataset-2_walk_normal_001.bvh";
+  mixed.clips[1].file = data / "cmu/amc2bvh-131/131_01.bvh";
+  std::string warning;
+  BuildOptions options;
+  options.animation.warning = [&](const std::string& message) { warning = message; };
+  Result<Database> db = build_database(mixed, options);
+  ASSERT_TRUE(db.ok()) << db.message();
+  EXPECT_EQ(db->animation(), nullptr);
+  EXPECT_NE(warning.find("different skeletons"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("131_01.bvh"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("walk_normal_001.bvh"), std::string::npos) << warning;
+}
+
 int run(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()); }
 
 TEST(AnimationCommandLine, BuildInspectExport) {

@@ -45,9 +45,13 @@ struct BuildProgress {
 };
 
 // The animation section (animation_data.hpp): on by default. It needs one
-// skeleton (joint names and parents) across all clips.
+// skeleton (joint names and parents) across all clips; when the clips'
+// skeletons differ (which the features allow), the database is built
+// without the section and `warning` (when set) receives a message naming two
+// clips that differ.
 struct AnimationBuildOptions {
   bool enabled = true;  // false = features only (mmvk build --no-animation)
+  std::function<void(const std::string&)> warning;
   FootContactParams contacts;
   RotationEncoding encoding = RotationEncoding::Float32;  // how the .mmdb file keeps rotations
 };

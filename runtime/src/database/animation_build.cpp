@@ -158,9 +158,9 @@ Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, c
   std::uint64_t frames = 0;
   for (const ClipAnimation& clip : clips) {
     if (clip.skeleton.names != first.skeleton.names || clip.skeleton.parents != first.skeleton.parents) {
-      return make_error("animation: " + clip.source + " and " + first.source +
-                        " have different skeletons (joint names or parents); the animation section holds one "
-                        "skeleton: build with --no-animation to store features only");
+      return make_error("no animation section: " + clip.source + " and " + first.source +
+                        " have different skeletons (joint names or parents), and the section holds one skeleton; "
+                        "build clips of one skeleton to animate them");
     }
     frames += clip.frame_count;
   }

@@ -38,7 +38,8 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
                                              std::string source);
 
 // Concatenates the clips in order. Errors: clips with different skeletons
-// (names or parents), naming both files and the way out (--no-animation).
+// (names or parents), naming both files (the build then leaves the section
+// out and passes the message on as a warning).
 Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, const FootContactParams& contacts,
                                          RotationEncoding encoding);
 

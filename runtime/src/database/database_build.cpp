@@ -98,8 +98,13 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
     animations.reserve(clips.size());
     for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
     Result<AnimationData> data = detail::assemble_animation(animations, animation.contacts, animation.encoding);
-    if (!data.ok()) return make_error(source + ": " + data.message());
-    parts.animation = std::move(*data);
+    if (data.ok()) {
+      parts.animation = std::move(*data);
+    } else if (animation.warning) {
+      // Mixed skeletons are valid for the features: the database is built
+      // without poses and the caller is told why.
+      animation.warning(source + ": " + data.message());
+    }
   }
   for (ProcessedClip& processed : clips) {
     Clip clip = processed.clip;

@@ -13,32 +13,34 @@ VulkanAsyncSearch::VulkanAsyncSearch(VulkanSearch& search, std::uint32_t capacit
   chunk_begin_.reserve(chunks);
 }
 
+Status VulkanAsyncSearch::submit_next_chunk() {
+  const std::size_t max_batch = search_.options().max_batch;
+  const std::size_t dims = search_.database().dims();
+  const std::size_t count = std::min(max_batch, batch_.size - next_chunk_);
+  QueryBatch chunk;
+  chunk.features = batch_.features.subspan(next_chunk_ * dims, count * dims);
+  chunk.params = batch_.params.empty() ? batch_.params : batch_.params.subspan(next_chunk_, count);
+  chunk.size = count;
+  Result<Ticket> ticket = search_.submit(chunk, 1);
+  if (!ticket.ok()) return ticket.status();
+  tickets_.push_back(*ticket);
+  chunk_begin_.push_back(next_chunk_);
+  next_chunk_ += count;
+  return {};
+}
+
 Status VulkanAsyncSearch::submit(const QueryBatch& batch) {
   if (in_flight_) return make_error("vulkan async search: submit while a search is in flight (collect it first)");
   batch_ = batch;
   next_chunk_ = 0;
   tickets_.clear();
   chunk_begin_.clear();
-  in_flight_ = true;
-  const std::size_t max_batch = search_.options().max_batch;
-  const std::size_t dims = search_.database().dims();
   // As many chunks as there are slots now; the rest go out in collect() as
   // slots free up.
   while (next_chunk_ < batch_.size && tickets_.size() < search_.options().slots) {
-    const std::size_t count = std::min(max_batch, batch_.size - next_chunk_);
-    QueryBatch chunk;
-    chunk.features = batch_.features.subspan(next_chunk_ * dims, count * dims);
-    chunk.params = batch_.params.empty() ? batch_.params : batch_.params.subspan(next_chunk_, count);
-    chunk.size = count;
-    Result<Ticket> ticket = search_.submit(chunk, 1);
-    if (!ticket.ok()) {
-      in_flight_ = false;
-      return ticket.status();
-    }
-    tickets_.push_back(*ticket);
-    chunk_begin_.push_back(next_chunk_);
-    next_chunk_ += count;
+    if (Status status = submit_next_chunk(); !status.ok()) return status;
   }
+  in_flight_ = true;
   return {};
 }
 
@@ -50,24 +52,11 @@ Status VulkanAsyncSearch::collect(std::span<Match> out) {
   }
   in_flight_ = false;
   const std::size_t max_batch = search_.options().max_batch;
-  const std::size_t dims = search_.database().dims();
   // Oldest chunk first; each finished one frees a slot for the next chunk.
   for (std::size_t i = 0; i < tickets_.size(); ++i) {
     const std::size_t first = chunk_begin_[i];
-    const std::size_t count = std::min(max_batch, batch_.size - first);
-    MMVK_TRY(search_.wait(tickets_[i], out.subspan(first, count)));
-    if (next_chunk_ < batch_.size) {
-      const std::size_t next = std::min(max_batch, batch_.size - next_chunk_);
-      QueryBatch chunk;
-      chunk.features = batch_.features.subspan(next_chunk_ * dims, next * dims);
-      chunk.params = batch_.params.empty() ? batch_.params : batch_.params.subspan(next_chunk_, next);
-      chunk.size = next;
-      Result<Ticket> ticket = search_.submit(chunk, 1);
-      if (!ticket.ok()) return ticket.status();
-      tickets_.push_back(*ticket);
-      chunk_begin_.push_back(next_chunk_);
-      next_chunk_ += next;
-    }
+    MMVK_TRY(search_.wait(tickets_[i], out.subspan(first, std::min(max_batch, batch_.size - first))));
+    if (next_chunk_ < batch_.size) MMVK_TRY(submit_next_chunk());
   }
   return {};
 }

@@ -25,6 +25,9 @@ class VulkanAsyncSearch final : public AsyncSearch {
   Status collect(std::span<Match> out) override;
 
  private:
+  // Submits the next chunk of batch_ (at most max_batch queries).
+  Status submit_next_chunk();
+
   VulkanSearch& search_;
   QueryBatch batch_;                      // the batch in flight
   std::size_t next_chunk_ = 0;            // first query not yet submitted

@@ -6,6 +6,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "mmvk/channel_kinds.hpp"
+
 namespace mmvk {
 
 Result<QueryAssembler> QueryAssembler::create(const Database& database) {
@@ -17,21 +19,10 @@ Result<QueryAssembler> QueryAssembler::create(const Database& database) {
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
     const std::uint32_t first = schema.offset(c);
-    bool trajectory = false;
-    switch (channel.kind) {
-      case ChannelKind::TrajectoryPosition:
-        has_positions = true;
-        trajectory = true;
-        break;
-      case ChannelKind::TrajectoryDirection:
-        trajectory = true;
-        break;
-      case ChannelKind::BonePosition:
-      case ChannelKind::BoneVelocity:
-      case ChannelKind::RootVelocity:
-      case ChannelKind::Custom:
-        break;
-    }
+    // Channels with trajectory offsets are filled from the prediction (the
+    // kind table says which); every other channel is copied from the frame.
+    const bool trajectory = uses_trajectory_offsets(channel.kind);
+    has_positions = has_positions || channel.kind == ChannelKind::TrajectoryPosition;
     if (!trajectory) {
       // Adjacent pose channels merge into one copy run.
       if (!out.copies_.empty() && out.copies_.back().begin + out.copies_.back().count == first) {
@@ -57,7 +48,7 @@ Result<QueryAssembler> QueryAssembler::create(const Database& database) {
   std::sort(out.offsets_.begin(), out.offsets_.end());
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
-    if (channel.kind != ChannelKind::TrajectoryPosition && channel.kind != ChannelKind::TrajectoryDirection) continue;
+    if (!uses_trajectory_offsets(channel.kind)) continue;
     std::uint32_t dim = schema.offset(c);
     for (float t : channel.offsets_seconds) {
       const auto index = static_cast<std::uint32_t>(std::find(out.offsets_.begin(), out.offsets_.end(), t) -

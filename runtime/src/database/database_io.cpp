@@ -58,20 +58,8 @@ class Reader {
     v = static_cast<std::uint8_t>(bytes_[pos_++]);
     return true;
   }
-  bool u32(std::uint32_t& v) {
-    if (left() < 4) return false;
-    v = 0;
-    for (int i = 0; i < 4; ++i) v |= std::uint32_t{static_cast<std::uint8_t>(bytes_[pos_ + i])} << (8 * i);
-    pos_ += 4;
-    return true;
-  }
-  bool u64(std::uint64_t& v) {
-    if (left() < 8) return false;
-    v = 0;
-    for (int i = 0; i < 8; ++i) v |= std::uint64_t{static_cast<std::uint8_t>(bytes_[pos_ + i])} << (8 * i);
-    pos_ += 8;
-    return true;
-  }
+  bool u32(std::uint32_t& v) { return little_endian(v); }
+  bool u64(std::uint64_t& v) { return little_endian(v); }
   bool f32(float& v) {
     std::uint32_t bits = 0;
     if (!u32(bits)) return false;
@@ -100,6 +88,17 @@ class Reader {
   }
 
  private:
+  template <class Unsigned>
+  bool little_endian(Unsigned& v) {
+    if (left() < sizeof(Unsigned)) return false;
+    v = 0;
+    for (std::size_t i = 0; i < sizeof(Unsigned); ++i) {
+      v |= Unsigned{static_cast<std::uint8_t>(bytes_[pos_ + i])} << (8 * i);
+    }
+    pos_ += sizeof(Unsigned);
+    return true;
+  }
+
   std::string_view bytes_;
   std::size_t pos_;
   std::size_t end_;

@@ -1,0 +1,44 @@
+// The search a crowd run uses: a backend made by name, behind the
+// controller's deferred interface (AsyncSearch). Every backend goes through
+// the same deferred path (results applied one tick after the search), so
+// that the chosen frames are equal across backends for the same seed; on
+// Vulkan the search really runs asynchronously and overlaps the host's next
+// step, on the CPU backends it runs at submit.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "mmvk/crowd_controller.hpp"
+#include "mmvk/database.hpp"
+#include "mmvk/search.hpp"
+#include "mmvk/status.hpp"
+#include "mmvk/thread_pool.hpp"
+
+#if defined(MMVK_HAS_VULKAN)
+#include "mmvk/vulkan/context.hpp"
+#endif
+
+namespace mmvk::crowd {
+
+struct CrowdSearch {
+#if defined(MMVK_HAS_VULKAN)
+  std::unique_ptr<vulkan::Context> context;  // declared first: outlives the backend
+#endif
+  std::unique_ptr<SearchBackend> backend;
+  std::unique_ptr<AsyncSearch> deferred;     // on `backend`
+  std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
+};
+
+// The backend names `mmvk crowd --backend` accepts, comma-separated.
+std::string crowd_backend_names();
+
+// Makes `name` on `database` for up to `agents` queries per tick. `device`
+// picks the Vulkan device (none: the best one). Errors: an unknown name
+// (listing the known ones), no Vulkan device, a database too large.
+Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
+                                      const Database& database, std::uint32_t agents, ThreadPool& pool);
+
+}  // namespace mmvk::crowd

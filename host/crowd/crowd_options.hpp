@@ -1,0 +1,29 @@
+// Everything `mmvk crowd` is asked to do, as the command line parsed it.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace mmvk::crowd {
+
+struct CrowdOptions {
+  std::optional<std::filesystem::path> data;  // .mmdb, manifest or BVH folder; none = the shipped CMU walks
+  std::optional<std::uint32_t> agents;        // none: 1000, or the scenario's count
+  double seconds = 10.0;                      // simulated time
+  double rate_hz = 30.0;                      // simulation ticks per second
+  double search_interval_s = 0.1;             // regular search period of each character
+  std::string backend = "vulkan";             // a backend registry name
+  std::optional<std::uint32_t> device;        // Vulkan device index; none = the best
+  std::uint64_t seed = 1;
+  std::optional<std::filesystem::path> scenario;
+  std::optional<std::filesystem::path> summary;
+  std::optional<std::filesystem::path> html;
+  // Set by the command line, not by flags.
+  std::filesystem::path executable;           // for the shipped data beside an installed binary
+  std::filesystem::path cache_dir;            // empty: never cache
+  bool progress = false;                      // draw the live progress line (stderr is a terminal)
+};
+
+}  // namespace mmvk::crowd

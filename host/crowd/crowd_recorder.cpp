@@ -1,0 +1,124 @@
+#include "crowd_recorder.hpp"
+
+#include <cmath>
+
+#include "mmvk/pose_batch.hpp"
+
+namespace mmvk::crowd {
+
+namespace {
+
+// The dims of the trajectory_position channel whose offsets are exactly the
+// controller's trajectory offsets, one per offset; empty when none matches.
+std::vector<std::uint32_t> matched_trajectory_dims(const Database& database, std::span<const float> offsets) {
+  const FeatureSchema& schema = database.schema();
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& ch = schema.channels[c];
+    if (ch.kind != ChannelKind::TrajectoryPosition || ch.offsets_seconds.size() != offsets.size()) continue;
+    if (!std::equal(offsets.begin(), offsets.end(), ch.offsets_seconds.begin())) continue;
+    std::vector<std::uint32_t> dims;
+    for (std::size_t i = 0; i < offsets.size(); ++i) dims.push_back(schema.offset(c) + std::uint32_t(2 * i));
+    return dims;
+  }
+  return {};
+}
+
+}  // namespace
+
+CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& scenario, std::string title, float dt,
+                             std::uint32_t ticks_per_sample)
+    : controller_(controller), dt_(dt), ticks_per_sample_(std::max<std::uint32_t>(1, ticks_per_sample)) {
+  Recording& r = recording_;
+  r.title = std::move(title);
+  r.sample_rate_hz = 1.0f / (dt * float(ticks_per_sample_));
+  r.agent_count = controller.size();
+  const auto offsets = controller.trajectory_offsets();
+  r.trajectory_times_s.assign(offsets.begin(), offsets.end());
+  r.goals.resize(r.agent_count);
+  for (std::size_t a = 0; a < r.agent_count && a < scenario.agents.size(); ++a) {
+    for (const auto& goal : scenario.agents[a].goals) r.goals[a].push_back({goal[0], goal[1]});
+  }
+  r.searches.resize(r.agent_count);
+  const Skeleton& skeleton = controller.animation().skeleton;
+  r.joint_names = skeleton.names;
+  r.joint_parents.assign(skeleton.parents.begin(), skeleton.parents.end());
+  frame_seen_.assign(controller.database().frame_count(), 0);
+  matched_dims_ = matched_trajectory_dims(controller.database(), offsets);
+}
+
+void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> collected,
+                                std::span<const std::uint32_t> searched_before,
+                                std::span<const std::uint32_t> frames_before) {
+  const auto jumped = controller_.jumped();
+  // The searches ran at the end of the previous tick.
+  const float searched_at = float(tick) * dt_;
+  for (std::size_t i = 0; i < collected.size() && i < searched_before.size(); ++i) {
+    const std::uint32_t b = searched_before[i];
+    SearchEvent event;
+    event.time_s = searched_at;
+    event.jumped = jumped[b] != 0;
+    event.from_frame = std::int32_t(frames_before[b]);
+    event.to_frame = collected[i].frame == kNoFrame ? -1 : std::int32_t(collected[i].frame);
+    event.cost = std::isfinite(collected[i].cost) ? collected[i].cost : 0.0f;
+    recording_.searches[b].push_back(event);
+  }
+  if (tick % ticks_per_sample_ == 0) sample(tick);
+}
+
+void CrowdRecorder::sample(std::uint64_t /*tick*/) {
+  Recording& r = recording_;
+  const std::size_t n = r.agent_count;
+  const std::size_t points = r.trajectory_points();
+  const auto roots = controller_.root_positions();
+  const auto yaws = controller_.root_yaws();
+  const auto frames = controller_.frames();
+  const auto predicted = controller_.predicted_positions();
+  const Database& db = controller_.database();
+  const auto norm = db.normalization();
+  for (std::size_t b = 0; b < n; ++b) {
+    r.root_x.push_back(roots[b].x);
+    r.root_z.push_back(roots[b].z);
+    r.facing.push_back(yaws[b]);
+    r.frame.push_back(std::int32_t(frames[b]));
+    frame_seen_[frames[b]] = 1;
+    const float c = std::cos(yaws[b]), s = std::sin(yaws[b]);
+    for (std::size_t p = 0; p < points; ++p) {
+      r.desired_x.push_back(predicted[b * points + p].x);
+      r.desired_z.push_back(predicted[b * points + p].z);
+      if (matched_dims_.empty()) continue;
+      // The matched frame's future root, from its features (character space).
+      const auto row = db.row(frames[b]);
+      const std::uint32_t d = matched_dims_[p];
+      const float x = row[d] * norm[d].scale + norm[d].offset;
+      const float z = row[d + 1] * norm[d + 1].scale + norm[d + 1].offset;
+      r.matched_x.push_back(roots[b].x + c * x + s * z);
+      r.matched_z.push_back(roots[b].z - s * x + c * z);
+    }
+  }
+  ++r.sample_count;
+}
+
+Recording CrowdRecorder::finish(ThreadPool& pool) {
+  Recording& r = recording_;
+  const AnimationData& animation = controller_.animation();
+  const std::size_t joints = animation.joint_count();
+  for (std::uint32_t f = 0; f < frame_seen_.size(); ++f) {
+    if (frame_seen_[f]) r.pose_frames.push_back(std::int32_t(f));
+  }
+  const std::size_t count = r.pose_frames.size();
+  std::vector<glm::quat> rotations(count * joints);
+  std::vector<glm::vec3> translations(count * joints), world(count * joints);
+  for (std::size_t i = 0; i < count; ++i) {
+    sample_pose(animation, std::uint32_t(r.pose_frames[i]), std::span(rotations).subspan(i * joints, joints),
+                std::span(translations).subspan(i * joints, joints));
+  }
+  // Character space: every pose at the origin, facing +Z.
+  const std::vector<glm::vec3> origins(count, glm::vec3(0.0f));
+  const std::vector<float> zero_yaws(count, 0.0f);
+  forward_kinematics_batch(animation.skeleton, rotations, translations, origins, zero_yaws, world, &pool);
+  r.pose_positions.reserve(count * joints * 3);
+  for (const glm::vec3& p : world) r.pose_positions.insert(r.pose_positions.end(), {p.x, p.y, p.z});
+  return std::move(recording_);
+}
+
+}  // namespace mmvk::crowd

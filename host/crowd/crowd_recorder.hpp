@@ -1,0 +1,45 @@
+// Fills the viewer's Recording (recording.hpp) while a crowd runs: the
+// sampled roots, frames and desired trajectories, each search as an event,
+// and at the end the character-space poses of every frame that was played.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mmvk/crowd_controller.hpp"
+#include "recording.hpp"
+#include "scenario.hpp"
+
+namespace mmvk::crowd {
+
+class CrowdRecorder {
+ public:
+  // Records every `ticks_per_sample`-th tick (ticks of `dt` seconds).
+  CrowdRecorder(const CrowdController& controller, const Scenario& scenario, std::string title, float dt,
+                std::uint32_t ticks_per_sample);
+
+  // After each tick `tick` (0-based, its end at (tick + 1) * dt):
+  // `collected` are the matches the tick applied, for the characters that
+  // searched in the tick before (`searched_before`, ascending), and
+  // `frames_before` the frames they played when they searched.
+  void record_tick(std::uint64_t tick, std::span<const Match> collected,
+                   std::span<const std::uint32_t> searched_before, std::span<const std::uint32_t> frames_before);
+
+  // Adds the poses of the frames seen and returns the recording.
+  Recording finish(ThreadPool& pool);
+
+ private:
+  void sample(std::uint64_t tick);
+
+  const CrowdController& controller_;
+  Recording recording_;
+  float dt_;
+  std::uint32_t ticks_per_sample_;
+  std::vector<std::uint8_t> frame_seen_;  // [database frames]
+  // The database's trajectory_position features, to draw the matched
+  // trajectory: first dim of each offset's (x, z), or empty.
+  std::vector<std::uint32_t> matched_dims_;
+};
+
+}  // namespace mmvk::crowd

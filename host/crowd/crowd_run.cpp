@@ -1,0 +1,268 @@
+#include "crowd_run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "crowd_backend.hpp"
+#include "crowd_recorder.hpp"
+#include "default_data.hpp"
+#include "fnv.hpp"
+#include "gait_speeds.hpp"
+#include "mmvk/crowd_controller.hpp"
+#include "mmvk/trajectory.hpp"
+#include "observed_search.hpp"
+#include "progress_line.hpp"
+#include "quality_meter.hpp"
+#include "scenario.hpp"
+#include "steering.hpp"
+
+#if defined(MMVK_CROWD_HAS_VIEWER)
+#include "viewer/viewer_html.hpp"
+#endif
+
+namespace mmvk::crowd {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+Status check_options(const CrowdOptions& o) {
+  if (o.agents && *o.agents == 0) return make_error("--agents must be at least 1");
+  if (!(o.seconds > 0.0) || !std::isfinite(o.seconds)) return make_error("--seconds must be a positive number");
+  if (!(o.rate_hz > 0.0) || !std::isfinite(o.rate_hz)) return make_error("--rate must be a positive number (Hz)");
+  if (!(o.search_interval_s > 0.0) || !std::isfinite(o.search_interval_s)) {
+    return make_error("--search-interval must be a positive number (seconds)");
+  }
+  if (o.seconds * o.rate_hz > 1.0e7) return make_error("--seconds x --rate is over 10 million ticks");
+  return {};
+}
+
+Result<OpenedDatabase> open_crowd_database(const CrowdOptions& options, std::FILE* log) {
+  auto say = [log](const std::string& line) {
+    if (log) std::fprintf(log, "mmvk crowd: %s\n", line.c_str());
+  };
+  if (options.data) return open_database(*options.data, options.cache_dir, say);
+  for (const auto& candidate : default_manifest_candidates(options.executable)) {
+    std::error_code ec;
+    if (std::filesystem::exists(candidate, ec)) return open_database(candidate, options.cache_dir, say);
+  }
+  return make_error("the default motion data (host/crowd/data/cmu131) was not found beside the program or in "
+                    "its source tree; pass --data DIR|manifest.json|db.mmdb");
+}
+
+Result<Scenario> make_scenario(const CrowdOptions& options) {
+  if (!options.scenario) {
+    RandomScenarioOptions random;
+    random.agents = options.agents.value_or(1000);
+    random.seed = options.seed;
+    return make_random_scenario(random);
+  }
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, load_scenario(*options.scenario));
+  if (options.agents && *options.agents != scenario.agents.size()) {
+    return make_error(scenario.source + ": defines " + std::to_string(scenario.agents.size()) +
+                      " agents, but --agents asks for " + std::to_string(*options.agents) +
+                      " (leave --agents out with --scenario)");
+  }
+  return scenario;
+}
+
+// Tags by name, per agent, into the controller's query parameters.
+Status apply_tags(const Scenario& scenario, const Database& database, std::span<QueryParams> params) {
+  for (std::size_t a = 0; a < scenario.agents.size(); ++a) {
+    const AgentPlan& plan = scenario.agents[a];
+    const std::string where = scenario.source + ": agents[" + std::to_string(a) + "].";
+    Result<TagMask> require = database.tag_mask(plan.require_tags);
+    if (!require) return make_error(where + "require_tags: " + require.message());
+    Result<TagMask> exclude = database.tag_mask(plan.exclude_tags);
+    if (!exclude) return make_error(where + "exclude_tags: " + exclude.message());
+    params[a].require_all = *require;
+    params[a].exclude_any = *exclude;
+  }
+  return {};
+}
+
+// The 1 s horizon of the trajectory error, as the controller would predict it.
+constexpr float kErrorHorizon[1] = {1.0f};
+
+}  // namespace
+
+Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
+  MMVK_TRY(check_options(options));
+  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(options, log));
+  const Database& db = opened.database;
+  const std::string db_name = (options.data ? options.data->string() : std::string("the CMU 131 walks (default)"));
+  if (!db.animation()) {
+    return make_error(db_name + ": " + missing_animation_error("mmvk crowd").message);
+  }
+  Result<GaitSpeeds> speeds = measure_gait_speeds(db);
+  if (!speeds) return make_error(db_name + ": " + speeds.message());
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options));
+  const auto agents = std::uint32_t(scenario.agents.size());
+
+  ControllerParams params;
+  params.search_interval = float(options.search_interval_s);
+  Result<CrowdController> created = CrowdController::create(db, agents, params);
+  if (!created) return make_error(db_name + ": " + created.message());
+  CrowdController controller = std::move(created.value());
+  MMVK_TRY(apply_tags(scenario, db, controller.query_params()));
+  for (std::uint32_t b = 0; b < agents; ++b) {
+    const AgentPlan& plan = scenario.agents[b];
+    const float yaw = std::atan2(plan.goals[0][0] - plan.start[0], plan.goals[0][1] - plan.start[1]);
+    MMVK_TRY(controller.place(b, glm::vec3(plan.start[0], 0.0f, plan.start[1]), yaw));
+  }
+
+  ThreadPool pool(0);
+  MMVK_ASSIGN_OR_RETURN(CrowdSearch search, make_crowd_search(options.backend, options.device, db, agents, pool));
+  if (log) {
+    std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, run %.2f m/s)\n",
+                 agents, options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps,
+                 speeds->run_mps);
+    std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
+                 search.device.c_str());
+  }
+
+  const float dt = float(1.0 / options.rate_hz);
+  const auto ticks = std::uint64_t(std::llround(options.seconds * options.rate_hz));
+  Steering steering(scenario, *speeds);
+  ObservedSearch observed(*search.deferred, agents);
+  QualityMeter meter(agents, 2, dt);
+  std::unique_ptr<CrowdRecorder> recorder;
+  if (options.html) {
+    const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
+    recorder = std::make_unique<CrowdRecorder>(
+        controller, scenario,
+        std::to_string(agents) + " agents, " + std::string(search.backend->name()) + " (" + search.device + "), " +
+            db_name,
+        dt, per_sample);
+  }
+  ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,
+                        std::size_t(std::max(1.0, options.rate_hz)));
+
+  // Per tick, [N] each; sized once.
+  std::vector<float> x(agents), z(agents), vx(agents), vz(agents), desired_xz(2 * agents), root_xz(2 * agents);
+  std::vector<glm::vec3> desired(agents), world(std::size_t(agents) * controller.animation().joint_count());
+  std::vector<float> foot_xz(4 * std::size_t(agents));
+  std::vector<std::uint8_t> contact(2 * std::size_t(agents));
+  std::vector<std::uint32_t> searched_before, searched_now, frames_before(agents);
+  searched_before.reserve(agents), searched_now.reserve(agents);
+  glm::vec3 horizon_pos[1];
+  float horizon_yaw[1];
+  const auto feet = controller.animation().contact_joints;
+
+  std::vector<double> search_ms, tick_ms;
+  search_ms.reserve(ticks), tick_ms.reserve(ticks);
+  Fnv1a chosen;
+  std::uint64_t searches = 0;
+  const auto run_start = Clock::now();
+  for (std::uint64_t t = 0; t < ticks; ++t) {
+    const auto tick_start = Clock::now();
+    const auto roots = controller.root_positions();
+    for (std::uint32_t b = 0; b < agents; ++b) x[b] = roots[b].x, z[b] = roots[b].z;
+    steering.update(x, z, vx, vz);
+    for (std::uint32_t b = 0; b < agents; ++b) desired[b] = glm::vec3(vx[b], 0.0f, vz[b]);
+    observed.begin_tick();
+    MMVK_TRY(controller.tick(dt, CrowdInput{desired, {}}, observed, pool));
+    tick_ms.push_back(ms_since(tick_start));
+    search_ms.push_back(observed.blocked_seconds() * 1e3);
+
+    // The chosen frames, in order: every applied match of every tick.
+    const auto matches = observed.collected_matches();
+    chosen.add_u32(std::uint32_t(t));
+    chosen.add_u32(std::uint32_t(matches.size()));
+    for (const Match& m : matches) chosen.add_u32(m.frame);
+    searches += controller.last_tick().searches;
+
+    // Quality: where the controller wants each character 1 s from now, where
+    // it is, and its feet.
+    const auto sim = controller.simulation();
+    const auto roots_now = controller.root_positions();
+    for (std::uint32_t b = 0; b < agents; ++b) {
+      predict_trajectory(sim[b], desired[b], yaw_of_velocity(desired[b], sim[b].yaw), params.spring, kErrorHorizon,
+                         horizon_pos, horizon_yaw);
+      desired_xz[2 * b] = horizon_pos[0].x, desired_xz[2 * b + 1] = horizon_pos[0].z;
+      root_xz[2 * b] = roots_now[b].x, root_xz[2 * b + 1] = roots_now[b].z;
+    }
+    meter.record_trajectory(desired_xz, root_xz);
+    if (feet[0] >= 0 && feet[1] >= 0) {
+      controller.world_positions(world, pool);
+      const auto contacts = controller.contacts();
+      const std::size_t joints = controller.animation().joint_count();
+      for (std::uint32_t b = 0; b < agents; ++b) {
+        for (int f = 0; f < 2; ++f) {
+          const glm::vec3& p = world[b * joints + std::size_t(feet[f])];
+          foot_xz[4 * b + 2 * f] = p.x, foot_xz[4 * b + 2 * f + 1] = p.z;
+          contact[2 * b + f] = (contacts[b] & (f == 0 ? kContactLeft : kContactRight)) ? 1 : 0;
+        }
+      }
+      meter.record_feet(foot_xz, contact);
+    }
+    meter.add_transitions(controller.last_tick().jumps);
+    meter.end_tick();
+
+    if (recorder) recorder->record_tick(t, matches, searched_before, frames_before);
+    searched_now.clear();
+    const auto flags = controller.searched();
+    for (std::uint32_t b = 0; b < agents; ++b) {
+      if (flags[b]) searched_now.push_back(b);
+    }
+    searched_before.swap(searched_now);
+    const auto frames = controller.frames();
+    std::copy(frames.begin(), frames.end(), frames_before.begin());
+    progress.tick(double(t + 1) * dt, controller.last_tick().searches, search_ms.back());
+  }
+  const double wall = std::chrono::duration<double>(Clock::now() - run_start).count();
+  progress.finish();
+
+  CrowdSummary s;
+  s.agents = agents;
+  s.ticks = ticks;
+  s.seconds = double(ticks) * dt;
+  s.rate_hz = options.rate_hz;
+  s.search_interval_s = options.search_interval_s;
+  s.seed = options.seed;
+  s.scenario = scenario.source;
+  s.database = opened.path.empty() ? db_name : opened.path.string();
+  s.database_frames = db.frame_count();
+  s.walk_mps = speeds->walk_mps;
+  s.run_mps = speeds->run_mps;
+  s.backend = std::string(search.backend->name());
+  s.device = search.device;
+  s.searches = searches;
+  s.forced_searches = controller.totals().forced;
+  s.no_candidate = controller.totals().no_candidate;
+  s.queries_per_tick = ticks ? double(searches) / double(ticks) : 0.0;
+  s.search_ms_p50 = percentile(search_ms, 0.5);
+  s.search_ms_p99 = percentile(search_ms, 0.99);
+  s.tick_ms_p50 = percentile(tick_ms, 0.5);
+  s.tick_ms_p99 = percentile(tick_ms, 0.99);
+  s.wall_seconds = wall;
+  s.realtime_factor = wall > 0.0 ? s.seconds / wall : 0.0;
+  s.trajectory_error_m_1s = meter.trajectory_error_m_median();
+  s.foot_sliding_cm_s = meter.foot_sliding_cm_s();
+  s.transitions_per_agent_s = meter.transitions_per_agent_s();
+  s.goals_reached = steering.goals_reached();
+  s.chosen_frames_hash = chosen.digest();
+
+  if (options.html) {
+#if defined(MMVK_CROWD_HAS_VIEWER)
+    Recording recording = recorder->finish(pool);
+    MMVK_ASSIGN_OR_RETURN(const std::size_t bytes, write_viewer_html(*options.html, recording));
+    s.html = options.html->string();
+    s.html_bytes = bytes;
+#else
+    return make_error("--html: this mmvk was built without the crowd viewer");
+#endif
+  }
+  return s;
+}
+
+}  // namespace mmvk::crowd

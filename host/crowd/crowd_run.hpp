@@ -1,0 +1,28 @@
+// One crowd run: open the database, lay out the scenario, make the search,
+// tick the world at a fixed rate and report what happened. The `mmvk crowd`
+// command line is a thin layer over run_crowd().
+//
+// Each tick (dt = 1 / rate_hz):
+//   1. steering: desired velocities from the characters' animated roots
+//      (seek the current goal, separate on a uniform grid);
+//   2. the controller's deferred tick: apply the previous tick's matches,
+//      play, predict, assemble the due characters' queries and submit them
+//      as one batch (on Vulkan the search runs while the host goes on);
+//   3. outside the timed step: the quality figures, the viewer's samples
+//      and the progress line.
+#pragma once
+
+#include <cstdio>
+
+#include "crowd_options.hpp"
+#include "mmvk/status.hpp"
+#include "summary.hpp"
+
+namespace mmvk::crowd {
+
+// Notes for the user (database, device, cache) go to `log` (may be null);
+// the progress line goes there too when options.progress is set.
+// Errors name the option, file or field at fault.
+Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log);
+
+}  // namespace mmvk::crowd

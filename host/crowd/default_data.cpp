@@ -1,0 +1,102 @@
+#include "default_data.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "fnv.hpp"
+#include "mmvk/database_build.hpp"
+#include "mmvk/database_io.hpp"
+#include "mmvk/manifest.hpp"
+
+namespace mmvk::crowd {
+
+namespace {
+
+// Bumped when the way the host builds databases changes (not the data).
+constexpr std::uint32_t kRecipeVersion = 1;
+
+bool read_whole_file(const std::filesystem::path& path, std::string& out) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return false;
+  std::stringstream text;
+  text << file.rdbuf();
+  out = text.str();
+  return bool(file) || file.eof();
+}
+
+// The digest of everything a build reads: the manifest (or folder listing)
+// and the bytes of every clip.
+Result<std::uint64_t> source_digest(const std::filesystem::path& source, const Manifest& manifest) {
+  Fnv1a hash;
+  hash.add_u32(kRecipeVersion);
+  hash.add_u32(kDatabaseFormatVersion);
+  std::string bytes;
+  if (!std::filesystem::is_directory(source)) {
+    if (!read_whole_file(source, bytes)) return make_error(source.string() + ": cannot read");
+    hash.add_text(bytes);
+  }
+  for (const ManifestClip& clip : manifest.clips) {
+    if (!read_whole_file(clip.file, bytes)) return make_error(clip.file.string() + ": cannot read");
+    hash.add_text(clip.file.filename().string());
+    hash.add_text(bytes);
+  }
+  return hash.digest();
+}
+
+std::string hex(std::uint64_t value) {
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> default_manifest_candidates(const std::filesystem::path& executable) {
+  std::vector<std::filesystem::path> candidates;
+  if (!executable.empty()) {
+    candidates.push_back(executable.parent_path() / ".." / "share" / "mmvk" / "crowd" / "cmu131" / "manifest.json");
+  }
+#if defined(MMVK_CROWD_SOURCE_DATA_DIR)
+  candidates.push_back(std::filesystem::path(MMVK_CROWD_SOURCE_DATA_DIR) / "cmu131" / "manifest.json");
+#endif
+  return candidates;
+}
+
+Result<OpenedDatabase> open_database(const std::filesystem::path& source, const std::filesystem::path& cache_dir,
+                                     const std::function<void(const std::string&)>& say) {
+  std::error_code ec;
+  if (!std::filesystem::exists(source, ec)) return make_error(source.string() + ": no such file or folder");
+  if (source.extension() == ".mmdb") {
+    MMVK_ASSIGN_OR_RETURN(Database database, load_database(source));
+    return OpenedDatabase{std::move(database), source, false};
+  }
+  MMVK_ASSIGN_OR_RETURN(Manifest manifest, load_manifest_or_directory(source));
+  MMVK_ASSIGN_OR_RETURN(const std::uint64_t digest, source_digest(source, manifest));
+  const std::string stem = std::filesystem::is_directory(source) ? source.filename().string() : source.stem().string();
+  const std::string label = (stem.empty() || stem == "manifest") ? source.parent_path().filename().string() : stem;
+  std::filesystem::path cached;
+  if (!cache_dir.empty()) {
+    cached = cache_dir / ("crowd-" + label + "-" + hex(digest) + ".mmdb");
+    if (std::filesystem::exists(cached, ec)) {
+      Result<Database> loaded = load_database(cached);
+      if (loaded) return OpenedDatabase{std::move(loaded.value()), cached, false};
+      say("the cached database " + cached.string() + " is unreadable (" + loaded.message() + "); rebuilding it");
+    }
+  }
+  say("building the database from " + source.string() + " (" + std::to_string(manifest.clips.size()) +
+      " clips; once, then cached)");
+  MMVK_ASSIGN_OR_RETURN(Database database, build_database(manifest));
+  if (!cached.empty()) {
+    std::filesystem::create_directories(cache_dir, ec);
+    if (Status saved = save_database(database, cached); !saved) {
+      say("could not cache the database (" + saved.message() + "); it will be built again next time");
+      cached.clear();
+    } else {
+      say("cached the database at " + cached.string());
+    }
+  }
+  return OpenedDatabase{std::move(database), cached, true};
+}
+
+}  // namespace mmvk::crowd

@@ -1,0 +1,50 @@
+// The --summary JSON of a crowd run: what ran, how fast and how well.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "mmvk/status.hpp"
+
+namespace mmvk::crowd {
+
+struct CrowdSummary {
+  // What ran.
+  std::uint64_t agents = 0;
+  std::uint64_t ticks = 0;
+  double seconds = 0.0;            // simulated
+  double rate_hz = 0.0;
+  double search_interval_s = 0.0;
+  std::uint64_t seed = 0;
+  std::string scenario;            // file or "seed N"
+  std::string database;            // the .mmdb or source folder
+  std::uint64_t database_frames = 0;
+  double walk_mps = 0.0;           // measured in the database
+  double run_mps = 0.0;
+  std::string backend;
+  std::string device;              // "cpu" for CPU backends
+  // How fast.
+  std::uint64_t searches = 0;      // queries searched
+  std::uint64_t forced_searches = 0;
+  std::uint64_t no_candidate = 0;  // queries that found no frame
+  double queries_per_tick = 0.0;
+  double search_ms_p50 = 0.0, search_ms_p99 = 0.0;  // per tick: the batched search (submit to results)
+  double tick_ms_p50 = 0.0, tick_ms_p99 = 0.0;      // per tick: steering + controller + search
+  double wall_seconds = 0.0;
+  double realtime_factor = 0.0;    // simulated seconds per wall second
+  // How well.
+  double trajectory_error_m_1s = 0.0;
+  double foot_sliding_cm_s = 0.0;
+  double transitions_per_agent_s = 0.0;
+  std::uint64_t goals_reached = 0;
+  std::uint64_t chosen_frames_hash = 0;
+  // The viewer, when written.
+  std::string html;
+  std::uint64_t html_bytes = 0;
+};
+
+std::string summary_to_json(const CrowdSummary& summary);
+Status write_summary(const CrowdSummary& summary, const std::filesystem::path& path);
+
+}  // namespace mmvk::crowd

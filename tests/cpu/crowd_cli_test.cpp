@@ -1,0 +1,116 @@
+// `mmvk crowd` end to end on the shipped CMU walks: the default data is
+// built once and cached, the summary has every key, and bad input gets a
+// clear message and an exit code in 1..127 (never a crash).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "support/command.hpp"
+#include "support/test_data.hpp"
+
+namespace mmvk {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_command;
+
+class CrowdCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto cli = test::cli_binary();
+    if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
+    dir_ = test::make_temp_dir();
+    // Every run caches into the test's own folder, never the user's.
+    mmvk_ = "XDG_CACHE_HOME=" + (dir_ / "cache").string() + " " + cli->string();
+    shipped_ = test::test_source_dir().parent_path() / "host" / "crowd" / "data" / "cmu131";
+  }
+
+  // Expects a clean failure whose message contains `expected`.
+  void expect_failure(const std::string& args, const std::string& expected) {
+    const auto result = run_command(mmvk_ + " crowd " + args);
+    EXPECT_GE(result.exit_code, 1) << args << "\n" << result.output;
+    EXPECT_LE(result.exit_code, 127) << args << " crashed:\n" << result.output;
+    EXPECT_NE(result.output.find(expected), std::string::npos)
+        << "mmvk crowd " << args << "\noutput: " << result.output << "\nexpected to contain: " << expected;
+  }
+
+  fs::path dir_;
+  std::string mmvk_;
+  fs::path shipped_;
+};
+
+TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
+  const std::string summary = (dir_ / "s.json").string();
+  const std::string args = " crowd --agents 20 --seconds 1 --backend fast --summary " + summary;
+  const auto first = run_command(mmvk_ + args);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  EXPECT_NE(first.output.find("building the database"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("backend fast"), std::string::npos) << first.output;
+  std::size_t cached = 0;
+  for (const auto& entry : fs::directory_iterator(dir_ / "cache" / "mmvk")) cached += entry.path().extension() == ".mmdb";
+  EXPECT_EQ(cached, 1u);
+
+  const auto second = run_command(mmvk_ + args);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  EXPECT_EQ(second.output.find("building the database"), std::string::npos) << second.output;
+
+  std::ifstream in(summary);
+  const auto json = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_FALSE(json.is_discarded());
+  for (const char* key : {"agents", "ticks", "seconds", "backend", "device", "searches", "no_candidate",
+                          "search_ms_p50", "search_ms_p99", "tick_ms_p50", "tick_ms_p99", "trajectory_error_m_1s",
+                          "foot_sliding_cm_s", "transitions_per_agent_s", "chosen_frames_hash"}) {
+    EXPECT_TRUE(json.contains(key)) << key;
+  }
+  EXPECT_EQ(json["agents"], 20);
+  EXPECT_EQ(json["ticks"], 30);
+  EXPECT_GT(json["searches"].get<int>(), 20);
+  EXPECT_EQ(json["device"].get<std::string>().rfind("cpu", 0), 0u);
+}
+
+TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
+  expect_failure("--agents 5 --seconds 1 --backend warp-drive", "unknown backend 'warp-drive'");
+  expect_failure("--agents 0", "--agents must be between 1");
+  expect_failure("--rate 0", "--rate expects a positive number");
+  expect_failure("--rate -30", "--rate expects a positive number");
+  expect_failure("--search-interval 0", "--search-interval expects a positive number");
+  expect_failure("--seconds nan", "--seconds expects a positive number");
+  expect_failure("--agents many", "--agents expects a whole number");
+  expect_failure("--data /nonexistent/db.mmdb", "/nonexistent/db.mmdb");
+  expect_failure("--frobnicate", "unknown option '--frobnicate'");
+  expect_failure("--agents 5 --seconds 1 --backend reference --device 0", "--device picks a Vulkan device");
+}
+
+TEST_F(CrowdCli, ScenarioErrorsNameTheFileAndTheField) {
+  const fs::path bad = dir_ / "bad.json";
+  std::ofstream(bad) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]]}, {"start": [1, 1], "goals": [[2, "x"]]}]})";
+  expect_failure("--backend fast --scenario " + bad.string(), bad.string() + ": agents[1].goals[0]: expected [x, z]");
+  const fs::path tags = dir_ / "tags.json";
+  std::ofstream(tags) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "require_tags": ["moonwalk"]}]})";
+  expect_failure("--backend fast --scenario " + tags.string(), tags.string() + ": agents[0].require_tags");
+  expect_failure("--backend fast --agents 3 --scenario " + tags.string(), "defines 1 agents, but --agents asks for 3");
+}
+
+TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {
+  const std::string manifest = (shipped_ / "manifest.json").string();
+  const std::string no_animation = (dir_ / "no-animation.mmdb").string();
+  auto built = run_command(mmvk_ + " build " + manifest + " --no-animation -o " + no_animation);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  expect_failure("--backend fast --agents 5 --data " + no_animation, "mmvk build");
+
+  const fs::path schema = dir_ / "feet-only.json";
+  std::ofstream(schema) << R"({"channels": [{"name": "left_foot", "kind": "bone_position", "bone": "@left_foot"},
+                                             {"name": "right_foot", "kind": "bone_position", "bone": "@right_foot"}]})";
+  const std::string no_trajectory = (dir_ / "no-trajectory.mmdb").string();
+  built = run_command(mmvk_ + " build " + manifest + " --schema " + schema.string() + " -o " + no_trajectory);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  expect_failure("--backend fast --agents 5 --data " + no_trajectory, "trajectory_position");
+}
+
+}  // namespace
+}  // namespace mmvk

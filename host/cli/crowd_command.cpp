@@ -123,12 +123,13 @@ int run_crowd(Args args, const char* argv0) {
   std::fprintf(stderr,
                "mmvk crowd: %llu ticks in %.2f s (%.1fx real time): %llu searches (%llu without a candidate), "
                "search %.2f / %.2f ms, tick %.2f / %.2f ms (p50 / p99)\n"
-               "mmvk crowd: trajectory error %.3f m at 1 s (median), foot sliding %.2f cm/s, %.2f transitions "
+               "mmvk crowd: trajectory error %.3f m at 1 s (median), foot sliding %.2f cm/s (the clips alone: %.2f), "
+               "%.2f transitions "
                "per agent per second; chosen frames 0x%016llx\n",
                static_cast<unsigned long long>(s.ticks), s.wall_seconds, s.realtime_factor,
                static_cast<unsigned long long>(s.searches), static_cast<unsigned long long>(s.no_candidate),
                s.search_ms_p50, s.search_ms_p99, s.tick_ms_p50, s.tick_ms_p99, s.trajectory_error_m_1s,
-               s.foot_sliding_cm_s, s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
+               s.foot_sliding_cm_s, s.foot_sliding_database_cm_s, s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
   if (options.summary) {
     if (Status written = crowd::write_summary(s, *options.summary); !written) {
       std::fprintf(stderr, "mmvk crowd: %s\n", written.message().c_str());

@@ -10,6 +10,7 @@
 
 #include "crowd_backend.hpp"
 #include "crowd_recorder.hpp"
+#include "database_sliding.hpp"
 #include "default_data.hpp"
 #include "fnv.hpp"
 #include "gait_speeds.hpp"
@@ -225,7 +226,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   CrowdSummary s;
   s.agents = agents;
   s.ticks = ticks;
-  s.seconds = double(ticks) * dt;
+  s.seconds = double(ticks) / options.rate_hz;
   s.rate_hz = options.rate_hz;
   s.search_interval_s = options.search_interval_s;
   s.seed = options.seed;
@@ -248,6 +249,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.realtime_factor = wall > 0.0 ? s.seconds / wall : 0.0;
   s.trajectory_error_m_1s = meter.trajectory_error_m_median();
   s.foot_sliding_cm_s = meter.foot_sliding_cm_s();
+  s.foot_sliding_database_cm_s = database_foot_sliding_cm_s(db, pool);
   s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
   s.chosen_frames_hash = chosen.digest();

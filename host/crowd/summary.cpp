@@ -48,6 +48,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["realtime_factor"] = number(s.realtime_factor);
   j["trajectory_error_m_1s"] = number(s.trajectory_error_m_1s);
   j["foot_sliding_cm_s"] = number(s.foot_sliding_cm_s);
+  j["foot_sliding_database_cm_s"] = number(s.foot_sliding_database_cm_s);
   j["transitions_per_agent_s"] = number(s.transitions_per_agent_s);
   j["goals_reached"] = s.goals_reached;
   // A string: a 64-bit value is not exact in every JSON reader's doubles.

@@ -36,6 +36,7 @@ struct CrowdSummary {
   // How well.
   double trajectory_error_m_1s = 0.0;
   double foot_sliding_cm_s = 0.0;
+  double foot_sliding_database_cm_s = 0.0;  // the same measure on the database's own clips (the floor)
   double transitions_per_agent_s = 0.0;
   std::uint64_t goals_reached = 0;
   std::uint64_t chosen_frames_hash = 0;

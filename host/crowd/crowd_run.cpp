@@ -148,10 +148,12 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   std::unique_ptr<CrowdRecorder> recorder;
   if (options.html) {
     const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
+    // Short enough for the page's header: "1000 agents · locomotion-normal · vulkan-brute-force on llvmpipe".
+    const std::string device = search.device.substr(0, search.device.find(" ("));
+    const std::string data = options.data ? options.data->filename().string() : std::string("CMU 131 walks");
     recorder = std::make_unique<CrowdRecorder>(
         controller, scenario,
-        std::to_string(agents) + " agents, " + std::string(search.backend->name()) + " (" + search.device + "), " +
-            db_name,
+        std::to_string(agents) + " agents \u00b7 " + data + " \u00b7 " + std::string(search.backend->name()) + " on " + device,
         dt, per_sample);
   }
   ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,

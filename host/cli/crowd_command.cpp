@@ -33,7 +33,7 @@ constexpr const char* kCrowdUsage =
     "  --seconds S           simulated time (default 10)\n"
     "  --rate HZ             simulation ticks per second (default 30)\n"
     "  --search-interval S   seconds between a character's regular searches (default 0.1)\n"
-    "  --backend NAME        the search backend (default vulkan, on the best device)\n"
+    "  --backend NAME        the search backend (default vulkan-brute, on the best device)\n"
     "  --device N            the Vulkan device index (default: the best one)\n"
     "  --seed N              the random scenario's seed (default 1)\n"
     "  --scenario FILE       starts, goals, speeds and tags from JSON (see host/crowd/scenario.hpp)\n"
@@ -46,17 +46,6 @@ std::filesystem::path cache_dir() {
   return {};
 }
 
-std::optional<std::uint64_t> parse_count(const char* option, const std::string& text) {
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long value = std::strtoull(text.c_str(), &end, 10);
-  if (text.empty() || text[0] == '-' || end != text.c_str() + text.size() || errno == ERANGE) {
-    std::fprintf(stderr, "mmvk crowd: %s expects a whole number, got '%s'\n", option, text.c_str());
-    return std::nullopt;
-  }
-  return value;
-}
-
 }  // namespace
 
 int run_crowd(Args args, const char* argv0) {
@@ -67,7 +56,7 @@ int run_crowd(Args args, const char* argv0) {
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
     std::fputs(kCrowdUsage, stdout);
-    std::printf("\nbackends: %s\n", crowd::crowd_backend_names().c_str());
+    std::printf("\nbackends:\n%s", crowd::crowd_backend_help().c_str());
     return 0;
   }
   if (!parsed->positional.empty()) {
@@ -75,35 +64,32 @@ int run_crowd(Args args, const char* argv0) {
                  parsed->positional[0].c_str(), kCrowdUsage);
     return 2;
   }
+  auto fail = [](const std::string& message) { return report_error("crowd", message, 1); };
   crowd::CrowdOptions options;
   if (const auto v = parsed->value("--data")) options.data = *v;
   if (const auto v = parsed->value("--agents")) {
-    const auto n = parse_count("--agents", *v);
-    if (!n) return 2;
-    if (*n == 0 || *n > 10'000'000) {
-      std::fprintf(stderr, "mmvk crowd: --agents must be between 1 and 10,000,000, got %s\n", v->c_str());
-      return 1;
-    }
-    options.agents = std::uint32_t(*n);
+    Result<std::uint32_t> agents = parse_u32("--agents", *v, 1, 10'000'000);
+    if (!agents) return fail(agents.message());
+    options.agents = *agents;
   }
   for (auto [option, target] : {std::pair{"--seconds", &options.seconds}, std::pair{"--rate", &options.rate_hz},
                                 std::pair{"--search-interval", &options.search_interval_s}}) {
     if (const auto v = parsed->value(option)) {
-      const auto value = parse_positive("crowd", option, *v);
-      if (!value) return 1;
+      Result<double> value = parse_positive(option, *v);
+      if (!value) return fail(value.message());
       *target = *value;
     }
   }
   if (const auto v = parsed->value("--backend")) options.backend = *v;
   if (const auto v = parsed->value("--device")) {
-    const auto n = parse_count("--device", *v);
-    if (!n || *n > 0xFFFFFFFFull) return 2;
-    options.device = std::uint32_t(*n);
+    Result<std::uint32_t> device = parse_u32("--device", *v);
+    if (!device) return fail(device.message());
+    options.device = *device;
   }
   if (const auto v = parsed->value("--seed")) {
-    const auto n = parse_count("--seed", *v);
-    if (!n) return 2;
-    options.seed = *n;
+    Result<std::uint64_t> seed = parse_integer("--seed", *v);
+    if (!seed) return fail(seed.message());
+    options.seed = *seed;
   }
   if (const auto v = parsed->value("--scenario")) options.scenario = *v;
   if (const auto v = parsed->value("--summary")) options.summary = *v;
@@ -115,10 +101,7 @@ int run_crowd(Args args, const char* argv0) {
   options.progress = stderr_is_terminal();
 
   Result<crowd::CrowdSummary> summary = crowd::run_crowd(options, stderr);
-  if (!summary) {
-    std::fprintf(stderr, "mmvk crowd: %s\n", summary.message().c_str());
-    return 1;
-  }
+  if (!summary) return fail(summary.message());
   const crowd::CrowdSummary& s = *summary;
   std::fprintf(stderr,
                "mmvk crowd: %llu ticks in %.2f s (%.1fx real time): %llu searches (%llu without a candidate), "
@@ -131,10 +114,7 @@ int run_crowd(Args args, const char* argv0) {
                s.search_ms_p50, s.search_ms_p99, s.tick_ms_p50, s.tick_ms_p99, s.trajectory_error_m_1s,
                s.foot_sliding_cm_s, s.foot_sliding_database_cm_s, s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
   if (options.summary) {
-    if (Status written = crowd::write_summary(s, *options.summary); !written) {
-      std::fprintf(stderr, "mmvk crowd: %s\n", written.message().c_str());
-      return 1;
-    }
+    if (Status written = crowd::write_summary(s, *options.summary); !written) return fail(written.message());
     std::fprintf(stderr, "mmvk crowd: summary written to %s\n", options.summary->string().c_str());
   }
   if (options.html) {

@@ -2,12 +2,10 @@
 
 #include <algorithm>
 
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/fast_search.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/backends.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
+#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_async_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #endif
@@ -26,85 +24,78 @@ const char* device_type_name(VkPhysicalDeviceType type) {
     case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
     case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
     case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU (software Vulkan)";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU, software Vulkan";
     default: return "other";
   }
 }
 
-Status make_vulkan(CrowdSearch& out, const std::string& name, std::optional<std::uint32_t> device,
-                   const Database& database, std::uint32_t agents, const ClusterTable* clusters) {
-  vulkan::ContextOptions context_options;
-  context_options.device_index = device;
-  context_options.application_name = "mmvk crowd";
-  MMVK_ASSIGN_OR_RETURN(out.context, vulkan::Context::create(context_options));
-  vulkan::VulkanSearchOptions options;
-  options.max_batch = std::min(kMaxBatch, std::max<std::uint32_t>(agents, 1));
-  options.max_k = 1;
-  if (name == "vulkan-clusters") options.mode = vulkan::SearchMode::ClustersExact;
-  if (name == "vulkan-nprobe") options.mode = vulkan::SearchMode::NProbe;
-  MMVK_ASSIGN_OR_RETURN(auto search, vulkan::VulkanSearch::create(*out.context, database, options, clusters));
-  out.deferred = std::make_unique<vulkan::VulkanAsyncSearch>(*search, agents);
-  out.backend = std::move(search);
-  // Which device: the index the loader gives it, so --device N can name it.
-  std::uint32_t index = device.value_or(0);
-  if (!device) {
+// "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan device 0, CPU, software Vulkan)":
+// the index the loader gives the device, so --device N can name it.
+std::string describe_device(const vulkan::Context& context, std::optional<std::uint32_t> requested) {
+  std::uint32_t index = requested.value_or(0);
+  if (!requested) {
     if (auto devices = vulkan::Context::enumerate_devices(); devices) {
       for (std::uint32_t i = 0; i < devices->size(); ++i) {
-        if ((*devices)[i].name == out.context->device_name()) {
+        if ((*devices)[i].name == context.device_name()) {
           index = i;
           break;
         }
       }
     }
   }
-  out.device = out.context->device_name() + " (Vulkan device " + std::to_string(index) + ", " +
-               device_type_name(out.context->properties().deviceType) + ")";
-  return {};
+  return context.device_name() + " (Vulkan device " + std::to_string(index) + ", " +
+         device_type_name(context.properties().deviceType) + ")";
 }
 #endif
 
+// The library's registry: the CPU backends, and the Vulkan ones on a
+// context created (on `device`) only when one of them is made.
+BackendRegistry crowd_registry([[maybe_unused]] CrowdSearch& out, [[maybe_unused]] std::optional<std::uint32_t> device) {
+  BackendRegistry registry = cpu_backends();
+#if defined(MMVK_HAS_VULKAN)
+  // The names are distinct from the CPU ones; a clash would be a bug in mmvk.
+  (void)vulkan::add_backends(registry, [&out, device]() -> Result<vulkan::Context*> {
+    if (!out.context) {
+      vulkan::ContextOptions options;
+      options.device_index = device;
+      options.application_name = "mmvk crowd";
+      MMVK_ASSIGN_OR_RETURN(out.context, vulkan::Context::create(options));
+    }
+    return out.context.get();
+  });
+#endif
+  return registry;
+}
+
 }  // namespace
 
-std::string crowd_backend_names() {
-  std::string names = "reference, fast-brute, fast-box (alias fast), clusters, clusters-nprobe";
-#if defined(MMVK_HAS_VULKAN)
-  names += ", vulkan, vulkan-clusters, vulkan-nprobe";
-#endif
-  return names;
+std::string crowd_backend_help() {
+  CrowdSearch unused;
+  return crowd_registry(unused, std::nullopt).help();
 }
 
 Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
                                       const Database& database, std::uint32_t agents, ThreadPool& pool) {
   CrowdSearch out;
-  const std::string cpu = "cpu, " + std::to_string(pool.thread_count()) + " threads";
-  const bool clustered = name == "clusters" || name == "clusters-nprobe" || name == "vulkan-clusters" ||
-                         name == "vulkan-nprobe";
-  std::optional<ClusterTable> table;
-  if (clustered) {
-    MMVK_ASSIGN_OR_RETURN(table, train_cluster_table(database, KMeansParams{}));
-  }
-  if (name == "reference") {
-    out.backend = std::make_unique<ReferenceSearch>(database);
-    out.device = "cpu, 1 thread";
-  } else if (name == "fast-brute" || name == "fast-box" || name == "fast") {
-    out.backend = std::make_unique<FastSearch>(database, pool, FastSearchOptions{.prune = name != "fast-brute"});
-    out.device = cpu;
-  } else if (name == "clusters" || name == "clusters-nprobe") {
-    ClusterSearchOptions options;
-    if (name == "clusters-nprobe") options.nprobe = 4;
-    MMVK_ASSIGN_OR_RETURN(out.backend, ClusterSearch::create(database, *table, pool, options));
-    out.device = cpu;
-  } else if (name == "vulkan" || name == "vulkan-clusters" || name == "vulkan-nprobe") {
+  const BackendRegistry registry = crowd_registry(out, device);
+  const BackendEntry* entry = registry.find(name);
+  if (!entry) return make_error("unknown backend '" + name + "' (known: " + registry.names() + ")");
+  BackendSpec spec;
+  spec.name = name;
+  spec.pool = &pool;
+  spec.max_batch = std::min(kMaxBatch, std::max<std::uint32_t>(agents, 1));
+  spec.max_k = 1;
+  MMVK_ASSIGN_OR_RETURN(out.backend, registry.make(spec, database));
 #if defined(MMVK_HAS_VULKAN)
-    MMVK_TRY(make_vulkan(out, name, device, database, agents, table ? &*table : nullptr));
+  if (auto* gpu = dynamic_cast<vulkan::VulkanSearch*>(out.backend.get())) {
+    out.deferred = std::make_unique<vulkan::VulkanAsyncSearch>(*gpu, agents);
+    out.device = describe_device(*out.context, device);
     return out;
-#else
-    return make_error("backend '" + name + "': this mmvk was built without Vulkan (MMVK_BUILD_VULKAN=OFF)");
-#endif
-  } else {
-    return make_error("unknown backend '" + name + "' (known: " + crowd_backend_names() + ")");
   }
+#endif
   if (device) return make_error("--device picks a Vulkan device; backend '" + name + "' runs on the CPU");
+  out.device = name == "reference" ? std::string("cpu, 1 thread")
+                                   : "cpu, " + std::to_string(pool.thread_count()) + " threads";
   out.deferred = std::make_unique<DeferredSearch>(*out.backend, kMaxBatch, agents);
   return out;
 }

@@ -32,12 +32,14 @@ struct CrowdSearch {
   std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
 };
 
-// The backend names `mmvk crowd --backend` accepts, comma-separated.
-std::string crowd_backend_names();
+// The backends `mmvk crowd --backend` accepts (the library's registry), one
+// line each with its description, for --help.
+std::string crowd_backend_help();
 
-// Makes `name` on `database` for up to `agents` queries per tick. `device`
-// picks the Vulkan device (none: the best one). Errors: an unknown name
-// (listing the known ones), no Vulkan device, a database too large.
+// Makes `name` from the library's backend registry on `database` for up to
+// `agents` queries per tick. `device` picks the Vulkan device (none: the
+// best one). Errors: an unknown name (listing the known ones), no Vulkan
+// device, a database too large, --device with a CPU backend.
 Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
                                       const Database& database, std::uint32_t agents, ThreadPool& pool);
 

@@ -14,7 +14,7 @@ struct CrowdOptions {
   double seconds = 10.0;                      // simulated time
   double rate_hz = 30.0;                      // simulation ticks per second
   double search_interval_s = 0.1;             // regular search period of each character
-  std::string backend = "vulkan";             // a backend registry name
+  std::string backend = "vulkan-brute";       // a backend registry name (mmvk/backends.hpp)
   std::optional<std::uint32_t> device;        // Vulkan device index; none = the best
   std::uint64_t seed = 1;
   std::optional<std::filesystem::path> scenario;

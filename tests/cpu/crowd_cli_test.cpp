@@ -46,11 +46,11 @@ class CrowdCli : public ::testing::Test {
 
 TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
   const std::string summary = (dir_ / "s.json").string();
-  const std::string args = " crowd --agents 20 --seconds 1 --backend fast --summary " + summary;
+  const std::string args = " crowd --agents 20 --seconds 1 --backend fast-box --summary " + summary;
   const auto first = run_command(mmvk_ + args);
   ASSERT_EQ(first.exit_code, 0) << first.output;
   EXPECT_NE(first.output.find("building the database"), std::string::npos) << first.output;
-  EXPECT_NE(first.output.find("backend fast"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("backend fast-box"), std::string::npos) << first.output;
   std::size_t cached = 0;
   for (const auto& entry : fs::directory_iterator(dir_ / "cache" / "mmvk")) cached += entry.path().extension() == ".mmdb";
   EXPECT_EQ(cached, 1u);
@@ -75,12 +75,12 @@ TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
 
 TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
   expect_failure("--agents 5 --seconds 1 --backend warp-drive", "unknown backend 'warp-drive'");
-  expect_failure("--agents 0", "--agents must be between 1");
+  expect_failure("--agents 0", "--agents expects an integer in [1, 10000000], got '0'");
   expect_failure("--rate 0", "--rate expects a positive number");
   expect_failure("--rate -30", "--rate expects a positive number");
   expect_failure("--search-interval 0", "--search-interval expects a positive number");
   expect_failure("--seconds nan", "--seconds expects a positive number");
-  expect_failure("--agents many", "--agents expects a whole number");
+  expect_failure("--agents many", "--agents expects an integer");
   expect_failure("--data /nonexistent/db.mmdb", "/nonexistent/db.mmdb");
   expect_failure("--frobnicate", "unknown option '--frobnicate'");
   expect_failure("--agents 5 --seconds 1 --backend reference --device 0", "--device picks a Vulkan device");
@@ -89,11 +89,11 @@ TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
 TEST_F(CrowdCli, ScenarioErrorsNameTheFileAndTheField) {
   const fs::path bad = dir_ / "bad.json";
   std::ofstream(bad) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]]}, {"start": [1, 1], "goals": [[2, "x"]]}]})";
-  expect_failure("--backend fast --scenario " + bad.string(), bad.string() + ": agents[1].goals[0]: expected [x, z]");
+  expect_failure("--backend fast-box --scenario " + bad.string(), bad.string() + ": agents[1].goals[0]: expected [x, z]");
   const fs::path tags = dir_ / "tags.json";
   std::ofstream(tags) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "require_tags": ["moonwalk"]}]})";
-  expect_failure("--backend fast --scenario " + tags.string(), tags.string() + ": agents[0].require_tags");
-  expect_failure("--backend fast --agents 3 --scenario " + tags.string(), "defines 1 agents, but --agents asks for 3");
+  expect_failure("--backend fast-box --scenario " + tags.string(), tags.string() + ": agents[0].require_tags");
+  expect_failure("--backend fast-box --agents 3 --scenario " + tags.string(), "defines 1 agents, but --agents asks for 3");
 }
 
 TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {
@@ -101,7 +101,7 @@ TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {
   const std::string no_animation = (dir_ / "no-animation.mmdb").string();
   auto built = run_command(mmvk_ + " build " + manifest + " --no-animation -o " + no_animation);
   ASSERT_EQ(built.exit_code, 0) << built.output;
-  expect_failure("--backend fast --agents 5 --data " + no_animation, "mmvk build");
+  expect_failure("--backend fast-box --agents 5 --data " + no_animation, "mmvk build");
 
   const fs::path schema = dir_ / "feet-only.json";
   std::ofstream(schema) << R"({"channels": [{"name": "left_foot", "kind": "bone_position", "bone": "@left_foot"},
@@ -109,7 +109,7 @@ TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {
   const std::string no_trajectory = (dir_ / "no-trajectory.mmdb").string();
   built = run_command(mmvk_ + " build " + manifest + " --schema " + schema.string() + " -o " + no_trajectory);
   ASSERT_EQ(built.exit_code, 0) << built.output;
-  expect_failure("--backend fast --agents 5 --data " + no_trajectory, "trajectory_position");
+  expect_failure("--backend fast-box --agents 5 --data " + no_trajectory, "trajectory_position");
 }
 
 }  // namespace

@@ -51,12 +51,12 @@ TEST(CrowdBackends, SameChosenFramesOnReferenceFastAndVulkanWithinQualityBounds)
   ASSERT_EQ(built.exit_code, 0) << built.output;
 
   nlohmann::json reference;
-  for (const char* backend : {"reference", "fast", "vulkan"}) {
+  for (const char* backend : {"reference", "fast-box", "vulkan-brute"}) {
     SCOPED_TRACE(backend);
     const fs::path summary = dir / (std::string(backend) + ".json");
     const auto ran = run_command(mmvk + " crowd --data " + db + " --agents 50 --seconds 2 --seed 1 --backend " +
                                  backend + " --summary " + summary.string());
-    if (std::string(backend) == "vulkan" && ran.exit_code != 0 &&
+    if (std::string(backend) == "vulkan-brute" && ran.exit_code != 0 &&
         ran.output.find("Vulkan") != std::string::npos) {
       const char* required = std::getenv("MMVK_REQUIRE_VULKAN");
       if (!(required && std::string(required) == "1")) GTEST_SKIP() << "no Vulkan device: " << ran.output;

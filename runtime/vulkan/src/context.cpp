@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "check.hpp"
+#include "pipeline_cache_blob.hpp"
 
 namespace mmvk::vulkan {
 
@@ -127,6 +128,9 @@ Result<VkInstance> create_instance(const ContextOptions& options, Context* conte
 }  // namespace
 
 Context::~Context() {
+  if (owns_pipeline_cache_ && pipeline_cache_ != VK_NULL_HANDLE) {
+    vkDestroyPipelineCache(device_, pipeline_cache_, nullptr);
+  }
   if (owns_device_ && device_ != VK_NULL_HANDLE) {
     vkDeviceWaitIdle(device_);
     vkDestroyDevice(device_, nullptr);
@@ -206,6 +210,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
   context->owns_device_ = true;
   vkGetDeviceQueue(context->device_, *family, 0, &context->queue_);
   MMVK_TRY(context->init_device_info());
+  MMVK_TRY(context->init_pipeline_cache(VK_NULL_HANDLE, options.pipeline_cache_data));
   return context;
 }
 
@@ -234,6 +239,7 @@ Result<std::unique_ptr<Context>> Context::adopt(const AdoptedDevice& handles) {
                       " does not exist or has no compute support");
   }
   MMVK_TRY(context->init_device_info());
+  MMVK_TRY(context->init_pipeline_cache(handles.pipeline_cache, handles.pipeline_cache_data));
   return context;
 }
 
@@ -258,6 +264,51 @@ Status Context::init_device_info() {
   timestamp_valid_bits_ = queue_family_ < count ? families[queue_family_].timestampValidBits : 0;
   if (properties_.limits.timestampPeriod <= 0.0f) timestamp_valid_bits_ = 0;
   return {};
+}
+
+Status Context::init_pipeline_cache(VkPipelineCache adopted, std::span<const std::byte> initial) {
+  if (adopted != VK_NULL_HANDLE) {
+    pipeline_cache_ = adopted;
+    if (!initial.empty()) pipeline_cache_note_ = "pipeline cache: the adopted VkPipelineCache is used, the blob is not";
+    return {};
+  }
+  if (!initial.empty()) {
+    // Checked here rather than left to the driver: the spec has drivers
+    // check the header too, but a blob read from a user's disk may be
+    // anything, and a rejected blob must only cost a note.
+    const Status usable = detail::check_pipeline_cache_blob(initial, properties_);
+    if (!usable) {
+      pipeline_cache_note_ = usable.message() + "; starting with an empty cache";
+      initial = {};
+    }
+  }
+  VkPipelineCacheCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO;
+  info.initialDataSize = initial.size();
+  info.pInitialData = initial.empty() ? nullptr : initial.data();
+  const VkResult created = vkCreatePipelineCache(device_, &info, nullptr, &pipeline_cache_);
+  if (created != VK_SUCCESS && !initial.empty()) {
+    pipeline_cache_note_ = std::string("pipeline cache: the driver refused the blob (") + detail::vk_result_name(created) +
+                           "); starting with an empty cache";
+    info.initialDataSize = 0;
+    info.pInitialData = nullptr;
+    MMVK_VK_CHECK(vkCreatePipelineCache(device_, &info, nullptr, &pipeline_cache_));
+  } else {
+    MMVK_VK_CHECK(created);
+  }
+  owns_pipeline_cache_ = true;
+  return {};
+}
+
+Result<std::vector<std::byte>> Context::pipeline_cache_data() const {
+  // The size can grow between the two calls only if another thread builds
+  // pipelines, which a Context does not allow; VK_INCOMPLETE is an error.
+  std::size_t size = 0;
+  MMVK_VK_CHECK(vkGetPipelineCacheData(device_, pipeline_cache_, &size, nullptr));
+  std::vector<std::byte> data(size);
+  MMVK_VK_CHECK(vkGetPipelineCacheData(device_, pipeline_cache_, &size, data.data()));
+  data.resize(size);
+  return data;
 }
 
 std::vector<std::string> Context::validation_messages() const {

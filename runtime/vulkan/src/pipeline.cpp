@@ -49,7 +49,7 @@ Result<UniquePipeline> create_compute_pipeline(const Context& context, VkPipelin
   info.stage.pSpecializationInfo = &spec_info;
   info.layout = layout;
   VkPipeline pipeline = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline));
+  MMVK_VK_CHECK(vkCreateComputePipelines(device, context.pipeline_cache(), 1, &info, nullptr, &pipeline));
   return UniquePipeline(device, pipeline);
 }
 

@@ -241,8 +241,11 @@ Status VulkanSearch::Impl::create_cluster_kernel(const ClusterTable& table) {
   return {};
 }
 
-// One dispatch of every variant: lavapipe compiles at the first one.
+// One dispatch of every variant: lavapipe compiles at the first one. The
+// caller's statistics and kernel time are kept.
 Status VulkanSearch::Impl::warm_up() {
+  const SearchStats kept_stats = stats;
+  const std::optional<double> kept_seconds = last_kernel_seconds;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> variants = kernel.variant_keys();
   if (clusters) {
     variants.clear();
@@ -258,7 +261,8 @@ Status VulkanSearch::Impl::warm_up() {
     std::vector<Match> out(std::size_t{tile} * k);
     MMVK_TRY(wait(ticket, out));
   }
-  stats = {};
+  stats = kept_stats;
+  last_kernel_seconds = kept_seconds;
   return {};
 }
 
@@ -300,6 +304,8 @@ std::optional<double> VulkanSearch::last_kernel_seconds() const { return impl_->
 const VulkanSearchOptions& VulkanSearch::options() const { return impl_->options; }
 std::uint32_t VulkanSearch::rows_per_invocation() const { return impl_->shape.rows_per_invocation; }
 std::uint32_t VulkanSearch::workgroup_size() const { return impl_->shape.workgroup_size; }
+
+Status VulkanSearch::warm_up() { return impl_->warm_up(); }
 
 Result<Ticket> VulkanSearch::submit(const QueryBatch& batch, std::uint32_t k) { return impl_->submit(batch, k, 0); }
 

@@ -4,15 +4,26 @@
 // that already renders with Vulkan; adopted handles are used, never
 // destroyed. No global state: every VulkanSearch takes a Context&.
 //
+// Pipeline cache: every pipeline of every search on a Context goes through
+// one VkPipelineCache. The application owns its contents: it passes a blob
+// from an earlier run in (ContextOptions / AdoptedDevice) and takes the
+// current one out (pipeline_cache_data()) to store it; mmvk writes no files
+// (mmvk/vulkan/pipeline_cache_file.hpp is an opt-in helper that does, in a
+// directory the application names). Drivers that compile at pipeline
+// creation skip what the blob holds; lavapipe compiles at the first dispatch
+// and keeps its own cache (Mesa's shader cache), see VulkanSearch::warm_up().
+//
 // Not thread-safe: use a Context (and the searches on it) from one thread at
 // a time. With an adopted queue, the application must not use that queue
 // concurrently with mmvk's submit calls (Vulkan's external sync rule).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,6 +41,11 @@ struct ContextOptions {
   // and a debug messenger that collects every warning and error.
   bool validation = false;
   std::string application_name = "mmvk";
+  // Initial contents of the pipeline cache: a blob from
+  // Context::pipeline_cache_data() of an earlier run. Empty = start empty.
+  // A blob for another device or driver version, or a malformed one, is
+  // ignored (pipeline_cache_note() says why); never an error.
+  std::vector<std::byte> pipeline_cache_data;
 };
 
 // The application's handles, for Context::adopt. The device must support
@@ -41,6 +57,11 @@ struct AdoptedDevice {
   VkDevice device = VK_NULL_HANDLE;
   std::uint32_t queue_family = 0;
   VkQueue queue = VK_NULL_HANDLE;
+  // The application's own pipeline cache, used and never destroyed (it must
+  // outlive the Context). When null, mmvk creates one, filled from
+  // pipeline_cache_data as ContextOptions::pipeline_cache_data.
+  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
+  std::vector<std::byte> pipeline_cache_data;
 };
 
 // One line per physical device, for tools and error messages.
@@ -77,6 +98,16 @@ class Context {
   // VkPhysicalDeviceMaintenance3Properties::maxMemoryAllocationSize.
   VkDeviceSize max_memory_allocation_size() const { return max_allocation_size_; }
 
+  // The cache every pipeline on this Context is created through.
+  VkPipelineCache pipeline_cache() const { return pipeline_cache_; }
+  // The cache's current contents (vkGetPipelineCacheData): the initial blob
+  // plus what the searches on this Context have built since. Store it and
+  // pass it back as ContextOptions::pipeline_cache_data in the next run.
+  Result<std::vector<std::byte>> pipeline_cache_data() const;
+  // Why the initial blob was ignored; empty when none was given or it was
+  // used. For a note to the user: an ignored blob is never an error.
+  const std::string& pipeline_cache_note() const { return pipeline_cache_note_; }
+
   // Validation messages (warnings and errors) collected so far; empty when
   // validation is off. Tests assert it stays empty.
   std::vector<std::string> validation_messages() const;
@@ -91,6 +122,7 @@ class Context {
  private:
   Context() = default;
   Status init_device_info();
+  Status init_pipeline_cache(VkPipelineCache adopted, std::span<const std::byte> initial);
 
   // Declaration order = reverse destruction order; the destructor destroys
   // only what this Context created (owns_*).
@@ -102,6 +134,9 @@ class Context {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   std::uint32_t queue_family_ = 0;
+  bool owns_pipeline_cache_ = false;
+  VkPipelineCache pipeline_cache_ = VK_NULL_HANDLE;
+  std::string pipeline_cache_note_;
 
   VkPhysicalDeviceProperties properties_{};
   VkPhysicalDeviceMemoryProperties memory_properties_{};

@@ -58,8 +58,8 @@ struct VulkanSearchOptions {
   // Per-slot scratch budget for the per-block best pairs, bytes; batches
   // whose scratch would not fit are processed in chunks inside one submit.
   std::uint64_t scratch_bytes = std::uint64_t{32} << 20;
-  // Runs every kernel variant once at creation: drivers such as lavapipe
-  // compile at the first dispatch, which would otherwise land in a search.
+  // Runs warm_up() at creation: drivers such as lavapipe compile at the
+  // first dispatch, which would otherwise land in a search.
   bool warm_up = true;
   // Uploads the database through a staging buffer and a copy even when the
   // device-local memory is host-visible (unified memory, lavapipe), so the
@@ -102,6 +102,15 @@ class VulkanSearch final : public SearchBackend {
   // Blocks until the ticket is done and writes its B*k matches to `out`
   // (layout as SearchBackend::search). Consumes the ticket.
   Status wait(const Ticket& ticket, std::span<Match> out);
+
+  // Builds every kernel variant this search can run and dispatches each
+  // once (a query per tile of row 0 of the database), so no later search
+  // pays a compile: pipelines are created at create() (through the
+  // Context's pipeline cache), and lavapipe compiles at the first dispatch
+  // (its own Mesa shader cache makes that fast in later processes). Needs a
+  // free slot; keeps stats() and last_kernel_seconds(). create() calls it
+  // unless options.warm_up is false.
+  Status warm_up();
 
   // GPU time of the last waited-for submit from timestamp queries, seconds;
   // nullopt when the queue has no timestamps.

@@ -1,0 +1,176 @@
+// The application-owned pipeline cache (Context) and VulkanSearch::warm_up():
+// a blob round-trips through a second Context, foreign or garbage blobs are
+// ignored with a note (never an error), an adopted VkPipelineCache is used,
+// and searches after warm_up() match the reference.
+#include <cstddef>
+#include <vector>
+
+#include "mmvk/reference_search.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
+#include "support/backend_suite.hpp"
+#include "support/test_data.hpp"
+#include "vulkan_test_env.hpp"
+
+namespace mmvk::test {
+
+// This file uses the suite's data helpers; the suite itself runs in
+// vulkan_backend_suite_test.cpp.
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BackendSuite);
+
+namespace {
+
+using vulkan::Context;
+using vulkan::ContextOptions;
+using vulkan::VulkanSearch;
+using vulkan::VulkanSearchOptions;
+
+// Small variants (tile <= 4, k <= 4) so the kernels compile quickly.
+VulkanSearchOptions small_options(bool warm_up) {
+  VulkanSearchOptions options;
+  options.max_batch = 16;
+  options.max_k = 4;
+  options.max_tile = 4;
+  options.warm_up = warm_up;
+  return options;
+}
+
+ContextOptions with_blob(std::vector<std::byte> blob) {
+  ContextOptions options;
+  options.pipeline_cache_data = std::move(blob);
+  return options;
+}
+
+const Database& test_database() {
+  static const Database db = synthetic_database({.frames = 3000, .seed = 77, .constraints = true});
+  return db;
+}
+
+// Searches with `context` (warm_up at creation) and checks it against the
+// reference on a few batches.
+void expect_search_matches(Context& context, bool call_warm_up) {
+  const Database& db = test_database();
+  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(context, db, small_options(!call_warm_up));
+  ASSERT_TRUE(search.ok()) << search.message();
+  if (call_warm_up) {
+    ASSERT_TRUE((*search)->warm_up().ok());
+    EXPECT_EQ((*search)->stats().queries, 0u) << "warm_up() counted its own dispatches";
+  }
+  ReferenceSearch reference(db);
+  for (const std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{16}}) {
+    const std::vector<float> queries = synthetic_queries(db, count, 500 + count);
+    const std::vector<QueryParams> params = random_params(db, count, 600 + count);
+    for (const std::uint32_t k : {1u, 4u}) {
+      SCOPED_TRACE("batch " + std::to_string(count) + ", k " + std::to_string(k));
+      expect_identical(run_search(reference, queries, params, count, k), run_search(**search, queries, params, count, k),
+                       k, params, (*search)->name());
+    }
+  }
+}
+
+// A further Context in a test whose first came from MMVK_VULKAN_CONTEXT
+// (which skips or fails when there is no device).
+std::unique_ptr<Context> another_context(const ContextOptions& options) {
+  Result<std::unique_ptr<Context>> context = Context::create(options);
+  EXPECT_TRUE(context.ok()) << context.message();
+  return context.ok() ? std::move(context).value() : nullptr;
+}
+
+std::vector<std::byte> blob_after_search(Context& context) {
+  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(context, test_database(), small_options(true));
+  EXPECT_TRUE(search.ok()) << search.message();
+  Result<std::vector<std::byte>> blob = context.pipeline_cache_data();
+  EXPECT_TRUE(blob.ok()) << blob.message();
+  return blob.ok() ? *blob : std::vector<std::byte>{};
+}
+
+TEST(PipelineCache, BlobRoundTripsThroughANewContext) {
+  MMVK_VULKAN_CONTEXT(first, ContextOptions{});
+  EXPECT_TRUE(first->pipeline_cache_note().empty());
+  const std::vector<std::byte> blob = blob_after_search(*first);
+  // At least the VkPipelineCacheHeaderVersionOne header (32 bytes); what
+  // follows is the driver's (lavapipe stores no pipelines in it).
+  ASSERT_GE(blob.size(), 32u);
+  first.reset();
+
+  std::unique_ptr<Context> second = another_context(with_blob(blob));
+  ASSERT_NE(second, nullptr);
+  EXPECT_TRUE(second->pipeline_cache_note().empty()) << second->pipeline_cache_note();
+  expect_search_matches(*second, false);
+  Result<std::vector<std::byte>> again = second->pipeline_cache_data();
+  ASSERT_TRUE(again.ok()) << again.message();
+  EXPECT_GE(again->size(), 32u);
+  // The blob of a context started from a blob is accepted in turn.
+  std::unique_ptr<Context> third = another_context(with_blob(*again));
+  ASSERT_NE(third, nullptr);
+  EXPECT_TRUE(third->pipeline_cache_note().empty()) << third->pipeline_cache_note();
+}
+
+TEST(PipelineCache, GarbageBlobIsIgnoredWithANote) {
+  std::vector<std::byte> garbage(4096);
+  for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = std::byte((i * 37 + 11) & 0xFF);
+  MMVK_VULKAN_CONTEXT(context, with_blob(garbage));
+  EXPECT_FALSE(context->pipeline_cache_note().empty());
+  expect_search_matches(*context, false);
+}
+
+TEST(PipelineCache, TruncatedBlobIsIgnoredWithANote) {
+  MMVK_VULKAN_CONTEXT(context, with_blob(std::vector<std::byte>(7, std::byte{1})));
+  EXPECT_NE(context->pipeline_cache_note().find("header"), std::string::npos) << context->pipeline_cache_note();
+  Result<std::vector<std::byte>> blob = context->pipeline_cache_data();
+  ASSERT_TRUE(blob.ok()) << blob.message();
+}
+
+TEST(PipelineCache, BlobOfAnotherDriverBuildIsIgnoredWithANote) {
+  MMVK_VULKAN_CONTEXT(first, ContextOptions{});
+  std::vector<std::byte> blob = blob_after_search(*first);
+  ASSERT_GE(blob.size(), 32u);
+  blob[20] ^= std::byte{0x5A};  // inside pipelineCacheUUID (bytes 16..31)
+  first.reset();
+  std::unique_ptr<Context> context = another_context(with_blob(blob));
+  ASSERT_NE(context, nullptr);
+  EXPECT_NE(context->pipeline_cache_note().find("driver build"), std::string::npos) << context->pipeline_cache_note();
+  expect_search_matches(*context, false);
+}
+
+TEST(PipelineCache, AdoptedCacheIsUsedAndKept) {
+  MMVK_VULKAN_CONTEXT(owner, ContextOptions{});
+  vulkan::AdoptedDevice handles;
+  handles.instance = owner->instance();
+  handles.physical_device = owner->physical_device();
+  handles.device = owner->device();
+  handles.queue_family = owner->queue_family();
+  handles.queue = owner->queue();
+  handles.pipeline_cache = owner->pipeline_cache();
+  {
+    Result<std::unique_ptr<Context>> adopted = Context::adopt(handles);
+    ASSERT_TRUE(adopted.ok()) << adopted.message();
+    EXPECT_EQ((*adopted)->pipeline_cache(), owner->pipeline_cache());
+    expect_search_matches(**adopted, true);
+  }
+  // The adopting Context did not destroy the application's cache.
+  Result<std::vector<std::byte>> blob = owner->pipeline_cache_data();
+  ASSERT_TRUE(blob.ok()) << blob.message();
+  EXPECT_GE(blob->size(), 32u);
+}
+
+TEST(PipelineCache, WarmUpThenSearchMatchesReference) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  expect_search_matches(*context, true);
+}
+
+TEST(PipelineCache, WarmUpKeepsTheCallersStatistics) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database& db = test_database();
+  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options(false));
+  ASSERT_TRUE(search.ok()) << search.message();
+  const std::vector<float> queries = synthetic_queries(db, 3, 9);
+  std::vector<Match> out(3);
+  ASSERT_TRUE((*search)->search(QueryBatch{queries, {}, 3}, 1, out).ok());
+  const SearchStats before = (*search)->stats();
+  ASSERT_TRUE((*search)->warm_up().ok());
+  EXPECT_EQ((*search)->stats().queries, before.queries);
+  EXPECT_EQ((*search)->stats().rows_evaluated, before.rows_evaluated);
+}
+
+}  // namespace
+}  // namespace mmvk::test

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 #include "mmvk/database.hpp"
@@ -68,11 +69,29 @@ struct ClusterTable {
   std::vector<float> channel_radius;
 };
 
+// Where training is, for a progress bar. Stages in order: "seeding"
+// (k-means++, step = centroids chosen), "lloyd" (step = iterations done;
+// it may stop early when stable), "assigning" (every frame to its nearest
+// centroid: step 0 of 1, then 1 of 1). `fraction` in [0, 1] weighs the
+// stages by their distance evaluations and never decreases.
+struct TrainingProgress {
+  const char* stage = "";
+  std::uint32_t step = 0;
+  std::uint32_t steps = 0;
+  double fraction = 0.0;
+};
+// Called on the training thread, between steps (never from the pool's
+// workers); it should return quickly.
+using TrainingProgressFn = std::function<void(const TrainingProgress&)>;
+
 // Trains k-means (k-means++ seeding, then Lloyd) and builds the table.
 // Deterministic for given params and database: the same table on every
-// machine and thread count. The pool overload spreads the distance work.
+// machine and thread count. The pool overload spreads the distance work;
+// `progress` (may be empty) reports each step.
 Result<ClusterTable> train_cluster_table(const Database& database, const KMeansParams& params);
 Result<ClusterTable> train_cluster_table(const Database& database, const KMeansParams& params, ThreadPool& pool);
+Result<ClusterTable> train_cluster_table(const Database& database, const KMeansParams& params, ThreadPool& pool,
+                                         const TrainingProgressFn& progress);
 
 // Checks that `table` was built from `database` (hash, dims, sizes) and is
 // internally consistent (members a partition of the frames, ascending within

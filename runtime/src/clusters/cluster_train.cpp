@@ -107,12 +107,14 @@ class Assigner {
 };
 
 std::vector<float> kmeans_plus_plus(const std::vector<float>& points, std::size_t count, std::uint32_t dims,
-                                    std::uint32_t k, std::mt19937_64& rng, ThreadPool* pool) {
+                                    std::uint32_t k, std::mt19937_64& rng, ThreadPool* pool,
+                                    const std::function<void(std::uint32_t)>& on_centroid) {
   std::vector<float> centroids(std::size_t{k} * dims);
   std::vector<float> min_distance(count, std::numeric_limits<float>::infinity());
   std::size_t chosen = uniform_index(rng, count);
   for (std::uint32_t c = 0; c < k; ++c) {
     std::copy_n(points.data() + chosen * dims, dims, centroids.data() + std::size_t{c} * dims);
+    if (on_centroid) on_centroid(c + 1);
     if (c + 1 == k) break;
     const float* center = centroids.data() + std::size_t{c} * dims;
     run_parallel(pool, count, [&](std::size_t begin, std::size_t end, unsigned) {
@@ -151,10 +153,15 @@ Result<ClusterTable> train_cluster_table(const Database& database, const KMeansP
   return detail::train_cluster_table_impl(database, params, &pool);
 }
 
+Result<ClusterTable> train_cluster_table(const Database& database, const KMeansParams& params, ThreadPool& pool,
+                                         const TrainingProgressFn& progress) {
+  return detail::train_cluster_table_impl(database, params, &pool, progress);
+}
+
 namespace detail {
 
 void run_lloyd(const float* points, std::size_t count, std::uint32_t dims, std::vector<float>& centroids,
-               std::uint32_t iterations, ThreadPool* pool) {
+               std::uint32_t iterations, ThreadPool* pool, const std::function<void(std::uint32_t)>& on_iteration) {
   const auto k = static_cast<std::uint32_t>(centroids.size() / dims);
   Assigner assigner(dims, k, pool);
   std::vector<std::uint32_t> assignment;
@@ -163,6 +170,7 @@ void run_lloyd(const float* points, std::size_t count, std::uint32_t dims, std::
   std::vector<double> sums(std::size_t{k} * dims);
   std::vector<std::uint32_t> sizes(k);
   for (std::uint32_t iteration = 0; iteration < iterations; ++iteration) {
+    if (iteration != 0 && on_iteration) on_iteration(iteration);
     assigner.assign(points, count, centroids, assignment, distance);
     if (assignment == previous) break;  // converged: the update would change nothing
     previous = assignment;
@@ -190,7 +198,8 @@ void run_lloyd(const float* points, std::size_t count, std::uint32_t dims, std::
   }
 }
 
-Result<ClusterTable> train_cluster_table_impl(const Database& database, const KMeansParams& params, ThreadPool* pool) {
+Result<ClusterTable> train_cluster_table_impl(const Database& database, const KMeansParams& params, ThreadPool* pool,
+                                              const TrainingProgressFn& progress) {
   const std::uint32_t frames = database.frame_count();
   const std::uint32_t dims = database.dims();
   if (frames == 0) return make_error("train_cluster_table: the database is empty");
@@ -219,15 +228,34 @@ Result<ClusterTable> train_cluster_table_impl(const Database& database, const KM
     std::copy(row.begin(), row.end(), points.begin() + i * dims);
   }
 
-  std::vector<float> centroids = kmeans_plus_plus(points, count, dims, k, rng, pool);
-  run_lloyd(points.data(), count, dims, centroids, params.iterations, pool);
+  // Progress weights in distance evaluations: seeding is one pass over the
+  // sample per centroid, an iteration k passes, the final assignment k
+  // passes over every frame.
+  const double seeding_work = double(count) * k;
+  const double iteration_work = double(count) * k;
+  const double total_work = seeding_work + iteration_work * params.iterations + double(frames) * k;
+  const auto report = [&](const char* stage, std::uint32_t step, std::uint32_t steps, double done) {
+    if (progress) progress(TrainingProgress{stage, step, steps, std::min(1.0, done / total_work)});
+  };
+  report("seeding", 0, k, 0.0);
+  std::vector<float> centroids = kmeans_plus_plus(points, count, dims, k, rng, pool, [&](std::uint32_t chosen) {
+    report("seeding", chosen, k, double(count) * chosen);
+  });
+  report("lloyd", 0, params.iterations, seeding_work);
+  run_lloyd(points.data(), count, dims, centroids, params.iterations, pool, [&](std::uint32_t done) {
+    report("lloyd", done, params.iterations, seeding_work + iteration_work * done);
+  });
 
   // Every frame goes to its nearest trained centroid.
+  const double assigning_start = seeding_work + iteration_work * params.iterations;
+  report("assigning", 0, 1, assigning_start);
   Assigner assigner(dims, k, pool);
   std::vector<std::uint32_t> frame_cluster;
   std::vector<float> distance;
   assigner.assign(database.features().data(), frames, centroids, frame_cluster, distance);
-  return build_cluster_table(database, std::move(centroids), frame_cluster);
+  ClusterTable table = build_cluster_table(database, std::move(centroids), frame_cluster);
+  report("assigning", 1, 1, total_work);
+  return table;
 }
 
 }  // namespace detail

@@ -3,9 +3,12 @@
 // ignored with a note (never an error), an adopted VkPipelineCache is used,
 // and searches after warm_up() match the reference.
 #include <cstddef>
+#include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include "mmvk/reference_search.hpp"
+#include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/backend_suite.hpp"
 #include "support/test_data.hpp"
@@ -170,6 +173,78 @@ TEST(PipelineCache, WarmUpKeepsTheCallersStatistics) {
   ASSERT_TRUE((*search)->warm_up().ok());
   EXPECT_EQ((*search)->stats().queries, before.queries);
   EXPECT_EQ((*search)->stats().rows_evaluated, before.rows_evaluated);
+}
+
+// A fresh directory per test under the build's temp dir.
+std::filesystem::path fresh_directory(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("mmvk_pipeline_cache_" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+TEST(PipelineCacheFile, EncodeDecodeRoundTripAndDamageIsDetected) {
+  std::vector<std::byte> blob(100);
+  for (std::size_t i = 0; i < blob.size(); ++i) blob[i] = std::byte(i * 7);
+  const std::string file = vulkan::encode_pipeline_cache_file(blob);
+  Result<std::vector<std::byte>> decoded = vulkan::decode_pipeline_cache_file(file);
+  ASSERT_TRUE(decoded.ok()) << decoded.message();
+  EXPECT_EQ(*decoded, blob);
+  EXPECT_FALSE(vulkan::decode_pipeline_cache_file(file.substr(0, file.size() - 1)).ok());
+  EXPECT_FALSE(vulkan::decode_pipeline_cache_file(file.substr(0, 10)).ok());
+  std::string flipped = file;
+  flipped[file.size() - 3] ^= 0x10;
+  EXPECT_NE(vulkan::decode_pipeline_cache_file(flipped).message().find("checksum"), std::string::npos);
+  std::string magic = file;
+  magic[0] = 'X';
+  EXPECT_FALSE(vulkan::decode_pipeline_cache_file(magic).ok());
+  EXPECT_TRUE(vulkan::decode_pipeline_cache_file(vulkan::encode_pipeline_cache_file({})).ok());
+}
+
+TEST(PipelineCacheFile, SaveThenLoadInANewContext) {
+  MMVK_VULKAN_CONTEXT(first, ContextOptions{});
+  const std::filesystem::path dir = fresh_directory("round_trip") / "nested";
+  EXPECT_EQ(vulkan::load_pipeline_cache_file(*first, dir), "") << "a missing file is the first run, not a problem";
+  (void)blob_after_search(*first);
+  const Status saved = vulkan::save_pipeline_cache_file(*first, dir);
+  ASSERT_TRUE(saved.ok()) << saved.message();
+  const std::filesystem::path file = vulkan::pipeline_cache_file(*first, dir);
+  EXPECT_EQ(file.parent_path(), dir);
+  ASSERT_TRUE(std::filesystem::exists(file));
+  first.reset();
+
+  std::unique_ptr<Context> second = another_context(ContextOptions{});
+  ASSERT_NE(second, nullptr);
+  EXPECT_EQ(vulkan::load_pipeline_cache_file(*second, dir), "");
+  expect_search_matches(*second, true);
+  EXPECT_TRUE(vulkan::save_pipeline_cache_file(*second, dir).ok());
+  std::filesystem::remove_all(dir.parent_path());
+}
+
+TEST(PipelineCacheFile, GarbageFileIsIgnoredWithANote) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const std::filesystem::path dir = fresh_directory("garbage");
+  std::filesystem::create_directories(dir);
+  std::ofstream(vulkan::pipeline_cache_file(*context, dir), std::ios::binary) << "not a pipeline cache at all";
+  const std::string note = vulkan::load_pipeline_cache_file(*context, dir);
+  EXPECT_NE(note.find("ignored"), std::string::npos) << note;
+  expect_search_matches(*context, false);
+  // The next save replaces it with a good file.
+  ASSERT_TRUE(vulkan::save_pipeline_cache_file(*context, dir).ok());
+  EXPECT_EQ(vulkan::load_pipeline_cache_file(*context, dir), "");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(PipelineCacheFile, FileOfAnotherDriverBuildIsIgnoredWithANote) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  std::vector<std::byte> blob = blob_after_search(*context);
+  ASSERT_GE(blob.size(), 32u);
+  blob[17] ^= std::byte{1};
+  const std::filesystem::path dir = fresh_directory("foreign");
+  std::filesystem::create_directories(dir);
+  std::ofstream(vulkan::pipeline_cache_file(*context, dir), std::ios::binary)
+      << vulkan::encode_pipeline_cache_file(blob);
+  EXPECT_NE(vulkan::load_pipeline_cache_file(*context, dir).find("driver build"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -300,6 +300,20 @@ Status Context::init_pipeline_cache(VkPipelineCache adopted, std::span<const std
   return {};
 }
 
+Status Context::merge_pipeline_cache_data(std::span<const std::byte> blob) {
+  MMVK_TRY(detail::check_pipeline_cache_blob(blob, properties_));
+  VkPipelineCacheCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO;
+  info.initialDataSize = blob.size();
+  info.pInitialData = blob.data();
+  VkPipelineCache loaded = VK_NULL_HANDLE;
+  MMVK_VK_CHECK(vkCreatePipelineCache(device_, &info, nullptr, &loaded));
+  const VkResult merged = vkMergePipelineCaches(device_, pipeline_cache_, 1, &loaded);
+  vkDestroyPipelineCache(device_, loaded, nullptr);
+  MMVK_VK_CHECK(merged);
+  return {};
+}
+
 Result<std::vector<std::byte>> Context::pipeline_cache_data() const {
   // The size can grow between the two calls only if another thread builds
   // pipelines, which a Context does not allow; VK_INCOMPLETE is an error.

@@ -104,6 +104,10 @@ class Context {
   // plus what the searches on this Context have built since. Store it and
   // pass it back as ContextOptions::pipeline_cache_data in the next run.
   Result<std::vector<std::byte>> pipeline_cache_data() const;
+  // Adds a blob's pipelines to the cache (for a blob found after the
+  // Context was made, e.g. in a file named after its device). An error
+  // says why the blob was not used; the cache is then unchanged and usable.
+  Status merge_pipeline_cache_data(std::span<const std::byte> blob);
   // Why the initial blob was ignored; empty when none was given or it was
   // used. For a note to the user: an ignored blob is never an error.
   const std::string& pipeline_cache_note() const { return pipeline_cache_note_; }

@@ -73,6 +73,12 @@ Result<Buffer> create_buffer(const Context& context, VkDeviceSize size, VkBuffer
   if ((flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) != 0) {
     MMVK_VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &result.mapped));
     result.coherent = (flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    // Touches every page now: on unified memory (lavapipe) the pages are
+    // otherwise faulted in by the first search that reaches them, which
+    // made the first search of a process measurably slower than later ones.
+    // Only coherent memory: a non-coherent host write could be written back
+    // over what the device wrote later.
+    if (result.coherent) std::memset(result.mapped, 0, size);
   }
   return result;
 }

@@ -143,9 +143,8 @@ TEST(PipelineCache, AdoptedCacheIsUsedAndKept) {
   handles.device = owner->device();
   handles.queue_family = owner->queue_family();
   handles.queue = owner->queue();
-  handles.pipeline_cache = owner->pipeline_cache();
   {
-    Result<std::unique_ptr<Context>> adopted = Context::adopt(handles);
+    Result<std::unique_ptr<Context>> adopted = Context::adopt(handles, owner->pipeline_cache());
     ASSERT_TRUE(adopted.ok()) << adopted.message();
     EXPECT_EQ((*adopted)->pipeline_cache(), owner->pipeline_cache());
     expect_search_matches(**adopted, true);

@@ -214,7 +214,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
   return context;
 }
 
-Result<std::unique_ptr<Context>> Context::adopt(const AdoptedDevice& handles) {
+Result<std::unique_ptr<Context>> Context::adopt(const AdoptedDevice& handles, VkPipelineCache pipeline_cache) {
   if (handles.instance == VK_NULL_HANDLE || handles.physical_device == VK_NULL_HANDLE ||
       handles.device == VK_NULL_HANDLE || handles.queue == VK_NULL_HANDLE) {
     return make_error("Vulkan context: adopt() needs an instance, a physical device, a device and a queue");
@@ -239,7 +239,7 @@ Result<std::unique_ptr<Context>> Context::adopt(const AdoptedDevice& handles) {
                       " does not exist or has no compute support");
   }
   MMVK_TRY(context->init_device_info());
-  MMVK_TRY(context->init_pipeline_cache(handles.pipeline_cache, handles.pipeline_cache_data));
+  MMVK_TRY(context->init_pipeline_cache(pipeline_cache, {}));
   return context;
 }
 
@@ -269,7 +269,6 @@ Status Context::init_device_info() {
 Status Context::init_pipeline_cache(VkPipelineCache adopted, std::span<const std::byte> initial) {
   if (adopted != VK_NULL_HANDLE) {
     pipeline_cache_ = adopted;
-    if (!initial.empty()) pipeline_cache_note_ = "pipeline cache: the adopted VkPipelineCache is used, the blob is not";
     return {};
   }
   if (!initial.empty()) {

@@ -6,8 +6,9 @@
 //
 // Pipeline cache: every pipeline of every search on a Context goes through
 // one VkPipelineCache. The application owns its contents: it passes a blob
-// from an earlier run in (ContextOptions / AdoptedDevice) and takes the
-// current one out (pipeline_cache_data()) to store it; mmvk writes no files
+// from an earlier run in (ContextOptions, merge_pipeline_cache_data(), or
+// its own cache to adopt()) and takes the current one out
+// (pipeline_cache_data()) to store it; mmvk writes no files
 // (mmvk/vulkan/pipeline_cache_file.hpp is an opt-in helper that does, in a
 // directory the application names). Drivers that compile at pipeline
 // creation skip what the blob holds; lavapipe compiles at the first dispatch
@@ -57,11 +58,6 @@ struct AdoptedDevice {
   VkDevice device = VK_NULL_HANDLE;
   std::uint32_t queue_family = 0;
   VkQueue queue = VK_NULL_HANDLE;
-  // The application's own pipeline cache, used and never destroyed (it must
-  // outlive the Context). When null, mmvk creates one, filled from
-  // pipeline_cache_data as ContextOptions::pipeline_cache_data.
-  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
-  std::vector<std::byte> pipeline_cache_data;
 };
 
 // One line per physical device, for tools and error messages.
@@ -76,7 +72,11 @@ class Context {
   // Errors (never exits): no Vulkan driver or device, the requested index
   // out of range, no compute queue, validation requested but not installed.
   static Result<std::unique_ptr<Context>> create(const ContextOptions& options = {});
-  static Result<std::unique_ptr<Context>> adopt(const AdoptedDevice& handles);
+  // `pipeline_cache`: the application's own cache, used and never destroyed
+  // (it must outlive the Context); null = mmvk creates an empty one (fill it
+  // with merge_pipeline_cache_data()).
+  static Result<std::unique_ptr<Context>> adopt(const AdoptedDevice& handles,
+                                                VkPipelineCache pipeline_cache = VK_NULL_HANDLE);
 
   ~Context();
   Context(const Context&) = delete;

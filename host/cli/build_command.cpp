@@ -40,12 +40,9 @@ void draw_progress(const BuildProgress& progress) {
   const auto now = std::chrono::steady_clock::now();
   if (progress.clips_done != progress.clip_count && now - last_draw < std::chrono::milliseconds(100)) return;
   last_draw = now;
-  constexpr int kWidth = 30;
-  const int filled = progress.clip_count ? int(kWidth * progress.clips_done / progress.clip_count) : kWidth;
-  std::string bar(static_cast<std::size_t>(filled), '#');
-  bar.append(static_cast<std::size_t>(kWidth - filled), '.');
-  std::fprintf(stderr, "\r[%s] %zu/%zu clips  %s frames", bar.c_str(), progress.clips_done, progress.clip_count,
-               thousands(progress.frames_done).c_str());
+  const double fraction = progress.clip_count ? double(progress.clips_done) / double(progress.clip_count) : 1.0;
+  std::fprintf(stderr, "\r%s %zu/%zu clips  %s frames", progress_bar(fraction).c_str(), progress.clips_done,
+               progress.clip_count, thousands(progress.frames_done).c_str());
   if (progress.clips_done == progress.clip_count) std::fputc('\n', stderr);
   std::fflush(stderr);
 }

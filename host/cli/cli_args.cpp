@@ -1,5 +1,6 @@
 #include "cli_args.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -110,6 +111,15 @@ std::string thousands(unsigned long long value) {
     out += digits[i];
   }
   return out;
+}
+
+std::string progress_bar(double fraction) {
+  constexpr int kWidth = 30;
+  const int filled = static_cast<int>(kWidth * std::clamp(fraction, 0.0, 1.0));
+  std::string bar = "[";
+  bar.append(static_cast<std::size_t>(filled), '#');
+  bar.append(static_cast<std::size_t>(kWidth - filled), '.');
+  return bar + "]";
 }
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }

@@ -49,6 +49,10 @@ int report_error(std::string_view command, std::string_view message, int exit_co
 // "1,234,567"
 std::string thousands(unsigned long long value);
 
+// "[#########.....................]": `fraction` of 30 cells (clamped to
+// [0, 1]), for the progress lines of long commands.
+std::string progress_bar(double fraction);
+
 bool stderr_is_terminal();
 
 }  // namespace mmvk::cli

@@ -15,5 +15,6 @@ int run_export(Args args);   // export_command.cpp
 int run_query(Args args);    // query_command.cpp
 // argv0: the program's path, to find data installed beside it.
 int run_crowd(Args args, const char* argv0);  // crowd_command.cpp
+int run_clusters(Args args);  // clusters_command.cpp
 
 }  // namespace mmvk::cli

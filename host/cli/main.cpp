@@ -16,6 +16,7 @@ constexpr const char* kUsage =
     "  export db.mmdb --features out.f32            the normalized feature matrix + JSON sidecar\n"
     "  query db.mmdb --queries q.f32 ...            batched search, one result line per query\n"
     "  crowd [--agents N] [--html out.html] ...     a motion-matched crowd, its figures and a viewer page\n"
+    "  clusters db.mmdb -o table.mmkc               train and save the cluster tables (query --clusters)\n"
     "\n"
     "Run `mmvk <command> --help` for a command's options.\n";
 
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   if (command == "export") return mmvk::cli::run_export(rest);
   if (command == "query") return mmvk::cli::run_query(rest);
   if (command == "crowd") return mmvk::cli::run_crowd(rest, argv[0]);
+  if (command == "clusters") return mmvk::cli::run_clusters(rest);
   std::fprintf(stderr, "mmvk: unknown command '%.*s'\n\n%s", int(command.size()), command.data(), kUsage);
   return 2;
 }

@@ -21,6 +21,8 @@
 #if defined(MMVK_HAS_VULKAN)
 #include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/context.hpp"
+#include "mmvk/vulkan/pipeline_cache_file.hpp"
+#include "user_cache_dir.hpp"
 #endif
 
 namespace mmvk::cli {
@@ -40,8 +42,8 @@ constexpr const char* kQueryUsage =
     "--backend NAME, one of:\n";
 
 constexpr const char* kQueryUsageOptions =
-    "  The cluster backends load --clusters table.mmkc when given, else train the\n"
-    "  tables with the default k-means parameters. --nprobe N: clusters searched\n"
+    "  The cluster backends load --clusters table.mmkc (from `mmvk clusters`) when\n"
+    "  given, else train the tables with the default k-means parameters. --nprobe N: clusters searched\n"
     "  per query by the *-nprobe backends (default 4).\n"
     "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores.\n"
     "\n"
@@ -54,7 +56,10 @@ constexpr const char* kQueryUsageOptions =
     "  'none' where fewer than k frames are candidates. Costs are printed with\n"
     "  %.9g, which round-trips float32 exactly.\n"
     "--explain prints the first query's explanation to stderr: the winner's and\n"
-    "the --frames' per-channel costs, and why frames are not candidates.\n";
+    "the --frames' per-channel costs, and why frames are not candidates.\n"
+    "\n"
+    "The vulkan-* backends keep their pipeline cache between runs in\n"
+    "$XDG_CACHE_HOME/mmvk (else ~/.cache/mmvk), one file per device.\n";
 
 std::vector<std::string> split_list(const std::string& text) {
   std::vector<std::string> items;
@@ -81,6 +86,26 @@ struct BackendHolder {
   explicit BackendHolder(unsigned threads) : pool(threads) {}
 };
 
+#if defined(MMVK_HAS_VULKAN)
+// The Vulkan pipeline cache is kept between runs in the user's cache
+// directory: loaded when the context is made, saved after the search. A
+// missing directory, or a damaged or foreign file, is a note, never an error.
+void load_pipeline_cache(vulkan::Context& context) {
+  const std::optional<std::filesystem::path> dir = user_cache_directory();
+  if (!dir) return;
+  const std::string note = vulkan::load_pipeline_cache_file(context, *dir);
+  if (!note.empty()) std::fprintf(stderr, "mmvk query: note: %s\n", note.c_str());
+}
+
+void save_pipeline_cache(const ContextHolder& context) {
+  const std::optional<std::filesystem::path> dir = user_cache_directory();
+  if (!context || !dir) return;
+  if (const Status saved = vulkan::save_pipeline_cache_file(*context, *dir); !saved) {
+    std::fprintf(stderr, "mmvk query: note: the pipeline cache was not saved: %s\n", saved.message().c_str());
+  }
+}
+#endif
+
 // The CPU backends, and the Vulkan ones when built with Vulkan. The Vulkan
 // context is created into `context` only when one of them is made, so
 // listing them (--help) needs no device.
@@ -90,6 +115,7 @@ BackendRegistry query_backends([[maybe_unused]] ContextHolder& context) {
   const Status added = vulkan::add_backends(registry, [&context]() -> Result<vulkan::Context*> {
     if (!context) {
       MMVK_ASSIGN_OR_RETURN(context, vulkan::Context::create());
+      load_pipeline_cache(*context);
     }
     return context.get();
   });
@@ -126,7 +152,9 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
       MMVK_ASSIGN_OR_RETURN(holder.table, load_cluster_table(*path));
       spec.clusters = &*holder.table;
     } else {
-      std::fputs("mmvk query: training k-means cluster tables (default parameters; pass --clusters to reuse)\n", stderr);
+      std::fputs("mmvk query: training k-means cluster tables (default parameters; train them once with\n"
+                 "  `mmvk clusters` and pass --clusters to reuse them)\n",
+                 stderr);
     }
   }
   MMVK_ASSIGN_OR_RETURN(holder.backend, registry.make(spec, db));
@@ -238,6 +266,9 @@ int run_query(Args args) {
       holder.backend->search(QueryBatch{*features, all_params, count}, k, results);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!searched) return fail(searched.message());
+#if defined(MMVK_HAS_VULKAN)
+  save_pipeline_cache(holder.context);
+#endif
   std::fprintf(stderr, "mmvk query: %zu queries, backend %s, %.3f ms (%.0f queries/s), %.2f%% of rows evaluated\n",
                count, std::string(holder.backend->name()).c_str(), seconds * 1e3, double(count) / seconds,
                100.0 * holder.backend->stats().rows_fraction(db->frame_count()));

@@ -6,7 +6,7 @@
 #include <system_error>
 
 #include "../../src/common/hash.hpp"
-#include "../../src/common/file_io.hpp"  // TEMP until mmvk/file_io.hpp lands
+#include "mmvk/file_io.hpp"
 
 namespace mmvk::vulkan {
 
@@ -77,7 +77,7 @@ std::string load_pipeline_cache_file(Context& context, const std::filesystem::pa
   const std::filesystem::path path = pipeline_cache_file(context, directory);
   std::error_code error;
   if (!std::filesystem::exists(path, error)) return {};  // the first run on this device
-  Result<std::string> bytes = detail::read_file(path);
+  Result<std::string> bytes = read_file(path);
   if (!bytes) return bytes.message() + "; the pipeline cache starts empty";
   Result<std::vector<std::byte>> blob = decode_pipeline_cache_file(*bytes);
   if (!blob) return path.string() + ": " + blob.message() + "; ignored, the pipeline cache starts empty";
@@ -91,7 +91,7 @@ Status save_pipeline_cache_file(const Context& context, const std::filesystem::p
   std::error_code error;
   std::filesystem::create_directories(directory, error);
   if (error) return make_error(directory.string() + ": cannot create the cache directory: " + error.message());
-  return detail::write_file_atomically(pipeline_cache_file(context, directory), encode_pipeline_cache_file(blob));
+  return write_file_atomically(pipeline_cache_file(context, directory), encode_pipeline_cache_file(blob));
 }
 
 }  // namespace mmvk::vulkan

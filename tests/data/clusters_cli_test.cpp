@@ -6,12 +6,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "support/command.hpp"
+#include "support/query_results.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -21,22 +21,8 @@ namespace fs = std::filesystem;
 using test::CommandResult;
 using test::run_command;
 
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// The result lines without the '#' comments (which name the backend).
-std::string result_lines(const fs::path& path) {
-  std::istringstream in(read_bytes(path));
-  std::string line, kept;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line[0] != '#') kept += line + "\n";
-  }
-  return kept;
-}
+using test::read_text;
+using test::result_lines;
 
 bool vulkan_required() {
   const char* value = std::getenv("MMVK_REQUIRE_VULKAN");
@@ -58,7 +44,7 @@ class ClustersCli : public ::testing::Test {
     // Queries: the database's own normalized rows (every 7th).
     const CommandResult exported = run_command(mmvk_ + " export " + db_ + " --features " + (dir_ / "f.f32").string());
     ASSERT_EQ(exported.exit_code, 0) << exported.output;
-    const std::string rows = read_bytes(dir_ / "f.f32");
+    const std::string rows = read_text(dir_ / "f.f32");
     std::string queries;
     for (std::size_t at = 0; at + 27 * 4 <= rows.size(); at += 7 * 27 * 4) queries += rows.substr(at, 27 * 4);
     queries_ = (dir_ / "q.f32").string();
@@ -93,7 +79,7 @@ TEST_F(ClustersCli, SavedTableIsDeterministicAndReusedByQuery) {
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
   EXPECT_NE(trained.output.find("9 clusters"), std::string::npos) << trained.output;
   ASSERT_EQ(run_command(train + (dir_ / "again.mmkc").string()).exit_code, 0);
-  EXPECT_EQ(read_bytes(table), read_bytes(dir_ / "again.mmkc")) << "training is deterministic";
+  EXPECT_EQ(read_text(table), read_text(dir_ / "again.mmkc")) << "training is deterministic";
 
   const CommandResult reference = run_command(query(db_, "--backend reference --out " + (dir_ / "ref.tsv").string()));
   ASSERT_EQ(reference.exit_code, 0) << reference.output;
@@ -169,7 +155,7 @@ TEST_F(ClustersCli, QueryKeepsThePipelineCacheAndIgnoresADamagedOne) {
   EXPECT_NE(damaged.output.find("note:"), std::string::npos) << damaged.output;
   EXPECT_NE(damaged.output.find(file.filename().string()), std::string::npos) << damaged.output;
   EXPECT_EQ(result_lines(dir_ / "v2.tsv"), result_lines(dir_ / "ref.tsv"));
-  EXPECT_NE(read_bytes(file), "damaged") << "the next run replaces a damaged file";
+  EXPECT_NE(read_text(file), "damaged") << "the next run replaces a damaged file";
   const CommandResult again = run_command(env + query(db_, "--backend vulkan-brute --out " + (dir_ / "v3.tsv").string()));
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_EQ(again.output.find("note"), std::string::npos) << again.output;

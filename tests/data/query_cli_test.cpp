@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/query_results.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -34,22 +35,8 @@ CommandResult run(const std::string& command) {
   return result;
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// The result lines without the '#' comments (which name the backend).
-std::string result_lines(const fs::path& path) {
-  std::istringstream in(read_text(path));
-  std::string line, kept;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line[0] != '#') kept += line + "\n";
-  }
-  return kept;
-}
+using test::read_text;
+using test::result_lines;
 
 class QueryCli : public ::testing::Test {
  protected:

@@ -3,7 +3,6 @@
 // viewer page. The work is in host/crowd (run_crowd); this file parses the
 // command line and reads the environment (the cache folder, the terminal).
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -11,6 +10,7 @@
 #include "commands.hpp"
 #include "crowd_backend.hpp"
 #include "crowd_run.hpp"
+#include "user_cache_dir.hpp"
 
 namespace mmvk::cli {
 
@@ -39,12 +39,6 @@ constexpr const char* kCrowdUsage =
     "  --scenario FILE       starts, goals, speeds and tags from JSON (see host/crowd/scenario.hpp)\n"
     "  --summary FILE        write the run's figures as JSON\n"
     "  --html FILE           write the viewer: one self-contained page\n";
-
-std::filesystem::path cache_dir() {
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "mmvk";
-  if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "mmvk";
-  return {};
-}
 
 }  // namespace
 
@@ -97,7 +91,7 @@ int run_crowd(Args args, const char* argv0) {
   std::error_code ec;
   if (argv0) options.executable = std::filesystem::canonical("/proc/self/exe", ec);
   if (ec || options.executable.empty()) options.executable = argv0 ? argv0 : "";
-  options.cache_dir = cache_dir();
+  options.cache_dir = user_cache_directory().value_or(std::filesystem::path{});
   options.progress = stderr_is_terminal();
 
   Result<crowd::CrowdSummary> summary = crowd::run_crowd(options, stderr);

@@ -6,6 +6,7 @@
 
 #if defined(MMVK_HAS_VULKAN)
 #include "mmvk/vulkan/backends.hpp"
+#include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "mmvk/vulkan/vulkan_async_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #endif
@@ -50,16 +51,18 @@ std::string describe_device(const vulkan::Context& context, std::optional<std::u
 
 // The library's registry: the CPU backends, and the Vulkan ones on a
 // context created (on `device`) only when one of them is made.
-BackendRegistry crowd_registry([[maybe_unused]] CrowdSearch& out, [[maybe_unused]] std::optional<std::uint32_t> device) {
+BackendRegistry crowd_registry([[maybe_unused]] CrowdSearch& out, [[maybe_unused]] std::optional<std::uint32_t> device,
+                               [[maybe_unused]] const std::filesystem::path& cache_dir) {
   BackendRegistry registry = cpu_backends();
 #if defined(MMVK_HAS_VULKAN)
   // The names are distinct from the CPU ones; a clash would be a bug in mmvk.
-  (void)vulkan::add_backends(registry, [&out, device]() -> Result<vulkan::Context*> {
+  (void)vulkan::add_backends(registry, [&out, device, cache_dir]() -> Result<vulkan::Context*> {
     if (!out.context) {
       vulkan::ContextOptions options;
       options.device_index = device;
       options.application_name = "mmvk crowd";
       MMVK_ASSIGN_OR_RETURN(out.context, vulkan::Context::create(options));
+      if (!cache_dir.empty()) out.pipeline_cache_note = vulkan::load_pipeline_cache_file(*out.context, cache_dir);
     }
     return out.context.get();
   });
@@ -71,13 +74,14 @@ BackendRegistry crowd_registry([[maybe_unused]] CrowdSearch& out, [[maybe_unused
 
 std::string crowd_backend_help() {
   CrowdSearch unused;
-  return crowd_registry(unused, std::nullopt).help();
+  return crowd_registry(unused, std::nullopt, {}).help();
 }
 
 Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
-                                      const Database& database, std::uint32_t agents, ThreadPool& pool) {
+                                      const Database& database, std::uint32_t agents, ThreadPool& pool,
+                                      const std::filesystem::path& cache_dir) {
   CrowdSearch out;
-  const BackendRegistry registry = crowd_registry(out, device);
+  const BackendRegistry registry = crowd_registry(out, device, cache_dir);
   const BackendEntry* entry = registry.find(name);
   if (!entry) return make_error("unknown backend '" + name + "' (known: " + registry.names() + ")");
   BackendSpec spec;
@@ -98,6 +102,14 @@ Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std
                                    : "cpu, " + std::to_string(pool.thread_count()) + " threads";
   out.deferred = std::make_unique<DeferredSearch>(*out.backend, kMaxBatch, agents);
   return out;
+}
+
+Status save_crowd_pipeline_cache([[maybe_unused]] const CrowdSearch& search,
+                                 [[maybe_unused]] const std::filesystem::path& cache_dir) {
+#if defined(MMVK_HAS_VULKAN)
+  if (search.context && !cache_dir.empty()) return vulkan::save_pipeline_cache_file(*search.context, cache_dir);
+#endif
+  return {};
 }
 
 }  // namespace mmvk::crowd

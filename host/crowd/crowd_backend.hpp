@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +31,7 @@ struct CrowdSearch {
   std::unique_ptr<SearchBackend> backend;
   std::unique_ptr<AsyncSearch> deferred;     // on `backend`
   std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
+  std::string pipeline_cache_note;           // why a pipeline cache file was not used, or ""
 };
 
 // The backends `mmvk crowd --backend` accepts (the library's registry), one
@@ -38,9 +40,16 @@ std::string crowd_backend_help();
 
 // Makes `name` from the library's backend registry on `database` for up to
 // `agents` queries per tick. `device` picks the Vulkan device (none: the
-// best one). Errors: an unknown name (listing the known ones), no Vulkan
+// best one). A Vulkan context starts from the pipeline cache file in
+// `cache_dir` (none when empty); save_crowd_pipeline_cache keeps it. Errors: an unknown name (listing the known ones), no Vulkan
 // device, a database too large, --device with a CPU backend.
 Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
-                                      const Database& database, std::uint32_t agents, ThreadPool& pool);
+                                      const Database& database, std::uint32_t agents, ThreadPool& pool,
+                                      const std::filesystem::path& cache_dir);
+
+// Writes the Vulkan context's pipeline cache to its file in `cache_dir`, so
+// that the next run's kernels compile without a stall; nothing for a CPU
+// backend or an empty `cache_dir`.
+Status save_crowd_pipeline_cache(const CrowdSearch& search, const std::filesystem::path& cache_dir);
 
 }  // namespace mmvk::crowd

@@ -131,13 +131,17 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   }
 
   ThreadPool pool(0);
-  MMVK_ASSIGN_OR_RETURN(CrowdSearch search, make_crowd_search(options.backend, options.device, db, agents, pool));
+  MMVK_ASSIGN_OR_RETURN(CrowdSearch search,
+                        make_crowd_search(options.backend, options.device, db, agents, pool, options.cache_dir));
   if (log) {
     std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, run %.2f m/s)\n",
                  agents, options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps,
                  speeds->run_mps);
     std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
                  search.device.c_str());
+    if (!search.pipeline_cache_note.empty()) {
+      std::fprintf(log, "mmvk crowd: note: %s\n", search.pipeline_cache_note.c_str());
+    }
   }
 
   const float dt = float(1.0 / options.rate_hz);
@@ -264,6 +268,9 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
   s.chosen_frames_hash = chosen.digest();
+  if (Status saved = save_crowd_pipeline_cache(search, options.cache_dir); !saved && log) {
+    std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
+  }
 
   if (options.html) {
 #if defined(MMVK_CROWD_HAS_VIEWER)

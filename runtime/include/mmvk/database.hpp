@@ -86,6 +86,9 @@ class Database {
   std::span<const TagMask> frame_tags() const { return frame_tags_; }
   std::span<const float> frame_multiplier() const { return frame_multiplier_; }
   std::span<const float> frame_bias() const { return frame_bias_; }
+  // [dims]: the largest |value| of each dimension over all rows, so a search
+  // can bound a query's costs before computing them (validate_search).
+  std::span<const float> max_abs_features() const { return max_abs_features_; }
 
   // Mask of the named tags; an unknown name is an error that names it.
   Result<TagMask> tag_mask(std::span<const std::string> names) const;
@@ -110,6 +113,7 @@ class Database {
   std::vector<TagMask> frame_tags_;
   std::vector<float> frame_multiplier_;
   std::vector<float> frame_bias_;
+  std::vector<float> max_abs_features_;
   std::uint64_t content_hash_ = 0;
 };
 

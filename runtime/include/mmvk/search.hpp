@@ -85,7 +85,9 @@ class SearchBackend {
 
 // The checks every backend runs before searching: k in [1, kMaxK], sizes,
 // finite query features, params (continuing frame in range, weights finite
-// and >= 0), an empty database. Errors name the query index and field.
+// and >= 0), an empty database, and costs that could overflow float (a
+// finite query so far from every row, or a weight so large, that its cost
+// bound exceeds FLT_MAX / 2). Errors name the query index and field.
 Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out);
 
 // True when frame `frame` may be a result for `params` (flags, tags and the

@@ -8,16 +8,32 @@
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
+
+#include "mmvk/status.hpp"
 
 namespace mmvk {
 
 class ThreadPool {
  public:
+  // The most threads a pool runs: far above any core count this library is
+  // meant for, low enough that a typo (--threads 100000) is an error rather
+  // than an attempt to start a hundred thousand threads.
+  static constexpr unsigned kMaxThreads = 1024;
+
   // `threads` = total threads working on a parallel_for, the caller's
-  // included; 0 = std::thread::hardware_concurrency().
+  // included; 0 = std::thread::hardware_concurrency(). Errors: threads >
+  // kMaxThreads, or the system refusing to start a thread (the message
+  // names which one and why); no thread is left running.
+  static Result<std::unique_ptr<ThreadPool>> create(unsigned threads = 0);
+
+  // Best effort: clamps `threads` to kMaxThreads and, where the system
+  // refuses a thread, works with the threads it did start (thread_count()
+  // says how many). Use create() to have either case reported.
   explicit ThreadPool(unsigned threads = 0);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
@@ -32,6 +48,8 @@ class ThreadPool {
 
  private:
   void worker_loop(unsigned index);
+
+  std::string start_error_;  // why a worker did not start, or empty
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;

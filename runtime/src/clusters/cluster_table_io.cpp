@@ -57,6 +57,9 @@ class Reader {
   template <class T>
   std::vector<T> get_array(std::size_t count) {
     std::vector<T> values(count);
+    // An empty vector's data() may be null, and memcpy from or to null is
+    // undefined even for zero bytes.
+    if (count == 0) return values;
     std::memcpy(values.data(), bytes_.data() + pos_, count * sizeof(T));
     pos_ += count * sizeof(T);
     return values;
@@ -129,6 +132,7 @@ Result<ClusterTable> load_cluster_table(const std::filesystem::path& path) {
   t.cluster_count = reader.get<std::uint32_t>();
   t.channel_count = reader.get<std::uint32_t>();
   const auto frames = reader.get<std::uint32_t>();
+  if (t.cluster_count == 0) return make_error(where + "cluster_count is 0 (a table needs at least one cluster)");
   // 64-bit arithmetic on 32-bit counts cannot overflow.
   const std::uint64_t k = t.cluster_count;
   const std::uint64_t kd = k * t.dims;

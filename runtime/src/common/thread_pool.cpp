@@ -1,5 +1,7 @@
 #include "mmvk/thread_pool.hpp"
 
+#include <system_error>
+
 namespace mmvk {
 
 namespace {
@@ -9,11 +11,34 @@ std::pair<std::size_t, std::size_t> chunk(std::size_t count, unsigned parts, uns
 }
 }  // namespace
 
+Result<std::unique_ptr<ThreadPool>> ThreadPool::create(unsigned threads) {
+  if (threads > kMaxThreads) {
+    return make_error("thread pool: " + std::to_string(threads) + " threads is more than the maximum of " +
+                      std::to_string(kMaxThreads));
+  }
+  auto pool = std::make_unique<ThreadPool>(threads);
+  if (!pool->start_error_.empty()) return make_error(pool->start_error_);
+  return pool;
+}
+
 ThreadPool::ThreadPool(unsigned threads) {
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min(threads, kMaxThreads);
   workers_.reserve(threads - 1);
   for (unsigned i = 1; i < threads; ++i) {
+#if defined(__cpp_exceptions)
+    // std::thread reports a refused start (EAGAIN: process or memory limits)
+    // only by throwing; the pool turns it into fewer workers and a message.
+    try {
+      workers_.emplace_back([this, i] { worker_loop(i); });
+    } catch (const std::system_error& error) {
+      start_error_ = "thread pool: could not start thread " + std::to_string(i + 1) + " of " +
+                     std::to_string(threads) + ": " + error.what();
+      break;
+    }
+#else
     workers_.emplace_back([this, i] { worker_loop(i); });
+#endif
   }
 }
 

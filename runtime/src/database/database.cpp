@@ -1,5 +1,6 @@
 #include "mmvk/database.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -104,6 +105,11 @@ Database::Database(DatabaseParts parts) : parts_(std::move(parts)) {
       frame_multiplier_[f] = clip.cost_multiplier;
       frame_bias_[f] = clip.cost_bias;
     }
+  }
+  max_abs_features_.assign(dims_, 0.0f);
+  for (std::size_t i = 0; i < parts_.features.size(); ++i) {
+    float& bound = max_abs_features_[i % dims_];
+    bound = std::max(bound, std::fabs(parts_.features[i]));
   }
   detail::Hasher hasher;
   hasher.add(parts_.fps);

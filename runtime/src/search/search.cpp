@@ -1,8 +1,35 @@
 #include "mmvk/search.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mmvk {
+
+namespace {
+
+// An upper bound of |cost| over every frame for one query, in double (which
+// cannot overflow here): multiplier * sum_c w_c * sum_d (|q_d| + max|row_d|)^2
+// + |bias| + |continuing bias|.
+double cost_bound(const Database& database, std::span<const float> query, const QueryParams& params,
+                  double max_multiplier, double max_abs_bias) {
+  const FeatureSchema& schema = database.schema();
+  const std::span<const float> max_abs = database.max_abs_features();
+  double total = 0.0;
+  std::uint32_t d = 0;
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const std::uint32_t end = d + schema.channels[c].dims();
+    double channel = 0.0;
+    for (; d < end; ++d) {
+      const double diff = std::fabs(double(query[d])) + double(max_abs[d]);
+      channel += diff * diff;
+    }
+    total += double(params.channel_weights[c]) * channel;
+  }
+  return max_multiplier * total + max_abs_bias + std::fabs(double(params.continuing_bias));
+}
+
+}  // namespace
 
 Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out) {
   if (database.frame_count() == 0) return make_error("search: the database is empty");
@@ -42,6 +69,26 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
         return make_error(where + "weight of channel '" + database.schema().channels[c].name +
                           "' must be finite and >= 0");
       }
+    }
+  }
+  // Costs are float sums; a query that is finite but far outside the data
+  // (or a huge weight) would turn every cost into +inf and "win" with
+  // garbage. Half of FLT_MAX leaves room for the float rounding of the sums.
+  double max_multiplier = 0.0;
+  double max_abs_bias = 0.0;
+  for (const Clip& clip : database.clips()) {
+    max_multiplier = std::max(max_multiplier, double(clip.cost_multiplier));
+    max_abs_bias = std::max(max_abs_bias, std::fabs(double(clip.cost_bias)));
+  }
+  const double limit = 0.5 * double(std::numeric_limits<float>::max());
+  const QueryParams defaults;
+  for (std::size_t q = 0; q < batch.size; ++q) {
+    const QueryParams& p = batch.params.empty() ? defaults : batch.params[q];
+    const double bound = cost_bound(database, batch.features.subspan(q * dims, dims), p, max_multiplier, max_abs_bias);
+    if (!(bound <= limit)) {
+      return make_error("search: query " + std::to_string(q) +
+                        ": its costs could overflow float (features or weights too large for this database; "
+                        "normalized features are usually within a few hundred)");
     }
   }
   return {};

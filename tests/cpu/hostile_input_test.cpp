@@ -1,0 +1,132 @@
+// Regression tests for hostile inputs and refused resources found by hand and
+// by fuzzing (issue 13): each ends in an error naming what was wrong, never a
+// crash, undefined behaviour or a garbage answer.
+#include <gtest/gtest.h>
+
+#include <sys/resource.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/reference_search.hpp"
+#include "mmvk/thread_pool.hpp"
+#include "support/search_test_data.hpp"
+#include "support/test_data.hpp"
+
+#if defined(__SANITIZE_ADDRESS__)
+#define MMVK_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MMVK_TEST_ASAN 1
+#endif
+#endif
+
+namespace mmvk {
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// ---------------------------------------------------------------------------
+// Thread pool
+
+TEST(HostileThreadPool, TooManyThreadsIsAnError) {
+  Result<std::unique_ptr<ThreadPool>> pool = ThreadPool::create(100000);
+  ASSERT_FALSE(pool.ok());
+  EXPECT_TRUE(contains(pool.message(), "100000")) << pool.message();
+  EXPECT_TRUE(contains(pool.message(), std::to_string(ThreadPool::kMaxThreads))) << pool.message();
+}
+
+TEST(HostileThreadPool, CreateWithinTheLimitWorks) {
+  Result<std::unique_ptr<ThreadPool>> pool = ThreadPool::create(3);
+  ASSERT_TRUE(pool.ok()) << pool.message();
+  EXPECT_EQ((*pool)->thread_count(), 3u);
+}
+
+// A refused thread start (here: an address-space limit too small for one
+// more thread stack) is an error, not an uncaught std::system_error. Runs in
+// a child process so that the limit stays there.
+TEST(HostileThreadPool, RefusedThreadStartIsAnError) {
+#if defined(MMVK_TEST_ASAN)
+  GTEST_SKIP() << "ASan reserves terabytes of address space; an RLIMIT_AS test cannot run under it";
+#else
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        rlimit limit{};
+        getrlimit(RLIMIT_AS, &limit);
+        // Whatever is mapped now plus 4 MiB: less than one default stack.
+        std::FILE* statm = std::fopen("/proc/self/statm", "r");
+        unsigned long pages = 0;
+        if (statm == nullptr || std::fscanf(statm, "%lu", &pages) != 1) std::_Exit(10);
+        std::fclose(statm);
+        limit.rlim_cur = pages * 4096ul + (4ul << 20);
+        if (setrlimit(RLIMIT_AS, &limit) != 0) std::_Exit(11);
+        Result<std::unique_ptr<ThreadPool>> pool = ThreadPool::create(64);
+        if (pool.ok()) std::_Exit(12);
+        std::fprintf(stderr, "%s\n", pool.message().c_str());
+        std::_Exit(3);
+      },
+      ::testing::ExitedWithCode(3), "could not start thread");
+#endif
+}
+
+// ---------------------------------------------------------------------------
+// Cluster tables
+
+TEST(HostileClusterTable, ZeroClustersIsAnError) {
+  ClusterTable table;
+  table.dims = 4;
+  table.channel_count = 1;
+  table.cluster_count = 0;
+  table.offsets = {0};
+  const std::filesystem::path path = test::make_temp_dir() / "empty.mmkc";
+  ASSERT_TRUE(save_cluster_table(table, path).ok());
+  Result<ClusterTable> loaded = load_cluster_table(path);
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_TRUE(contains(loaded.message(), "cluster_count is 0")) << loaded.message();
+  EXPECT_TRUE(contains(loaded.message(), path.string())) << loaded.message();
+}
+
+// ---------------------------------------------------------------------------
+// Search
+
+TEST(HostileSearch, QueriesWhoseCostsOverflowAreRejected) {
+  const Database db = test::synthetic_database({.frames = 200, .clips = 2});
+  std::vector<float> queries = test::synthetic_queries(db, 3, 5);
+  queries[db.dims() + 2] = 1e30f;  // query 1 only
+  ReferenceSearch search(db);
+  std::vector<Match> out(3);
+  const Status status = search.search(QueryBatch{queries, {}, 3}, 1, out);
+  ASSERT_FALSE(status.ok());
+  EXPECT_TRUE(contains(status.message(), "query 1")) << status.message();
+  EXPECT_TRUE(contains(status.message(), "overflow")) << status.message();
+}
+
+TEST(HostileSearch, HugeWeightsThatOverflowAreRejected) {
+  const Database db = test::synthetic_database({.frames = 200, .clips = 2});
+  const std::vector<float> queries = test::synthetic_queries(db, 2, 5);
+  std::vector<QueryParams> params(2);
+  params[1].channel_weights[0] = 3e38f;
+  ReferenceSearch search(db);
+  std::vector<Match> out(2);
+  const Status status = search.search(QueryBatch{queries, params, 2}, 1, out);
+  ASSERT_FALSE(status.ok());
+  EXPECT_TRUE(contains(status.message(), "query 1")) << status.message();
+}
+
+TEST(HostileSearch, LargeButSafeQueriesStillSearch) {
+  const Database db = test::synthetic_database({.frames = 200, .clips = 2});
+  std::vector<float> queries = test::synthetic_queries(db, 1, 5);
+  queries[0] = 1e6f;
+  ReferenceSearch search(db);
+  std::vector<Match> out(1);
+  ASSERT_TRUE(search.search(QueryBatch{queries, {}, 1}, 1, out).ok());
+  EXPECT_NE(out[0].frame, kNoFrame);
+  EXPECT_TRUE(std::isfinite(out[0].cost));
+}
+
+}  // namespace
+}  // namespace mmvk

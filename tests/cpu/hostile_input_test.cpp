@@ -10,7 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "mmvk/bvh.hpp"
 #include "mmvk/cluster_table.hpp"
+#include "mmvk/feature_schema.hpp"
+#include "mmvk/manifest.hpp"
+#include "mmvk/motion.hpp"
 #include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "support/search_test_data.hpp"
@@ -126,6 +130,53 @@ TEST(HostileSearch, LargeButSafeQueriesStillSearch) {
   ASSERT_TRUE(search.search(QueryBatch{queries, {}, 1}, 1, out).ok());
   EXPECT_NE(out[0].frame, kNoFrame);
   EXPECT_TRUE(std::isfinite(out[0].cost));
+}
+
+// ---------------------------------------------------------------------------
+// JSON and frame rates
+
+TEST(HostileJson, DuplicateManifestKeysAreRejected) {
+  const Result<Manifest> manifest =
+      parse_manifest_json(R"({"fps": 30, "clips": [{"file": "a.bvh", "loop": true, "loop": false}]})", "m.json", ".");
+  ASSERT_FALSE(manifest.ok());
+  EXPECT_TRUE(contains(manifest.message(), "m.json")) << manifest.message();
+  EXPECT_TRUE(contains(manifest.message(), "duplicate key \"loop\"")) << manifest.message();
+  const Result<Manifest> top = parse_manifest_json(R"({"fps": 30, "fps": 60, "clips": []})", "m.json", ".");
+  ASSERT_FALSE(top.ok());
+  EXPECT_TRUE(contains(top.message(), "duplicate key \"fps\"")) << top.message();
+}
+
+TEST(HostileJson, DuplicateSchemaKeysAreRejected) {
+  const Result<FeatureSchema> schema = parse_schema_json(
+      R"({"channels": [{"name": "a", "name": "b", "kind": "bone_position", "bone": "Hips"}]})", "s.json");
+  ASSERT_FALSE(schema.ok());
+  EXPECT_TRUE(contains(schema.message(), "s.json: duplicate key \"name\"")) << schema.message();
+}
+
+TEST(HostileJson, EqualKeysInDifferentObjectsAreFine) {
+  const Result<Manifest> manifest = parse_manifest_json(
+      R"({"clips": [{"file": "a.bvh", "loop": true}, {"file": "b.bvh", "loop": false}]})", "m.json", ".");
+  EXPECT_TRUE(manifest.ok()) << manifest.message();
+}
+
+TEST(HostileFrameRate, TinyManifestFpsIsABadFrameRate) {
+  const Result<Manifest> manifest = parse_manifest_json(R"({"fps": 1e-9, "clips": []})", "m.json", ".");
+  ASSERT_FALSE(manifest.ok());
+  EXPECT_TRUE(contains(manifest.message(), "fps: 1e-09 is outside the supported")) << manifest.message();
+}
+
+TEST(HostileFrameRate, TinyFrameTimeIsABadFrameRate) {
+  for (const char* frame_time : {"1e-30", "1e-9", "1000"}) {
+    const std::string text = std::string("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n"
+                                         " End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 2\nFrame Time: ") +
+                             frame_time + "\n0 0 0\n0 0 1\n";
+    const Result<BvhFile> file = parse_bvh(text, "t.bvh");
+    ASSERT_TRUE(file.ok()) << file.message();
+    const Result<Motion> motion = motion_from_bvh(*file, ImportOptions{});
+    ASSERT_FALSE(motion.ok()) << frame_time;
+    EXPECT_TRUE(contains(motion.message(), "t.bvh: Frame Time")) << motion.message();
+    EXPECT_TRUE(contains(motion.message(), "frames/s, outside the supported")) << motion.message();
+  }
 }
 
 }  // namespace

@@ -41,6 +41,12 @@ struct Motion {
   std::size_t index(std::uint32_t frame, std::size_t joint) const { return frame * joint_count() + joint; }
 };
 
+// Frame rates mmvk accepts, from a BVH's Frame Time, a manifest's fps or
+// --fps: outside them a value is a typo or a corrupt file (a Frame Time of
+// 1e-30 would otherwise surface later as a baffling normalization error).
+inline constexpr float kMinFps = 1.0f;
+inline constexpr float kMaxFps = 10000.0f;
+
 enum class UpAxis : std::uint8_t { Y, Z };
 
 struct ImportOptions {

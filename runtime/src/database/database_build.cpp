@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <optional>
 
@@ -35,6 +36,33 @@ void flag_ranges(std::span<const TimeRange> ranges, float fps, std::uint32_t fla
   }
 }
 
+// The plausibility rule of database_build.hpp, on one clip's raw features.
+Status check_plausible(const RawFeatures& raw, const FeatureSchema& schema, float fps, const std::string& source) {
+  std::uint32_t first = 0;
+  for (const FeatureChannel& channel : schema.channels) {
+    const std::uint32_t dims = channel.dims();
+    const bool speed = channel.kind == ChannelKind::BoneVelocity || channel.kind == ChannelKind::RootVelocity;
+    const bool position = channel.kind == ChannelKind::BonePosition || channel.kind == ChannelKind::TrajectoryPosition;
+    if (speed || position) {
+      const float limit = speed ? kMaxPlausibleSpeed : kMaxPlausiblePosition;
+      for (std::uint32_t f = 0; f < raw.frame_count; ++f) {
+        for (std::uint32_t d = first; d < first + dims; ++d) {
+          const float value = raw.values[std::size_t{f} * raw.dims + d];
+          if (std::abs(value) <= limit) continue;
+          char text[320];
+          std::snprintf(text, sizeof(text), "frame %u (%.3f s), channel '%s': %s %g %s is beyond the limit of %g %s", f,
+                        double(f) / fps, channel.name.c_str(), speed ? "speed" : "position", double(value),
+                        speed ? "m/s" : "m", double(limit), speed ? "m/s" : "m");
+          return make_error(source + ": " + text +
+                            " (physically impossible motion: a corrupt value or wrong units in the file?)");
+        }
+      }
+    }
+    first += dims;
+  }
+  return {};
+}
+
 Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& motion,
                                      std::span<const std::vector<float>> custom, bool mirrored,
                                      const MotionBuildSettings& settings) {
@@ -48,6 +76,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   options.custom = custom;
   Result<RawFeatures> raw = extract_features(motion, *root, settings.schema, options);
   if (!raw.ok()) return raw.error();
+  MMVK_TRY(check_plausible(*raw, settings.schema, motion.fps, source + ": clip '" + meta.name + "'"));
 
   ProcessedClip out;
   out.clip.name = mirrored ? meta.name + "_mirrored" : meta.name;
@@ -132,6 +161,12 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
   if (!normalization.ok()) return make_error(source + ": " + normalization.message());
   parts.normalization = std::move(*normalization);
   apply_normalization(parts.normalization, parts.features);
+  const std::uint32_t never = kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition;
+  if (std::all_of(parts.frame_flags.begin(), parts.frame_flags.end(), [&](std::uint32_t f) { return (f & never) != 0; })) {
+    return make_error(source + ": no frame of the " + std::to_string(frames) +
+                      " can be jumped to (every one is do-not-use, block-transition or edge-excluded); "
+                      "check the clips' time ranges, or their length against the longest trajectory offset");
+  }
   Result<Database> database = Database::create(std::move(parts));
   if (!database.ok()) return make_error(source + ": " + database.message());
   return database;
@@ -199,6 +234,14 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     if (!valid.ok()) return make_error(source + ": " + valid.message());
   }
   if (manifest.clips.empty()) return make_error(source + ": no clips");
+  // 0 keeps the source rate; anything else is a resampling target (the
+  // manifest parser checks this too, but --fps overrides it afterwards).
+  if (manifest.fps != 0.0f && !(manifest.fps >= kMinFps && manifest.fps <= kMaxFps)) {
+    char text[160];
+    std::snprintf(text, sizeof(text), ": fps %g is outside the supported [%g, %g] frames/s", double(manifest.fps),
+                  double(kMinFps), double(kMaxFps));
+    return make_error(source + text);
+  }
   const std::size_t count = manifest.clips.size();
   std::vector<LoadedClip> loaded(count);
   std::atomic<std::size_t> next{0};

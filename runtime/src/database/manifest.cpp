@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <system_error>
 
 #include <nlohmann/json.hpp>
 
+#include "common/json_parse.hpp"
 #include "mmvk/file_io.hpp"
 
 namespace mmvk {
@@ -126,8 +128,9 @@ bool is_bvh(const std::filesystem::path& path) {
 Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_view source,
                                      const std::filesystem::path& base_dir) {
   const std::string name(source.empty() ? std::string_view("manifest") : source);
-  const Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-  if (root.is_discarded()) return make_error(name + ": not valid JSON");
+  Result<Json> parsed = detail::parse_json_text(json_text, name);
+  if (!parsed.ok()) return parsed.error();
+  const Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"clips\"");
   MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "clips"}));
 
@@ -151,7 +154,12 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   }
   if (root.contains("fps")) {
     MMVK_READ(manifest.fps, read_number(root["fps"], at + "fps"));
-    if (!(manifest.fps > 0.0f) || manifest.fps > 10000.0f) return make_error(at + "fps: must be in (0, 10000]");
+    if (!(manifest.fps >= kMinFps && manifest.fps <= kMaxFps)) {
+      char text[120];
+      std::snprintf(text, sizeof(text), "fps: %g is outside the supported [%g, %g] frames/s", double(manifest.fps),
+                    double(kMinFps), double(kMaxFps));
+      return make_error(at + text);
+    }
   }
   if (root.contains("import")) {
     const Json& import = root["import"];

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/json_parse.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/normalization.hpp"
@@ -95,8 +96,9 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
 
 Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source) {
   const std::string name(source.empty() ? std::string_view("schema") : source);
-  Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-  if (root.is_discarded()) return make_error(name + ": not valid JSON");
+  Result<Json> parsed = detail::parse_json_text(json_text, name);
+  if (!parsed.ok()) return parsed.error();
+  Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"channels\"");
   for (const auto& item : root.items()) {
     if (item.key() != "channels") return make_error(name + ": " + item.key() + ": unknown field");

@@ -2,6 +2,7 @@
 // rotations (unit quaternions), in mmvk's Y-up frame.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,12 @@ Status validate_bvh(const BvhFile& file) {
   if (file.joints.empty()) return make_error(where + ": no joints");
   if (!(file.frame_time > 0.0) || !std::isfinite(file.frame_time)) {
     return make_error(where + ": frame time must be positive, got " + std::to_string(file.frame_time));
+  }
+  if (const double fps = 1.0 / file.frame_time; !(fps >= kMinFps && fps <= kMaxFps)) {
+    char text[200];
+    std::snprintf(text, sizeof(text), ": Frame Time %g s is %g frames/s, outside the supported [%g, %g]",
+                  file.frame_time, fps, double(kMinFps), double(kMaxFps));
+    return make_error(where + text);
   }
   if (file.frame_count < 0 || file.channel_count < 0) return make_error(where + ": negative frame or channel count");
   int next_channel = 0;

@@ -1,0 +1,30 @@
+#include "common/json_parse.hpp"
+
+#include <set>
+#include <vector>
+
+namespace mmvk::detail {
+
+Result<nlohmann::json> parse_json_text(std::string_view text, const std::string& source) {
+  using Json = nlohmann::json;
+  // The keys seen so far in each object being parsed, innermost last.
+  std::vector<std::set<std::string>> open_objects;
+  std::string duplicate;
+  const Json::parser_callback_t track = [&](int, Json::parse_event_t event, Json& parsed) {
+    if (event == Json::parse_event_t::object_start) {
+      open_objects.emplace_back();
+    } else if (event == Json::parse_event_t::object_end) {
+      if (!open_objects.empty()) open_objects.pop_back();
+    } else if (event == Json::parse_event_t::key && !open_objects.empty() && parsed.is_string()) {
+      const std::string& key = parsed.get_ref<const std::string&>();
+      if (!open_objects.back().insert(key).second && duplicate.empty()) duplicate = key;
+    }
+    return true;
+  };
+  Json root = Json::parse(text, track, /*allow_exceptions=*/false);
+  if (root.is_discarded()) return make_error(source + ": not valid JSON");
+  if (!duplicate.empty()) return make_error(source + ": duplicate key \"" + duplicate + "\"");
+  return root;
+}
+
+}  // namespace mmvk::detail

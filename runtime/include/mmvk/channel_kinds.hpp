@@ -58,6 +58,14 @@ struct ChannelExtraction;  // runtime/src/features/channel_extraction.hpp
 // Fills one channel's dims for every frame of a clip.
 using ChannelExtractor = void (*)(const detail::ChannelExtraction& job);
 
+// The largest |value| a real capture can give a kind measured in metres (in
+// character space) or metres per second: far beyond any human motion
+// (sprinting is ~10 m/s, a hand's swing ~30 m/s) and its capture noise. A
+// database build rejects a clip beyond them (database_build.hpp), since one
+// corrupt value would set its channel's normalization scale.
+inline constexpr float kMaxPlausiblePosition = 1000.0f;  // metres
+inline constexpr float kMaxPlausibleSpeed = 1000.0f;     // metres per second
+
 struct ChannelKindInfo {
   ChannelKind kind;
   std::string_view name;          // the JSON name, e.g. "trajectory_position"
@@ -67,6 +75,8 @@ struct ChannelKindInfo {
   ChannelField fields;            // the FeatureChannel fields the kind reads
   std::string_view default_bone;  // used when `bone` is empty; empty = `bone` is required
   MirrorRule mirror;
+  float plausible_limit = 0.0f;   // largest plausible |value| (above), 0 = unchecked
+  std::string_view limit_unit;    // the limit's unit for messages: "m", "m/s"
   ChannelExtractor extract;       // library-internal
 };
 

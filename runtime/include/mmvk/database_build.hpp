@@ -22,11 +22,11 @@
 //   - Skeletons may differ between clips as long as the schema's bones
 //     resolve on each (find_bone).
 //   - Physically impossible motion is an error naming the clip, frame and
-//     channel: a bone or trajectory position feature beyond
-//     kMaxPlausiblePosition metres from the character, or a bone or root
-//     velocity feature beyond kMaxPlausibleSpeed m/s. One corrupt value (a
-//     1e30 in a BVH) would otherwise set its channel's normalization scale
-//     and flatten that channel for every other frame.
+//     channel: a feature beyond its kind's plausible_limit (channel_kinds.hpp:
+//     positions kMaxPlausiblePosition metres from the character, velocities
+//     kMaxPlausibleSpeed m/s). One corrupt value (a 1e30 in a BVH) would
+//     otherwise set its channel's normalization scale and flatten that
+//     channel for every other frame.
 //   - A database in which no frame can ever be a result (every frame
 //     do-not-use or edge-excluded) is an error.
 #pragma once
@@ -45,11 +45,6 @@
 #include "mmvk/thread_pool.hpp"
 
 namespace mmvk {
-
-// Limits of the plausibility check above: far beyond any human motion
-// (sprinting is ~10 m/s, a hand's swing ~30 m/s) and its capture noise.
-inline constexpr float kMaxPlausiblePosition = 1000.0f;  // metres, in character space
-inline constexpr float kMaxPlausibleSpeed = 1000.0f;     // metres per second
 
 struct BuildProgress {
   std::size_t clips_done = 0;     // manifest clips loaded so far

@@ -41,21 +41,17 @@ Status check_plausible(const RawFeatures& raw, const FeatureSchema& schema, floa
   std::uint32_t first = 0;
   for (const FeatureChannel& channel : schema.channels) {
     const std::uint32_t dims = channel.dims();
-    const bool speed = channel.kind == ChannelKind::BoneVelocity || channel.kind == ChannelKind::RootVelocity;
-    const bool position = channel.kind == ChannelKind::BonePosition || channel.kind == ChannelKind::TrajectoryPosition;
-    if (speed || position) {
-      const float limit = speed ? kMaxPlausibleSpeed : kMaxPlausiblePosition;
-      for (std::uint32_t f = 0; f < raw.frame_count; ++f) {
-        for (std::uint32_t d = first; d < first + dims; ++d) {
-          const float value = raw.values[std::size_t{f} * raw.dims + d];
-          if (std::abs(value) <= limit) continue;
-          char text[320];
-          std::snprintf(text, sizeof(text), "frame %u (%.3f s), channel '%s': %s %g %s is beyond the limit of %g %s", f,
-                        double(f) / fps, channel.name.c_str(), speed ? "speed" : "position", double(value),
-                        speed ? "m/s" : "m", double(limit), speed ? "m/s" : "m");
-          return make_error(source + ": " + text +
-                            " (physically impossible motion: a corrupt value or wrong units in the file?)");
-        }
+    const ChannelKindInfo& kind = channel_kind_info(channel.kind);
+    for (std::uint32_t f = 0; kind.plausible_limit > 0.0f && f < raw.frame_count; ++f) {
+      for (std::uint32_t d = first; d < first + dims; ++d) {
+        const float value = raw.values[std::size_t{f} * raw.dims + d];
+        if (std::abs(value) <= kind.plausible_limit) continue;
+        char text[320];
+        std::snprintf(text, sizeof(text), "frame %u (%.3f s), channel '%s': %g %s is beyond the limit of %g %s", f,
+                      double(f) / fps, channel.name.c_str(), double(value), kind.limit_unit.data(),
+                      double(kind.plausible_limit), kind.limit_unit.data());
+        return make_error(source + ": " + text +
+                          " (physically impossible motion: a corrupt value or wrong units in the file?)");
       }
     }
     first += dims;

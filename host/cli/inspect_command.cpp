@@ -23,6 +23,24 @@ constexpr const char* kInspectUsage =
     "(unnormalized) mean, std, min and max.\n"
     "  --json   the same as one JSON object on stdout\n";
 
+// Names come from files anyone can write: control characters (an escape
+// sequence in a clip name) are shown as \xHH instead of reaching the terminal.
+std::string printable(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\x%02x", byte);
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 std::string tag_list(const Database& db, TagMask mask) {
   std::string out;
   for (std::size_t t = 0; t < db.tag_names().size(); ++t) {
@@ -123,11 +141,13 @@ int run_inspect(Args args) {
                               {"cost_multiplier", clip.cost_multiplier}, {"cost_bias", clip.cost_bias},
                               {"tags", tag_list(db, clip.tags)}});
     }
-    std::printf("%s\n", out.dump(2).c_str());
+    // JSON escapes control characters itself; invalid UTF-8 in a name is
+    // replaced (U+FFFD) rather than thrown as an exception.
+    std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return 0;
   }
 
-  std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n", path.c_str(),
+  std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n", printable(path).c_str(),
               thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()), db.clips().size(), mirrored,
               looping, db.dims(), double(db.fps()));
   std::printf("content hash: %016" PRIx64 "\n", db.content_hash());
@@ -137,7 +157,7 @@ int run_inspect(Args args) {
               thousands(candidates).c_str());
   std::printf("tags (%zu):", tag_frames.size());
   for (std::size_t t = 0; t < tag_frames.size(); ++t) {
-    std::printf(" %s (%s frames)%s", db.tag_names()[t].c_str(), thousands(tag_frames[t]).c_str(),
+    std::printf(" %s (%s frames)%s", printable(db.tag_names()[t]).c_str(), thousands(tag_frames[t]).c_str(),
                 t + 1 < tag_frames.size() ? "," : "");
   }
   std::printf("%s\n", tag_frames.empty() ? " none" : "");
@@ -150,11 +170,11 @@ int run_inspect(Args args) {
       detail = "offsets (s):";
       for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);
     }
-    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", channel.name.c_str(), channel_kind_name(channel.kind).data(),
-                normalization_name(channel.normalization).data(), double(channel.weight), detail.c_str());
+    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", printable(channel.name).c_str(), channel_kind_name(channel.kind).data(),
+                normalization_name(channel.normalization).data(), double(channel.weight), printable(detail).c_str());
     std::printf("    %-32s %10s %10s %10s %10s %10s %10s\n", "dimension", "offset", "scale", "mean", "std", "min", "max");
     for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
-      std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", schema.dim_name(d).c_str(),
+      std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", printable(schema.dim_name(d)).c_str(),
                   double(db.normalization()[d].offset), double(db.normalization()[d].scale), raw[d].mean, raw[d].std,
                   raw[d].min, raw[d].max);
     }
@@ -164,9 +184,9 @@ int run_inspect(Args args) {
               "mult", "bias", "tags");
   for (std::size_t c = 0; c < db.clips().size(); ++c) {
     const Clip& clip = db.clips()[c];
-    std::printf("  %5zu  %-40s %8u %8u  %-5s %-8s %6g %6g  %s\n", c, clip.name.c_str(), clip.first_frame,
+    std::printf("  %5zu  %-40s %8u %8u  %-5s %-8s %6g %6g  %s\n", c, printable(clip.name).c_str(), clip.first_frame,
                 clip.frame_count, clip.loop ? "yes" : "no", clip.mirrored ? "yes" : "no", double(clip.cost_multiplier),
-                double(clip.cost_bias), tag_list(db, clip.tags).c_str());
+                double(clip.cost_bias), printable(tag_list(db, clip.tags)).c_str());
   }
   return 0;
 }

@@ -1,5 +1,7 @@
 // mmvk: build, inspect, export and query motion matching databases.
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <string_view>
 #include <vector>
 
@@ -20,22 +22,42 @@ constexpr const char* kUsage =
     "\n"
     "Run `mmvk <command> --help` for a command's options.\n";
 
+int dispatch(std::string_view command, mmvk::cli::Args rest, const char* program) {
+  if (command == "build") return mmvk::cli::run_build(rest);
+  if (command == "inspect") return mmvk::cli::run_inspect(rest);
+  if (command == "export") return mmvk::cli::run_export(rest);
+  if (command == "query") return mmvk::cli::run_query(rest);
+  if (command == "crowd") return mmvk::cli::run_crowd(rest, program);
+  if (command == "clusters") return mmvk::cli::run_clusters(rest);
+  std::fprintf(stderr, "mmvk: unknown command '%.*s'\n\n%s", int(command.size()), command.data(), kUsage);
+  return 2;
+}
+
+// Results on stdout are what the user asked for: a full disk (> /dev/full)
+// or any other failed write must not end with exit 0. The commands print
+// through stdio, so one check of the stream's error flag and its final
+// flush covers every printf and fputs before it.
+int check_stdout(std::string_view command, int exit_code) {
+  errno = 0;
+  const bool failed = std::ferror(stdout) != 0;
+  if (std::fclose(stdout) == 0 && !failed) return exit_code;
+  std::fprintf(stderr, "mmvk %.*s: writing to standard output failed%s%s\n", int(command.size()), command.data(),
+               errno != 0 ? ": " : "", errno != 0 ? std::strerror(errno) : "");
+  return exit_code != 0 ? exit_code : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string_view> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-    std::fputs(kUsage, args.empty() ? stderr : stdout);
-    return args.empty() ? 2 : 0;
+    if (args.empty()) {
+      std::fputs(kUsage, stderr);
+      return 2;
+    }
+    std::fputs(kUsage, stdout);
+    return check_stdout("help", 0);
   }
   const std::string_view command = args[0];
-  const mmvk::cli::Args rest(args.data() + 1, args.size() - 1);
-  if (command == "build") return mmvk::cli::run_build(rest);
-  if (command == "inspect") return mmvk::cli::run_inspect(rest);
-  if (command == "export") return mmvk::cli::run_export(rest);
-  if (command == "query") return mmvk::cli::run_query(rest);
-  if (command == "crowd") return mmvk::cli::run_crowd(rest, argv[0]);
-  if (command == "clusters") return mmvk::cli::run_clusters(rest);
-  std::fprintf(stderr, "mmvk: unknown command '%.*s'\n\n%s", int(command.size()), command.data(), kUsage);
-  return 2;
+  return check_stdout(command, dispatch(command, mmvk::cli::Args(args.data() + 1, args.size() - 1), argv[0]));
 }

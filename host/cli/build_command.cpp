@@ -1,12 +1,14 @@
 // mmvk build: manifest (or folder of BVH) -> .mmdb database file.
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/thread_pool.hpp"
 
@@ -27,7 +29,7 @@ constexpr const char* kBuildUsage =
     "  --schema FILE          feature schema JSON (overrides the manifest's)\n"
     "  --mirror               also add a mirrored copy of every clip\n"
     "  --edge-rule RULE       exclude | clamp (overrides the manifest's)\n"
-    "  --threads N            threads loading clips (default 0: all cores)\n"
+    "  --threads N            threads loading clips (default 0: all cores; at most 1024)\n"
     "  --no-animation         store features only (no skeleton, poses, root motion or contacts)\n"
     "  --quantize-rotations   store joint rotations as 16-bit integers (8 instead of 16 bytes per joint)\n"
     "  --progress             show the progress bar even when stderr is not a terminal\n"
@@ -63,7 +65,10 @@ int run_build(Args args) {
     std::fputs(kBuildUsage, stderr);
     return 2;
   }
-  Result<Manifest> manifest = load_manifest_or_directory(parsed->positional[0]);
+  // Before anything else: a build can take minutes, and its result would be
+  // lost to a typo in the output path.
+  if (Status writable = check_writable(*output); !writable) return report_error("build", writable.message(), 1);
+    Result<Manifest> manifest = load_manifest_or_directory(parsed->positional[0]);
   if (!manifest.ok()) {
     std::fprintf(stderr, "mmvk build: %s\n", manifest.message().c_str());
     return 1;
@@ -96,14 +101,15 @@ int run_build(Args args) {
   }
   unsigned threads = 0;
   if (auto text = parsed->value("--threads")) {
-    const Result<std::uint32_t> value = parse_u32("--threads", *text);
+    const Result<std::uint32_t> value = parse_u32("--threads", *text, 0, ThreadPool::kMaxThreads);
     if (!value) return report_error("build", value.message(), 2);
     threads = *value;
   }
 
-  ThreadPool pool(threads);
+  Result<std::unique_ptr<ThreadPool>> pool = ThreadPool::create(threads);
+  if (!pool) return report_error("build", pool.message(), 1);
   BuildOptions options;
-  options.pool = &pool;
+  options.pool = pool->get();
   options.animation.enabled = !parsed->has("--no-animation");
   options.animation.warning = [](const std::string& message) {
     std::fprintf(stderr, "mmvk build: warning: %s\n", message.c_str());

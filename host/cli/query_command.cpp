@@ -45,7 +45,7 @@ constexpr const char* kQueryUsageOptions =
     "  The cluster backends load --clusters table.mmkc (from `mmvk clusters`) when\n"
     "  given, else train the tables with the default k-means parameters. --nprobe N: clusters searched\n"
     "  per query by the *-nprobe backends (default 4).\n"
-    "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores.\n"
+    "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores, at most 1024.\n"
     "\n"
     "query options (applied to every query):\n"
     "  --continuing F, --continuing-bias X, --exclusion-window N,\n"
@@ -79,11 +79,10 @@ struct ContextHolder {};
 
 // Everything a backend borrows, declared before it so that it outlives it.
 struct BackendHolder {
-  ThreadPool pool;
+  std::unique_ptr<ThreadPool> pool;
   std::optional<ClusterTable> table;
   ContextHolder context;  // created when a Vulkan backend is made
   std::unique_ptr<SearchBackend> backend;
-  explicit BackendHolder(unsigned threads) : pool(threads) {}
 };
 
 #if defined(MMVK_HAS_VULKAN)
@@ -137,7 +136,7 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
   const BackendRegistry registry = query_backends(holder.context);
   BackendSpec spec;
   spec.name = name;
-  spec.pool = &holder.pool;
+  spec.pool = holder.pool.get();
   spec.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
   spec.max_k = k;
   // One search per run: warming up every kernel variant would compile (on
@@ -147,6 +146,14 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
     MMVK_ASSIGN_OR_RETURN(spec.nprobe, parse_u32("--nprobe", *text, 1));
   }
   const BackendEntry* entry = registry.find(name);
+  // An option the chosen backend would ignore is a mistake worth naming
+  // (the user believes a table or a probe count is in effect).
+  if (entry != nullptr && !entry->uses_cluster_table && args.value("--clusters")) {
+    return make_error("--clusters: backend '" + name + "' uses no cluster table");
+  }
+  if (entry != nullptr && !entry->uses_nprobe && args.value("--nprobe")) {
+    return make_error("--nprobe: backend '" + name + "' searches no subset of clusters (the *-nprobe backends do)");
+  }
   if (entry != nullptr && entry->uses_cluster_table) {
     if (const auto path = args.value("--clusters")) {
       MMVK_ASSIGN_OR_RETURN(holder.table, load_cluster_table(*path));
@@ -236,9 +243,12 @@ int run_query(Args args) {
   }
   std::uint32_t threads = 0;
   if (const auto text = parsed->value("--threads")) {
-    const Result<std::uint32_t> value = parse_u32("--threads", *text);
+    const Result<std::uint32_t> value = parse_u32("--threads", *text, 0, ThreadPool::kMaxThreads);
     if (!value) return report_error("query", value.message(), 2);
     threads = *value;
+  }
+  if (const auto out = parsed->value("--out")) {
+    if (Status writable = check_writable(*out); !writable) return fail(writable.message());
   }
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db) return fail(db.message());
@@ -256,7 +266,23 @@ int run_query(Args args) {
   if (!params) return fail(params.message());
   const std::vector<QueryParams> all_params(count, *params);
 
-  BackendHolder holder(threads);
+  // --explain's frames are checked before any work, so that a typo does not
+  // fail after the results are printed.
+  std::vector<std::uint32_t> explain_frames;
+  if (parsed->has("--explain")) {
+    const auto list = parsed->value("--frames") ? parsed->value("--frames") : parsed->value("--frame");
+    for (const std::string& item : list ? split_list(*list) : std::vector<std::string>{}) {
+      const Result<std::uint32_t> frame = parse_u32("--frames", item, 0, db->frame_count() - 1);
+      if (!frame) return report_error("query", frame.message() + " (the database has " +
+                                                   std::to_string(db->frame_count()) + " frames)", 2);
+      explain_frames.push_back(*frame);
+    }
+  }
+
+  BackendHolder holder;
+  Result<std::unique_ptr<ThreadPool>> pool = ThreadPool::create(threads);
+  if (!pool) return fail(pool.message());
+  holder.pool = std::move(pool.value());
   const std::string backend_name = parsed->value("--backend").value_or(BackendSpec{}.name);
   const Status made = make_backend(holder, *db, backend_name, *parsed, count, k);
   if (!made) return fail(made.message());
@@ -284,17 +310,8 @@ int run_query(Args args) {
   }
 
   if (parsed->has("--explain")) {
-    std::vector<std::uint32_t> frames;
-    const auto list = parsed->value("--frames") ? parsed->value("--frames") : parsed->value("--frame");
-    if (list) {
-      for (const std::string& item : split_list(*list)) {
-        const Result<std::uint32_t> frame = parse_u32("--frames", item);
-        if (!frame) return report_error("query", frame.message(), 2);
-        frames.push_back(*frame);
-      }
-    }
     Result<Explanation> explanation = explain_query(*db, std::span<const float>(*features).first(db->dims()),
-                                                    all_params[0], frames, k);
+                                                    all_params[0], explain_frames, k);
     if (!explanation) return fail(explanation.message());
     std::fputs(("explain, query 0:\n" + format_explanation(*db, *explanation)).c_str(), stderr);
   }

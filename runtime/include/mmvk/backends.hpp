@@ -68,6 +68,9 @@ struct BackendEntry {
   // Needs a ClusterTable (BackendSpec::clusters, or one trained from
   // BackendSpec::kmeans), so a caller knows whether to load one.
   bool uses_cluster_table = false;
+  // Reads BackendSpec::nprobe, so a host can refuse an --nprobe that would
+  // otherwise be ignored without a word.
+  bool uses_nprobe = false;
 };
 
 class BackendRegistry {

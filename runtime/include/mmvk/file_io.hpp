@@ -19,6 +19,11 @@ namespace mmvk {
 
 Result<std::string> read_file(const std::filesystem::path& path);
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+// Checks up front that write_file_atomically(path, ...) can succeed as far as
+// the path goes: path is not a directory, its folder exists and is
+// writable. Hosts call it before long work (a database build) whose result
+// would otherwise be lost at the end. Errors name the path or folder.
+Status check_writable(const std::filesystem::path& path);
 
 // The float32 codec every mmvk file uses, independent of the host's byte
 // order. decode: precondition bytes.size() >= 4 * values.size().

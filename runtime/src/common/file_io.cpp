@@ -18,12 +18,27 @@ std::string describe_errno(const std::filesystem::path& path, const char* what) 
 }  // namespace
 
 Result<std::string> read_file(const std::filesystem::path& path) {
+  // An ifstream opens a directory and reads it as empty, which every loader
+  // would then report as an empty or truncated file.
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) return make_error(path.string() + ": is a directory, expected a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) return make_error(path.string() + ": cannot open for reading");
   std::ostringstream contents;
   contents << in.rdbuf();
   if (in.bad()) return make_error(path.string() + ": read error");
   return contents.str();
+}
+
+Status check_writable(const std::filesystem::path& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) return make_error(path.string() + ": is a directory, expected a file");
+  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(folder, error)) {
+    return make_error(path.string() + ": cannot write there: folder " + folder.string() + " does not exist");
+  }
+  if (::access(folder.c_str(), W_OK) != 0) return make_error(describe_errno(folder, "cannot write in this folder"));
+  return {};
 }
 
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {

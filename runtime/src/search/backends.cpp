@@ -105,7 +105,7 @@ BackendRegistry cpu_backends() {
                       [](const BackendSpec& spec, const Database& database) {
                         return make_clusters(spec, database, true);
                       },
-                      true});
+                      true, true});
   return registry;
 }
 

@@ -41,7 +41,7 @@ Status add_backends(BackendRegistry& registry, ContextSource context, const Vulk
   MMVK_TRY(registry.add({"vulkan-clusters", "GPU, exact, rows pruned by k-means cluster bounds",
                          factory(context, base, SearchMode::ClustersExact), true}));
   MMVK_TRY(registry.add({"vulkan-nprobe", "GPU, approximate: the nprobe clusters with the nearest centroids",
-                         factory(context, base, SearchMode::NProbe), true}));
+                         factory(context, base, SearchMode::NProbe), true, true}));
   return {};
 }
 

@@ -3,6 +3,7 @@
 // reuse them instead of training (seconds at 400k frames) on every run.
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "cli_args.hpp"
@@ -68,17 +69,19 @@ int run_clusters(Args args) {
   }
   KMeansParams params;
   unsigned threads = 0;
+  constexpr std::uint32_t kAny = std::numeric_limits<std::uint32_t>::max();
   const struct {
     const char* option;
     std::uint32_t* value;
     std::uint32_t min;
-  } counts[] = {{"--clusters", &params.clusters, 1},
-                {"--iterations", &params.iterations, 0},
-                {"--training-frames", &params.max_training_frames, 0},
-                {"--threads", &threads, 0}};
+    std::uint32_t max;
+  } counts[] = {{"--clusters", &params.clusters, 1, kAny},
+                {"--iterations", &params.iterations, 0, kAny},
+                {"--training-frames", &params.max_training_frames, 0, kAny},
+                {"--threads", &threads, 0, ThreadPool::kMaxThreads}};
   for (const auto& count : counts) {
     if (const auto text = parsed->value(count.option)) {
-      Result<std::uint32_t> value = parse_u32(count.option, *text, count.min);
+      Result<std::uint32_t> value = parse_u32(count.option, *text, count.min, count.max);
       if (!value) return report_error("clusters", value.message(), 2);
       *count.value = *value;
     }
@@ -91,7 +94,9 @@ int run_clusters(Args args) {
 
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db) return report_error("clusters", db.message(), 1);
-  ThreadPool pool(threads);
+  Result<std::unique_ptr<ThreadPool>> pool_made = ThreadPool::create(threads);
+  if (!pool_made) return report_error("clusters", pool_made.message(), 1);
+  ThreadPool& pool = **pool_made;
   const bool show_progress = !parsed->has("--no-progress") && (parsed->has("--progress") || stderr_is_terminal());
   const TrainingProgressFn progress = show_progress ? TrainingProgressFn(draw_progress) : TrainingProgressFn();
   const auto start = std::chrono::steady_clock::now();

@@ -108,6 +108,8 @@ TEST_F(HostileCli, ThreadCountsBeyondTheMaximumAreErrors) {
     expect_clean_error(run(mmvk_ + " build " + (dir_ / "clips").string() + " -o " + (dir_ / "t.mmdb").string() +
                            " --threads " + count),
                        {"--threads"}, count);
+    expect_clean_error(run(mmvk_ + " clusters " + db_ + " -o " + (dir_ / "t.mmkc").string() + " --threads " + count),
+                       {"--threads"}, count);
   }
 }
 

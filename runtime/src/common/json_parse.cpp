@@ -1,5 +1,6 @@
 #include "common/json_parse.hpp"
 
+#include <cmath>
 #include <set>
 #include <vector>
 
@@ -25,6 +26,13 @@ Result<nlohmann::json> parse_json_text(std::string_view text, const std::string&
   if (root.is_discarded()) return make_error(source + ": not valid JSON");
   if (!duplicate.empty()) return make_error(source + ": duplicate key \"" + duplicate + "\"");
   return root;
+}
+
+Result<float> json_float(const nlohmann::json& value, const std::string& where) {
+  if (!value.is_number()) return make_error(where + ": expected a number");
+  const double number = value.get<double>();
+  if (!std::isfinite(number) || std::abs(number) > 3.0e38) return make_error(where + ": not a finite number");
+  return static_cast<float>(number);
 }
 
 }  // namespace mmvk::detail

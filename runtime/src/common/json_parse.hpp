@@ -1,7 +1,7 @@
 // JSON parsing for manifests and schemas: nlohmann::json keeps the last of
 // two equal keys in an object without a word, so a manifest with "fps" twice
 // would silently use one of them. parse_json_object_text rejects that, naming
-// the key.
+// the key. Also the reading of a JSON number into a float that both share.
 #pragma once
 
 #include <string>
@@ -15,5 +15,9 @@ namespace mmvk::detail {
 
 // Parses `text`; errors name `source`: "not valid JSON", or a duplicate key.
 Result<nlohmann::json> parse_json_text(std::string_view text, const std::string& source);
+
+// A JSON number as a finite float; errors name `where` ("expected a number",
+// or "not a finite number" beyond float's range).
+Result<float> json_float(const nlohmann::json& value, const std::string& where);
 
 }  // namespace mmvk::detail

@@ -17,6 +17,7 @@ namespace mmvk {
 namespace {
 
 using Json = nlohmann::json;
+using detail::json_float;
 
 Status check_fields(const Json& object, const std::string& where, const std::set<std::string>& known) {
   for (const auto& item : object.items()) {
@@ -25,13 +26,6 @@ Status check_fields(const Json& object, const std::string& where, const std::set
     if (!known.count(item.key())) return make_error(where + (top ? "" : ".") + item.key() + ": unknown field");
   }
   return {};
-}
-
-Result<float> read_number(const Json& value, const std::string& where) {
-  if (!value.is_number()) return make_error(where + ": expected a number");
-  const double number = value.get<double>();
-  if (!std::isfinite(number) || std::abs(number) > 3.0e38) return make_error(where + ": not a finite number");
-  return static_cast<float>(number);
 }
 
 Result<bool> read_bool(const Json& value, const std::string& where) {
@@ -51,9 +45,9 @@ Result<std::vector<TimeRange>> read_ranges(const Json& value, const std::string&
     const std::string at = where + "[" + std::to_string(i) + "]";
     const Json& pair = value[i];
     if (!pair.is_array() || pair.size() != 2) return make_error(at + ": expected [begin, end] in seconds");
-    Result<float> begin = read_number(pair[0], at + "[0]");
+    Result<float> begin = json_float(pair[0], at + "[0]");
     if (!begin.ok()) return begin.error();
-    Result<float> end = read_number(pair[1], at + "[1]");
+    Result<float> end = json_float(pair[1], at + "[1]");
     if (!end.ok()) return end.error();
     if (*begin < 0.0f || !(*end > *begin)) {
       return make_error(at + ": expected 0 <= begin < end, got [" + std::to_string(*begin) + ", " +
@@ -64,7 +58,9 @@ Result<std::vector<TimeRange>> read_ranges(const Json& value, const std::string&
   return ranges;
 }
 
-// Macro-free helper: assigns a parsed value or returns its error.
+// Assigns a parsed value to an existing target or returns its error; one
+// statement (do-while), so it fits an unbraced `if`, which
+// MMVK_ASSIGN_OR_RETURN (it may declare its target) does not.
 #define MMVK_READ(target, expr)          \
   do {                                   \
     auto mmvk_read_ = (expr);            \
@@ -104,10 +100,10 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (object.contains("loop")) MMVK_READ(clip.loop, read_bool(object["loop"], where + ".loop"));
   if (object.contains("mirror")) MMVK_READ(clip.mirror, read_bool(object["mirror"], where + ".mirror"));
   if (object.contains("cost_multiplier")) {
-    MMVK_READ(clip.cost_multiplier, read_number(object["cost_multiplier"], where + ".cost_multiplier"));
+    MMVK_READ(clip.cost_multiplier, json_float(object["cost_multiplier"], where + ".cost_multiplier"));
     if (!(clip.cost_multiplier > 0.0f)) return make_error(where + ".cost_multiplier: must be > 0");
   }
-  if (object.contains("cost_bias")) MMVK_READ(clip.cost_bias, read_number(object["cost_bias"], where + ".cost_bias"));
+  if (object.contains("cost_bias")) MMVK_READ(clip.cost_bias, json_float(object["cost_bias"], where + ".cost_bias"));
   if (object.contains("do_not_use")) {
     MMVK_READ(clip.do_not_use, read_ranges(object["do_not_use"], where + ".do_not_use"));
   }
@@ -153,7 +149,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
     }
   }
   if (root.contains("fps")) {
-    MMVK_READ(manifest.fps, read_number(root["fps"], at + "fps"));
+    MMVK_READ(manifest.fps, json_float(root["fps"], at + "fps"));
     if (!(manifest.fps >= kMinFps && manifest.fps <= kMaxFps)) {
       char text[120];
       std::snprintf(text, sizeof(text), "fps: %g is outside the supported [%g, %g] frames/s", double(manifest.fps),
@@ -166,7 +162,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
     if (!import.is_object()) return make_error(at + "import: expected an object");
     MMVK_TRY(check_fields(import, at + "import", {"metres_per_unit", "up_axis"}));
     if (import.contains("metres_per_unit")) {
-      MMVK_READ(manifest.import.metres_per_unit, read_number(import["metres_per_unit"], at + "import.metres_per_unit"));
+      MMVK_READ(manifest.import.metres_per_unit, json_float(import["metres_per_unit"], at + "import.metres_per_unit"));
       if (manifest.import.metres_per_unit < 0.0f) {
         return make_error(at + "import.metres_per_unit: must be > 0 (or 0 to guess)");
       }
@@ -193,7 +189,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
     }
     if (options.contains("facing_smoothing_seconds")) {
       MMVK_READ(manifest.character_root.facing_smoothing_seconds,
-                read_number(options["facing_smoothing_seconds"], at + "character_root.facing_smoothing_seconds"));
+                json_float(options["facing_smoothing_seconds"], at + "character_root.facing_smoothing_seconds"));
       if (manifest.character_root.facing_smoothing_seconds < 0.0f) {
         return make_error(at + "character_root.facing_smoothing_seconds: must be >= 0");
       }

@@ -16,13 +16,6 @@ namespace {
 
 using Json = nlohmann::json;
 
-Result<float> finite_number(const Json& value, const std::string& where) {
-  if (!value.is_number()) return make_error(where + ": expected a number");
-  const double number = value.get<double>();
-  if (!std::isfinite(number) || std::abs(number) > 3.0e38) return make_error(where + ": not a finite float");
-  return static_cast<float>(number);
-}
-
 Result<FeatureChannel> parse_channel(const Json& object, const std::string& where) {
   if (!object.is_object()) return make_error(where + ": expected an object");
   static const std::set<std::string> kKnown = {"name",           "kind", "bone",   "second_bone",
@@ -57,7 +50,7 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     const Json& offsets = object["offsets_seconds"];
     if (!offsets.is_array()) return make_error(where + ".offsets_seconds: expected an array of numbers");
     for (std::size_t i = 0; i < offsets.size(); ++i) {
-      Result<float> t = finite_number(offsets[i], where + ".offsets_seconds[" + std::to_string(i) + "]");
+      Result<float> t = detail::json_float(offsets[i], where + ".offsets_seconds[" + std::to_string(i) + "]");
       if (!t.ok()) return t.error();
       channel.offsets_seconds.push_back(*t);
     }
@@ -79,7 +72,7 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     }
   }
   if (object.contains("weight")) {
-    Result<float> weight = finite_number(object["weight"], where + ".weight");
+    Result<float> weight = detail::json_float(object["weight"], where + ".weight");
     if (!weight.ok()) return weight.error();
     channel.weight = *weight;
   }

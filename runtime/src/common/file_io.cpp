@@ -90,6 +90,7 @@ void append_f32_le(std::string& bytes, std::span<const float> values) {
   const std::size_t start = bytes.size();
   bytes.resize(start + values.size() * 4);
   char* out = bytes.data() + start;
+  if (values.empty()) return;  // memcpy with a null pointer is undefined, even for 0 bytes
   if constexpr (std::endian::native == std::endian::little) {
     std::memcpy(out, values.data(), values.size_bytes());
   } else {
@@ -101,6 +102,7 @@ void append_f32_le(std::string& bytes, std::span<const float> values) {
 }
 
 void decode_f32_le(std::string_view bytes, std::span<float> values) {
+  if (values.empty()) return;  // memcpy with a null pointer is undefined, even for 0 bytes
   const char* in = bytes.data();
   if constexpr (std::endian::native == std::endian::little) {
     std::memcpy(values.data(), in, values.size_bytes());

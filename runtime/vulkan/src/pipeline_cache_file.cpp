@@ -69,7 +69,7 @@ Result<std::vector<std::byte>> decode_pipeline_cache_file(std::string_view bytes
   const std::string_view blob = bytes.substr(kFrameBytes);
   if (read_le(bytes, 24, 8) != checksum(blob.data(), blob.size())) return make_error("checksum mismatch (damaged file)");
   std::vector<std::byte> data(blob.size());
-  std::memcpy(data.data(), blob.data(), blob.size());
+  if (!blob.empty()) std::memcpy(data.data(), blob.data(), blob.size());  // null data() for an empty blob
   return data;
 }
 

@@ -12,6 +12,7 @@
 
 #include "support/command.hpp"
 #include "support/query_results.hpp"
+#include "support/cli_fixture.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -29,16 +30,12 @@ bool vulkan_required() {
   return value != nullptr && std::string(value) == "1";
 }
 
-class ClustersCli : public ::testing::Test {
+class ClustersCli : public test::CliFixture {
  protected:
   void SetUp() override {
-    const auto data = test::find_data_dir();
-    if (!data) GTEST_SKIP() << "motion data not found (set MMVK_DATA)";
-    const auto cli = test::cli_binary();
-    if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
-    mmvk_ = cli->string();
-    dir_ = test::make_temp_dir();
-    const fs::path walks = *data / "bandai-namco-nc" / "locomotion-normal";
+    CliFixture::SetUp();
+    if (IsSkipped()) return;
+    const fs::path walks = data_ / "bandai-namco-nc" / "locomotion-normal";
     db_ = build("walks", walks / "dataset-2_walk_normal_001.bvh", walks / "dataset-2_run_normal_001.bvh");
     other_db_ = build("other", walks / "dataset-2_walk_normal_002.bvh", walks / "dataset-2_run_normal_002.bvh");
     // Queries: the database's own normalized rows (every 7th).
@@ -65,8 +62,6 @@ class ClustersCli : public ::testing::Test {
     return mmvk_ + " query " + db + " --queries " + queries_ + " --normalized --k 3 " + options;
   }
 
-  std::string mmvk_;
-  fs::path dir_;
   std::string db_;
   std::string other_db_;
   std::string queries_;

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/cli_fixture.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -52,16 +53,12 @@ void expect_clean_error(const Ran& ran, const std::vector<std::string>& parts, c
   }
 }
 
-class HostileCli : public ::testing::Test {
+class HostileCli : public test::CliFixture {
  protected:
   void SetUp() override {
-    const auto data = test::find_data_dir();
-    if (!data) GTEST_SKIP() << "motion data not found (set MMVK_DATA)";
-    const auto cli = test::cli_binary();
-    if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
-    mmvk_ = cli->string();
-    dir_ = test::make_temp_dir();
-    bvh_ = *data / "tiny" / "cmu_amc2bvh_131_09_frames300-419.bvh";
+    CliFixture::SetUp();
+    if (IsSkipped()) return;
+    bvh_ = data_ / "tiny" / "cmu_amc2bvh_131_09_frames300-419.bvh";
     fs::create_directories(dir_ / "clips");
     fs::copy_file(bvh_, dir_ / "clips" / "walk.bvh");
     db_ = (dir_ / "walk.mmdb").string();
@@ -95,8 +92,6 @@ class HostileCli : public ::testing::Test {
     return folder;
   }
 
-  std::string mmvk_;
-  fs::path dir_;
   fs::path bvh_;
   std::string db_;
   std::uint32_t dims_ = 0;

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "support/query_results.hpp"
+#include "support/cli_fixture.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -38,17 +39,13 @@ CommandResult run(const std::string& command) {
 using test::read_text;
 using test::result_lines;
 
-class QueryCli : public ::testing::Test {
+class QueryCli : public test::CliFixture {
  protected:
   void SetUp() override {
-    const auto data = test::find_data_dir();
-    if (!data) GTEST_SKIP() << "motion data not found (set MMVK_DATA)";
-    const auto cli = test::cli_binary();
-    if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
-    mmvk_ = cli->string();
-    dir_ = test::make_temp_dir();
+    CliFixture::SetUp();
+    if (IsSkipped()) return;
     db_ = (dir_ / "walks.mmdb").string();
-    const fs::path walks = *data / "bandai-namco-nc" / "locomotion-normal";
+    const fs::path walks = data_ / "bandai-namco-nc" / "locomotion-normal";
     std::ofstream(dir_ / "m.json") << R"({"mirror": true, "clips": [)"
                                    << R"({"file": ")" << (walks / "dataset-2_walk_normal_001.bvh").string() << R"("},)"
                                    << R"({"file": ")" << (walks / "dataset-2_run_normal_001.bvh").string() << R"("}]})";
@@ -78,8 +75,6 @@ class QueryCli : public ::testing::Test {
     return path;
   }
 
-  std::string mmvk_;
-  fs::path dir_;
   std::string db_;
 };
 

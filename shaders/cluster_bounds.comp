@@ -2,16 +2,12 @@
 // cluster's lower bound for the query as an orderable key, or kSkip when the
 // cluster holds no candidate (ClusterSearch's rules: empty, all members
 // do-not-use / edge-excluded / block-transition, tag union misses
-// require_all, tag intersection hits exclude_any, contradictory masks).
-// In nprobe mode it also writes the channel-weighted squared distance of the
-// query to the centroid.
+// require_all, tag intersection hits exclude_any, contradictory masks), and
+// the channel-weighted squared distance of the query to the centroid (the
+// seed is the nearest cluster, as ClusterSearch's seed_nearest; nprobe mode
+// also probes by it).
 //
-// The bound is ClusterSearch's box bound, computed the same way: per channel
-// (weight 0 skipped) a float sum of gap_d^2 in dim order, gap_d the distance
-// of q_d to [box_min_d, box_max_d], total += w * sum, min_multiplier * total
-// + min_bias. Each rounding step is monotone and at most the matching step
-// of a member's own cost, so the bound never exceeds a member's cost
-// (mmvk/cluster_search.hpp); `precise` keeps the order on fusing GPUs.
+// The bound is ClusterSearch's box bound (cluster_bound.glsl).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -19,6 +15,7 @@
 #include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
+#include "cluster_bound.glsl"
 
 void main() {
   const uint c = gl_GlobalInvocationID.x;
@@ -44,45 +41,10 @@ void main() {
     [[unroll]] for (uint v = 0; v < DV; ++v) {
       lo[v] = texelFetch(cluster_vectors, int((c * 3u) * DV + v));
       hi[v] = texelFetch(cluster_vectors, int((c * 3u + 1u) * DV + v));
-      center[v] = pc.nprobe != 0u ? texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v)) : vec4(0.0);
+      center[v] = texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v));
     }
-    precise float total = 0.0;
-    precise float sum = 0.0;
-    precise float distance_total = 0.0;
-    precise float distance_sum = 0.0;
-    uint ch = 0u;
-    [[unroll]] for (uint d = 0; d < DIMS; ++d) {
-      const float qd = q[d >> 2u][d & 3u];
-      // At most one of below/above is > 0 (lo <= hi).
-      precise float below = lo[d >> 2u][d & 3u] - qd;
-      precise float above = qd - hi[d >> 2u][d & 3u];
-      const float outside = below > above ? below : above;
-      const float gap = outside > 0.0 ? outside : 0.0;
-      sum = sum + gap * gap;
-      // The centroid as a zero-size box (ClusterSearch's nprobe distance);
-      // skipped in exact mode (a uniform branch).
-      if (pc.nprobe != 0u) {
-        precise float c_below = center[d >> 2u][d & 3u] - qd;
-        precise float c_above = qd - center[d >> 2u][d & 3u];
-        const float c_outside = c_below > c_above ? c_below : c_above;
-        const float c_gap = c_outside > 0.0 ? c_outside : 0.0;
-        distance_sum = distance_sum + c_gap * c_gap;
-      }
-      if (ends_channel(d)) {
-        if (w[ch] != 0.0) {
-          total = total + w[ch] * sum;
-          distance_total = distance_total + w[ch] * distance_sum;
-        }
-        sum = 0.0;
-        distance_sum = 0.0;
-        ++ch;
-      }
-    }
-    precise float bound = uintBitsToFloat(scale.x) * total;
-    bound = bound + uintBitsToFloat(scale.y);
-    // A NaN bound (0 * inf) prunes nothing, as in ClusterSearch.
-    keys.x = isnan(bound) ? 0u : orderable_bits(bound);
-    keys.y = pc.nprobe != 0u ? orderable_bits(distance_total) : 0u;
+    keys.x = bound_key(box_total(q, w, lo, hi), scale.xy);
+    keys.y = orderable_bits(box_total(q, w, center, center));
   }
   bound_keys[local_query * pc.cluster_count + c] = keys;
 }

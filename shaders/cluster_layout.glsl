@@ -20,6 +20,10 @@ const uint kNeverCandidate = 7u;
 // evaluates the block's rows i, i + kRowLanes, ..., so the lanes of a SIMD
 // group share one block and one visit decision.
 const uint kRowLanes = 8u;
+// Work items per cluster_scan workgroup (cluster_layout.hpp:
+// kScanWorkgroup / kRowLanes); the scan is built with that workgroup size.
+const uint kScanWorkgroup = 64u;
+const uint kItemsPerScanGroup = kScanWorkgroup / kRowLanes;
 
 // cluster_layout.hpp: ClusterPush (32 bytes).
 layout(push_constant) uniform ClusterPush {
@@ -33,20 +37,24 @@ layout(push_constant) uniform ClusterPush {
   uint pad0;
 } pc;
 
-// cluster_layout.hpp: ClusterQueryState (32 bytes, std430).
+// cluster_layout.hpp: ClusterQueryState (48 bytes, std430).
 struct ClusterQueryState {
-  uint seed;              // cluster evaluated first (least bound), kNone if none
+  uint seed;              // cluster evaluated first (nearest centroid), kNone if none
   uint upper_key;         // orderable key of the k-th best after the seed, kSkip if fewer than k
   uint rows;              // rows evaluated (statistics)
   uint pad0;
   uvec2 continuing_pair;  // (key, frame) of the continuing frame, (kNone, kNone) when not a candidate
+  uvec2 items0;           // (first work item, count) of the query's blocks in scan round 0
+  uvec2 items1;           // the same for round 1 (first counts from item 0 of round 0)
   uvec2 pad1;
 };
 
 // [frames] R32UI: ClusterTable::members (frame ids, cluster by cluster).
 layout(set = 1, binding = 0) uniform usamplerBuffer members;
-// [blocks] RGBA32UI: (cluster, first member, end member, 0); a cluster's
-// members split into blocks of at most rows_per_block.
+// [blocks x 2] RGBA32UI: (cluster, first member, end member, AND of the
+// members' flags), (min multiplier bits, min bias bits, 0, 0) of the
+// block's members; a cluster's members (ascending frames) split into blocks
+// of at most rows_per_block.
 layout(set = 1, binding = 1) uniform usamplerBuffer block_info;
 // [clusters x 3] RGBA32UI: (flags_intersection, offsets[c], offsets[c+1],
 // first block), (tag_union lo, hi, tag_intersection lo, hi),
@@ -54,28 +62,24 @@ layout(set = 1, binding = 1) uniform usamplerBuffer block_info;
 layout(set = 1, binding = 2) uniform usamplerBuffer cluster_info;
 // [clusters x 3 x DV] RGBA32F: box_min, box_max, centroid, padded like rows.
 layout(set = 1, binding = 3) uniform samplerBuffer cluster_vectors;
+// [blocks x 2 x DV] RGBA32F: each member block's box_min, box_max.
+layout(set = 1, binding = 4) uniform samplerBuffer block_vectors;
 // [chunk x clusters]: (bound key, centroid distance key), kSkip when skipped.
-layout(std430, set = 1, binding = 4) buffer BoundKeys { uvec2 bound_keys[]; };
+layout(std430, set = 1, binding = 5) buffer BoundKeys { uvec2 bound_keys[]; };
 // [max_batch] per query state, indexed by the query's batch index.
-layout(std430, set = 1, binding = 5) buffer States { ClusterQueryState states[]; };
-// [chunk x blocks x kRowLanes x K] per-lane best (key, frame) pairs of each block.
-layout(std430, set = 1, binding = 6) buffer BlockPairs { uvec2 block_pairs[]; };
+layout(std430, set = 1, binding = 6) buffer States { ClusterQueryState states[]; };
+// [work items x K] the best (key, frame) pairs of each work item (round 0's
+// items, then round 1's; at most chunk x blocks).
+layout(std430, set = 1, binding = 7) buffer BlockPairs { uvec2 block_pairs[]; };
 // Per scan round: (workgroups x, 1, 1, work items), the indirect dispatch
 // of cluster_scan (cluster_layout.hpp: kScanDispatchReset); the host
 // zeroes x and the count before each chunk.
-layout(std430, set = 1, binding = 7) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
-// [chunk x blocks] (local query, block) pairs the current scan round visits.
-layout(std430, set = 1, binding = 8) buffer WorkItems { uvec2 work_items[]; };
-
-// Appends a block to evaluate for a query in scan round `round`: only the
-// visited blocks are dispatched (a grid over every (block, query) spent
-// most of its time on pruned invocations: 435 of 500 ms on 22k frames).
-// The group count is ceil(items / items per workgroup), raised by the
-// appender of each workgroup's first item.
-void append_work(uint round, uint local_query, uint block) {
-  const uint index = atomicAdd(scan_dispatch[round].w, 1u);
-  work_items[index] = uvec2(local_query, block);
-  if (index % (gl_WorkGroupSize.x / kRowLanes) == 0u) atomicAdd(scan_dispatch[round].x, 1u);
-}
+layout(std430, set = 1, binding = 8) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
+// [chunk x blocks] (local query, block): the work items, each query's
+// items of a round consecutive.
+layout(std430, set = 1, binding = 9) buffer WorkItems { uvec2 work_items[]; };
+// [chunk x blocks] per query: the blocks it lists, before they get their
+// place among the work items.
+layout(std430, set = 1, binding = 10) buffer Listed { uint listed[]; };
 
 #endif

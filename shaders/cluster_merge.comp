@@ -1,15 +1,15 @@
 // Cluster search, pass 4 (twice per chunk): one invocation per query merges
-// the continuing frame's pair and the per-lane best pairs of the visited
-// blocks into the query's best K, in the strict (cost, frame) order.
-//  round 0: the seed cluster's blocks; writes the k-th best key as the
-//           upper bound of round 1 (kSkip while fewer than k were found)
-//           and lists the blocks of the other clusters whose bound key is
-//           <= it for scan round 1.
-//  round 1: every visited block (the seed's, and those whose cluster bound
-//           key is <= the upper bound); writes the results and the number
-//           of rows evaluated. The loops run at most block_count x
-//           (kRowLanes + 1) + cluster_count iterations (capped for
-//           llvmpipe's loop limit).
+// the continuing frame's pair and the per-lane best pairs of its work items
+// into the query's best K, in the strict (cost, frame) order.
+//  round 0: the seed cluster's items; the k-th best key is the upper bound
+//           of round 1 (kSkip while fewer than k were found); lists, of the
+//           other clusters whose bound key is <= it, the blocks whose own
+//           bound key is <= it (block-level culling: a block's box is much
+//           tighter than its cluster's) for scan round 1.
+//  round 1: the items of both rounds; writes the results and the number of
+//           rows evaluated.
+// The loops run at most cluster_count + 2 x block_count iterations per
+// invocation (capped for llvmpipe's loop limit).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -17,7 +17,21 @@
 #include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
+#include "cluster_bound.glsl"
+#include "cluster_blocks.glsl"
 #include "top_k.glsl"
+
+// Inserts the per-lane pairs of work items [items.x, items.x + items.y);
+// returns the rows they evaluated.
+uint merge_items(inout uvec2 best[K], uvec2 items) {
+  uint rows = 0u;
+  for (uint item = items.x; item < items.x + items.y; ++item) {
+    [[unroll]] for (uint i = 0; i < K; ++i) insert_pair(best, block_pairs[item * K + i]);
+    const uvec4 info = texelFetch(block_info, int(work_items[item].y * 2u));
+    rows += info.z - info.y;
+  }
+  return rows;
+}
 
 void main() {
   const uint local_query = gl_GlobalInvocationID.x;
@@ -28,49 +42,32 @@ void main() {
   uvec2 best[K];
   clear_pairs(best);
   insert_pair(best, state.continuing_pair);
-  const uint pair_base = local_query * pc.block_count;
+  uint rows = merge_items(best, state.items0);
 
   if (pc.round == 0u) {
-    if (state.seed != kNone) {
-      const uint first = texelFetch(cluster_info, int(state.seed * 3u)).w;
-      const uint end = texelFetch(cluster_info, int(state.seed * 3u + 2u)).z;
-      for (uint lane_list = first * kRowLanes; lane_list < end * kRowLanes; ++lane_list) {
-        [[unroll]] for (uint i = 0; i < K; ++i) insert_pair(best, block_pairs[(pair_base * kRowLanes + lane_list) * K + i]);
-      }
-    }
     uint upper = kSkip;
     [[unroll]] for (uint j = 0; j < K; ++j) {
       if (j + 1u == pc.k && best[j].y != kNone) upper = best[j].x;
     }
     states[query].upper_key = upper;
+    vec4 q[DV];
+    float w[CHANNELS];
+    load_query(query, q, w);
+    uint count = 0u;
     const uint key_base = local_query * pc.cluster_count;
     for (uint c = 0u; c < pc.cluster_count; ++c) {
       const uint key = bound_keys[key_base + c].x;
       if (c == state.seed || key == kSkip || key > upper) continue;
       const uint first = texelFetch(cluster_info, int(c * 3u)).w;
       const uint end = texelFetch(cluster_info, int(c * 3u + 2u)).z;
-      for (uint b = first; b < end; ++b) append_work(1u, local_query, b);
+      count = list_blocks(local_query, first, end, upper, count, q, w);
     }
+    states[query].items1 = move_listed(1u, local_query, count);
     return;
   }
 
-  uint rows = state.continuing_pair.y != kNone ? 1u : 0u;
-  const uint key_base = local_query * pc.cluster_count;
-  for (uint b = 0u; b < pc.block_count; ++b) {
-    const uvec4 info = texelFetch(block_info, int(b));
-    bool visited = info.x == state.seed;
-    if (!visited) {
-      const uint key = bound_keys[key_base + info.x].x;
-      visited = key != kSkip && key <= state.upper_key;
-    }
-    if (visited) {
-      rows += info.z - info.y;
-      for (uint lane = 0u; lane < kRowLanes; ++lane) {
-        const uint at = ((pair_base + b) * kRowLanes + lane) * K;
-        [[unroll]] for (uint i = 0; i < K; ++i) insert_pair(best, block_pairs[at + i]);
-      }
-    }
-  }
+  rows += merge_items(best, state.items1);
+  rows += state.continuing_pair.y != kNone ? 1u : 0u;
   [[unroll]] for (uint j = 0; j < K; ++j) results[query * K + j] = best[j];
   states[query].rows = rows;
 }

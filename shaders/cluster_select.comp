@@ -4,10 +4,13 @@
 //    (the threshold is found by a binary search over the 32-bit distance
 //    keys: 32 counting loops over the clusters, so cluster_count is capped
 //    for llvmpipe's loop limit).
-//  - picks the seed: the cluster of least (bound, id), which ClusterSearch
-//    visits first, and lists its blocks for scan round 0;
 //  - evaluates the continuing frame (cost with continuing_bias), which the
-//    cluster scans skip, as ClusterSearch seeds it.
+//    cluster scans skip, as ClusterSearch seeds it;
+//  - picks the seed: the eligible cluster of least (centroid distance, id),
+//    ClusterSearch's seed_nearest (the least bound was a worse seed: many
+//    clusters whose box holds the query tie at 0), and lists its blocks for
+//    scan round 0: with k = 1 only those whose bound is <= the continuing
+//    frame's cost, else all.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -15,6 +18,8 @@
 #include "kernel_shape.glsl"
 #include "cluster_layout.glsl"
 #include "search_cost.glsl"
+#include "cluster_bound.glsl"
+#include "cluster_blocks.glsl"
 
 void main() {
   const uint local_query = gl_GlobalInvocationID.x;
@@ -25,9 +30,10 @@ void main() {
 
   if (pc.nprobe != 0u) {
     uint eligible = 0u;
-    for (uint c = 0u; c < clusters; ++c) eligible += bound_keys[base + c].y != kSkip ? 1u : 0u;
+    for (uint c = 0u; c < clusters; ++c) eligible += bound_keys[base + c].x != kSkip ? 1u : 0u;
     if (eligible > pc.nprobe) {
-      // The least T with count(distance key <= T) >= nprobe.
+      // The least T with count(distance key <= T) >= nprobe (ineligible
+      // clusters have distance key kSkip, above every T tried).
       uint lo = 0u;
       uint hi = kSkip - 1u;
       for (uint step = 0u; step < 32u && lo < hi; ++step) {
@@ -56,20 +62,27 @@ void main() {
   }
 
   uint seed = kNone;
-  uint seed_key = kSkip;
+  uint seed_distance = kSkip;
   for (uint c = 0u; c < clusters; ++c) {
-    const uint key = bound_keys[base + c].x;
-    if (key < seed_key) {
-      seed_key = key;
+    const uvec2 keys = bound_keys[base + c];
+    if (keys.x != kSkip && (seed == kNone || keys.y < seed_distance)) {
+      seed_distance = keys.y;
       seed = c;
     }
   }
 
+  const uvec2 continuing = continuing_pair(query);
+  uvec2 items = uvec2(0u, 0u);
   if (seed != kNone) {
+    vec4 q[DV];
+    float w[CHANNELS];
+    load_query(query, q, w);
+    const uint upper = pc.k == 1u && continuing.y != kNone ? continuing.x : kSkip;
     const uint first = texelFetch(cluster_info, int(seed * 3u)).w;
     const uint end = texelFetch(cluster_info, int(seed * 3u + 2u)).z;
-    for (uint b = first; b < end; ++b) append_work(0u, local_query, b);
+    items = move_listed(0u, local_query, list_blocks(local_query, first, end, upper, 0u, q, w));
   }
   states[query].seed = seed;
-  states[query].continuing_pair = continuing_pair(query);
+  states[query].continuing_pair = continuing;
+  states[query].items0 = items;
 }

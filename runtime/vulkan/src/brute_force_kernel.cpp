@@ -61,6 +61,12 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> BruteForceKernel::variant_k
   return keys;
 }
 
+std::vector<std::string_view> BruteForceKernel::kernel_names() const {
+  std::vector<std::string_view> names(variants_.size(), "brute_force_scan");
+  names.insert(names.end(), merges_.size(), "topk_merge");
+  return names;
+}
+
 const BruteForceKernel::Variant* BruteForceKernel::find(std::uint32_t k, std::uint32_t tile) const {
   for (const Variant& v : variants_) {
     if (v.k_class == k && v.tile == tile) return &v;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "handles.hpp"
@@ -27,6 +28,8 @@ class BruteForceKernel {
   const KernelShape& shape() const { return shape_; }
   // (K, tile) pairs this kernel can run, for warm-up.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> variant_keys() const;
+  // The shader of each pipeline built (VulkanSearch::kernels()).
+  std::vector<std::string_view> kernel_names() const;
 
   // Scratch pairs one query needs for k.
   std::uint64_t scratch_pairs_per_query(std::uint32_t k) const {

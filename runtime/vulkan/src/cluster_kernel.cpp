@@ -15,14 +15,17 @@ namespace mmvk::vulkan::detail {
 
 namespace {
 
-// Rows per member block, evaluated by kRowLanes invocations (64 rows each
-// at most): big clusters split over several workgroups (B = 1 latency).
-constexpr std::uint32_t kRowsPerBlock = 512;
+// Rows per member block, evaluated by kRowLanes invocations (8 rows each):
+// the unit of block-level culling. A block is a run of a cluster's members
+// in frame order (mostly neighbouring frames), so its box is much tighter
+// than its cluster's; ClusterSearch's 16-row tiles are the same idea.
+constexpr std::uint32_t kRowsPerBlock = 64;
 // Loop limits of one invocation (llvmpipe stops loops at 65,535 iterations
-// in total): the final merge walks every block and the lanes of the visited
-// ones, the nprobe selection walks the clusters 35 times.
-constexpr std::uint32_t kMaxBlocks = 7000;
-constexpr std::uint32_t kMaxProbeClusters = 1800;
+// in total): the round-0 merge walks the clusters, lists blocks and moves
+// them (cluster_count + 2 x blocks at most), the nprobe selection walks the
+// clusters 35 times.
+constexpr std::uint64_t kMaxLoopIterations = 60000;
+constexpr std::uint32_t kMaxProbeClusters = 1700;
 
 // Between any two steps of a chunk: shader writes, the dispatch-argument
 // reset (a transfer) and indirect reads are all ordered.
@@ -36,12 +39,47 @@ void full_barrier(VkCommandBuffer commands) {
 
 // The table in the kernels' layouts (cluster_layout.glsl); creation only.
 struct PackedTable {
-  std::vector<std::array<std::uint32_t, 4>> block_info;    // [blocks]
+  std::vector<std::array<std::uint32_t, 4>> block_info;    // [blocks x 2]
   std::vector<std::array<std::uint32_t, 4>> cluster_info;  // [clusters x 3]
   std::vector<float> vectors;                              // [clusters x 3 x dim_vec4s x 4]
+  std::vector<float> block_vectors;                        // [blocks x 2 x dim_vec4s x 4]
+  std::uint32_t block_count = 0;
 };
 
-PackedTable pack_table(const ClusterTable& table, const KernelShape& shape) {
+// Member block [first, end) of `table`: its two block_info texels and its
+// box (min, max over the members, padded like the rows), appended. The
+// minimum multiplier and bias and the AND of the flags cover every member,
+// as the cluster's do, so the block's box bound is one too.
+void pack_block(const ClusterTable& table, const Database& database, std::uint32_t cluster, std::uint32_t first,
+                std::uint32_t end, std::uint32_t dv, PackedTable& packed) {
+  const std::uint32_t dims = database.dims();
+  std::vector<float> lo(std::size_t{dv} * 4, 0.0f);
+  std::vector<float> hi(std::size_t{dv} * 4, 0.0f);
+  float min_multiplier = 0.0f;
+  float min_bias = 0.0f;
+  std::uint32_t flags = ~0u;
+  for (std::uint32_t m = first; m < end; ++m) {
+    const std::uint32_t frame = table.members[m];
+    const std::span<const float> row = database.row(frame);
+    const float multiplier = database.frame_multiplier()[frame];
+    const float bias = database.frame_bias()[frame];
+    for (std::uint32_t d = 0; d < dims; ++d) {
+      lo[d] = m == first ? row[d] : std::min(lo[d], row[d]);
+      hi[d] = m == first ? row[d] : std::max(hi[d], row[d]);
+    }
+    min_multiplier = m == first ? multiplier : std::min(min_multiplier, multiplier);
+    min_bias = m == first ? bias : std::min(min_bias, bias);
+    flags &= database.frame_flags()[frame];
+  }
+  packed.block_info.push_back({cluster, first, end, flags});
+  packed.block_info.push_back(
+      {std::bit_cast<std::uint32_t>(min_multiplier), std::bit_cast<std::uint32_t>(min_bias), 0, 0});
+  packed.block_vectors.insert(packed.block_vectors.end(), lo.begin(), lo.end());
+  packed.block_vectors.insert(packed.block_vectors.end(), hi.begin(), hi.end());
+  ++packed.block_count;
+}
+
+PackedTable pack_table(const ClusterTable& table, const Database& database, const KernelShape& shape) {
   const std::uint32_t clusters = table.cluster_count;
   const std::uint32_t dv = shape.dim_vec4s;
   const std::uint32_t dims = shape.dims;
@@ -51,9 +89,9 @@ PackedTable pack_table(const ClusterTable& table, const KernelShape& shape) {
   for (std::uint32_t c = 0; c < clusters; ++c) {
     const std::uint32_t first = table.offsets[c];
     const std::uint32_t end = table.offsets[c + 1];
-    const auto first_block = static_cast<std::uint32_t>(packed.block_info.size());
+    const std::uint32_t first_block = packed.block_count;
     for (std::uint32_t m = first; m < end; m += kRowsPerBlock) {
-      packed.block_info.push_back({c, m, std::min(end, m + kRowsPerBlock), 0});
+      pack_block(table, database, c, m, std::min(end, m + kRowsPerBlock), dv, packed);
     }
     const TagMask tag_union = table.tag_union[c];
     const TagMask tag_intersection = table.tag_intersection[c];
@@ -62,7 +100,7 @@ PackedTable pack_table(const ClusterTable& table, const KernelShape& shape) {
     info[1] = {static_cast<std::uint32_t>(tag_union), static_cast<std::uint32_t>(tag_union >> 32),
                static_cast<std::uint32_t>(tag_intersection), static_cast<std::uint32_t>(tag_intersection >> 32)};
     info[2] = {std::bit_cast<std::uint32_t>(table.min_multiplier[c]), std::bit_cast<std::uint32_t>(table.min_bias[c]),
-               static_cast<std::uint32_t>(packed.block_info.size()), 0};
+               packed.block_count, 0};
     float* box_min = &packed.vectors[std::size_t{c} * 3 * dv * 4];
     float* box_max = box_min + std::size_t{dv} * 4;
     float* centroid = box_max + std::size_t{dv} * 4;
@@ -80,17 +118,15 @@ PackedTable pack_table(const ClusterTable& table, const KernelShape& shape) {
 
 Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPool pool,
                                             VkDescriptorSetLayout search_layout, const KernelShape& shape,
-                                            const ClusterTable& table, const ClusterKernelOptions& options) {
+                                            const Database& database, const ClusterTable& table,
+                                            const ClusterKernelOptions& options) {
   const std::array<SetShape, 2> sets = {kSearchSet, kClusterSet};
   MMVK_TRY(check_binding_limits(context, sets, "cluster kernels"));
   ClusterKernel kernel;
+  // The per-query kernels (select, merge) use the search's workgroup (8 on
+  // CPU drivers: one workgroup runs on one CPU thread, and a chunk may hold
+  // only tens of queries); the grids (bounds, scan) use kScanWorkgroup.
   kernel.shape_ = shape;
-  // 64 invocations per workgroup, also on CPU drivers: most cluster
-  // invocations exit at once (pruned blocks), and lavapipe's cost per
-  // workgroup added up with 8.
-  const VkPhysicalDeviceLimits& limits = context.properties().limits;
-  kernel.shape_.workgroup_size =
-      std::min({64u, limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
   kernel.max_batch_ = options.max_batch;
   kernel.cluster_count_ = table.cluster_count;
   kernel.nprobe_ = options.nprobe < table.cluster_count ? options.nprobe : 0;
@@ -98,7 +134,7 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
     return make_error("Vulkan: nprobe search supports at most " + std::to_string(kMaxProbeClusters) +
                       " clusters, the table has " + std::to_string(table.cluster_count));
   }
-  MMVK_TRY(kernel.upload_table(context, pool, table, options.force_staging));
+  MMVK_TRY(kernel.upload_table(context, pool, database, table, options.force_staging));
   MMVK_TRY(kernel.create_layouts(context, search_layout, options.slots));
   MMVK_ASSIGN_OR_RETURN(const std::uint64_t chunk, kernel.size_scratch(context, options));
   MMVK_TRY(kernel.create_slots(context, options, chunk));
@@ -106,14 +142,16 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   return kernel;
 }
 
-Status ClusterKernel::upload_table(const Context& context, VkCommandPool pool, const ClusterTable& table,
-                                   bool force_staging) {
-  const PackedTable packed = pack_table(table, shape_);
-  if (packed.block_info.size() > kMaxBlocks) {
-    return make_error("Vulkan: the cluster table splits into " + std::to_string(packed.block_info.size()) +
-                      " member blocks, over the kernels' " + std::to_string(kMaxBlocks));
+Status ClusterKernel::upload_table(const Context& context, VkCommandPool pool, const Database& database,
+                                   const ClusterTable& table, bool force_staging) {
+  const PackedTable packed = pack_table(table, database, shape_);
+  if (table.cluster_count + 2 * std::uint64_t{packed.block_count} > kMaxLoopIterations) {
+    return make_error("Vulkan: the cluster table has " + std::to_string(table.cluster_count) + " clusters in " +
+                      std::to_string(packed.block_count) + " member blocks of " + std::to_string(kRowsPerBlock) +
+                      " rows; the cluster kernels support clusters + 2 x blocks <= " +
+                      std::to_string(kMaxLoopIterations));
   }
-  block_count_ = static_cast<std::uint32_t>(packed.block_info.size());
+  block_count_ = packed.block_count;
   const struct {
     TexelBuffer ClusterKernel::*member;
     VkFormat format;
@@ -128,6 +166,8 @@ Status ClusterKernel::upload_table(const Context& context, VkCommandPool pool, c
        "the cluster info"},
       {&ClusterKernel::cluster_vectors_, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(packed.vectors),
        "the cluster boxes and centroids"},
+      {&ClusterKernel::block_vectors_, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(packed.block_vectors),
+       "the member block boxes"},
   };
   for (const auto& u : uploads) {
     MMVK_ASSIGN_OR_RETURN(this->*(u.member),
@@ -154,18 +194,22 @@ Result<std::uint64_t> ClusterKernel::size_scratch(const Context& context, const 
   const VkPhysicalDeviceLimits& limits = context.properties().limits;
   const std::uint64_t range = limits.maxStorageBufferRange;
   const std::uint64_t clusters = cluster_count_;
-  const std::uint64_t pairs_per_query = std::uint64_t{block_count_} * kRowLanes * k_class(options.max_k);
-  const std::uint64_t per_query_bytes = (pairs_per_query + clusters) * 8;
+  const std::uint64_t pairs_per_query = std::uint64_t{block_count_} * k_class(options.max_k);
+  // Bound keys, block pairs, work items (8 bytes each) and listed blocks
+  // (4 bytes): a query lists each block at most once over both rounds.
+  const std::uint64_t per_query_bytes = (pairs_per_query + clusters) * 8 + std::uint64_t{block_count_} * 12;
   std::uint64_t chunk = std::clamp<std::uint64_t>(options.scratch_bytes / per_query_bytes, 1, options.max_batch);
   // The indirect scans: every block of the chunk visited must stay within
   // maxComputeWorkGroupCount[0] workgroups.
-  const std::uint64_t items_per_group = shape_.workgroup_size / kRowLanes;
+  const std::uint64_t items_per_group = kItemsPerScanGroup;
   chunk = std::min({chunk, range / (pairs_per_query * 8), range / (clusters * 8),
+                    range / (std::uint64_t{block_count_} * 8),
                     std::uint64_t{limits.maxComputeWorkGroupCount[1]},
                     std::uint64_t{limits.maxComputeWorkGroupCount[0]} * items_per_group / block_count_});
   if (chunk == 0) return make_error("Vulkan: one query's cluster scratch exceeds maxStorageBufferRange");
   bound_capacity_ = chunk * clusters;
   pair_capacity_ = chunk * pairs_per_query;
+  item_chunk_ = chunk;
   return chunk;
 }
 
@@ -187,10 +231,12 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
        storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::DeviceLocal,
        "the cluster scan dispatch arguments"},
       {&SlotScratch::work_items, chunk * block_count_ * 8, storage, MemoryUse::DeviceLocal, "the cluster work items"},
+      {&SlotScratch::listed, chunk * block_count_ * 4, storage, MemoryUse::DeviceLocal, "the cluster listed blocks"},
   };
   static_assert(std::size(buffers) == kClusterSet.storage);
   const std::array<VkBufferView, kClusterSet.texel> views = {members_.view.get(), block_info_.view.get(),
-                                                             cluster_info_.view.get(), cluster_vectors_.view.get()};
+                                                             cluster_info_.view.get(), cluster_vectors_.view.get(),
+                                                             block_vectors_.view.get()};
   slots_.resize(options.slots);
   for (SlotScratch& slot : slots_) {
     std::array<VkBuffer, kClusterSet.storage> handles{};
@@ -207,14 +253,17 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
 // Bounds and select once, scan and merge per K class.
 Status ClusterKernel::create_pipelines(const Context& context, std::uint32_t max_k) {
   const VkPipelineLayout layout = pipeline_layout_.get();
-  const std::vector<SpecValue> base_spec = shape_spec(shape_, 1);
-  MMVK_ASSIGN_OR_RETURN(bounds_, create_compute_pipeline(context, layout, "cluster_bounds", base_spec));
-  MMVK_ASSIGN_OR_RETURN(select_, create_compute_pipeline(context, layout, "cluster_select", base_spec));
+  KernelShape grid_shape = shape_;
+  grid_shape.workgroup_size = kScanWorkgroup;
+  MMVK_ASSIGN_OR_RETURN(bounds_,
+                        create_compute_pipeline(context, layout, "cluster_bounds", shape_spec(grid_shape, 1)));
+  MMVK_ASSIGN_OR_RETURN(select_, create_compute_pipeline(context, layout, "cluster_select", shape_spec(shape_, 1)));
   for (const std::uint32_t k : {1u, 4u, 16u}) {
     if (k > k_class(max_k)) break;
-    const std::vector<SpecValue> spec = shape_spec(shape_, k);
-    MMVK_ASSIGN_OR_RETURN(UniquePipeline scan, create_compute_pipeline(context, layout, "cluster_scan", spec));
-    MMVK_ASSIGN_OR_RETURN(UniquePipeline merge, create_compute_pipeline(context, layout, "cluster_merge", spec));
+    MMVK_ASSIGN_OR_RETURN(UniquePipeline scan,
+                          create_compute_pipeline(context, layout, "cluster_scan", shape_spec(grid_shape, k)));
+    MMVK_ASSIGN_OR_RETURN(UniquePipeline merge,
+                          create_compute_pipeline(context, layout, "cluster_merge", shape_spec(shape_, k)));
     variants_.push_back(Variant{k, std::move(scan), std::move(merge)});
   }
   return {};
@@ -226,9 +275,20 @@ std::vector<std::uint32_t> ClusterKernel::k_classes() const {
   return classes;
 }
 
+std::vector<std::string_view> ClusterKernel::kernel_names() const {
+  std::vector<std::string_view> names = {"cluster_bounds", "cluster_select"};
+  for (std::size_t v = 0; v < variants_.size(); ++v) {
+    names.push_back("cluster_scan");
+    names.push_back("cluster_merge");
+  }
+  return names;
+}
+
 std::uint32_t ClusterKernel::chunk_for(std::uint32_t kc) const {
+  // The work items and listed blocks hold item_chunk_ queries whatever k.
   const std::uint64_t chunk =
-      std::min(bound_capacity_ / cluster_count_, pair_capacity_ / (std::uint64_t{block_count_} * kRowLanes * kc));
+      std::min({bound_capacity_ / cluster_count_, pair_capacity_ / (std::uint64_t{block_count_} * kc),
+                item_chunk_});
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(chunk, max_batch_));
 }
 
@@ -248,7 +308,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
   const std::array<VkDescriptorSet, 2> sets = {search_set, scratch.set};
   const VkPipelineLayout layout = pipeline_layout_.get();
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, sets.data(), 0, nullptr);
-  const std::uint32_t items_per_group = wg / kRowLanes;
+  const std::uint32_t items_per_group = kItemsPerScanGroup;
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);
     ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, 0};
@@ -257,8 +317,8 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
     if (base != 0) full_barrier(commands);
     vkCmdUpdateBuffer(commands, scratch.scan_dispatch.buffer.get(), 0, sizeof(kScanDispatchReset),
                       kScanDispatchReset.data());
-    MMVK_TRY(dispatch(context, commands, bounds_.get(), layout, push, (cluster_count_ + wg - 1) / wg, count,
-                      "cluster_bounds"));
+    MMVK_TRY(dispatch(context, commands, bounds_.get(), layout, push,
+                      (cluster_count_ + kScanWorkgroup - 1) / kScanWorkgroup, count, "cluster_bounds"));
     full_barrier(commands);
     MMVK_TRY(dispatch(context, commands, select_.get(), layout, push, query_groups, 1, "cluster_select"));
     // A round lists each (query, block) at most once, so its work items

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "device_database.hpp"
@@ -46,11 +47,13 @@ class ClusterKernel {
   // `table` must have been validated against the database of `shape`
   // (validate_cluster_table; VulkanSearch::create does it once).
   static Result<ClusterKernel> create(const Context& context, VkCommandPool pool, VkDescriptorSetLayout search_layout,
-                                      const KernelShape& shape, const ClusterTable& table,
+                                      const KernelShape& shape, const Database& database, const ClusterTable& table,
                                       const ClusterKernelOptions& options);
 
   // K classes (1, 4, 16) the kernel has pipelines for.
   std::vector<std::uint32_t> k_classes() const;
+  // The shader of each pipeline built (VulkanSearch::kernels()).
+  std::vector<std::string_view> kernel_names() const;
   std::uint32_t cluster_count() const { return cluster_count_; }
   std::uint32_t block_count() const { return block_count_; }
 
@@ -68,9 +71,10 @@ class ClusterKernel {
   struct SlotScratch {
     Buffer bound_keys;   // [chunk x clusters] uvec2
     Buffer states;       // [max_batch] ClusterQueryState, host-mapped
-    Buffer block_pairs;  // [chunk x blocks x kRowLanes x K] uvec2
+    Buffer block_pairs;  // [chunk x blocks x K] uvec2, by work item
     Buffer scan_dispatch;  // 2 x (groups x, 1, 1, items): indirect args of the scans
     Buffer work_items;     // [chunk x blocks] (local query, block)
+    Buffer listed;         // [chunk x blocks] blocks listed per query
     VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
   };
   struct Variant {
@@ -79,7 +83,8 @@ class ClusterKernel {
     UniquePipeline merge;
   };
   // The steps of create(), in order.
-  Status upload_table(const Context& context, VkCommandPool pool, const ClusterTable& table, bool force_staging);
+  Status upload_table(const Context& context, VkCommandPool pool, const Database& database, const ClusterTable& table,
+                      bool force_staging);
   Status create_layouts(const Context& context, VkDescriptorSetLayout search_layout, std::uint32_t slots);
   Result<std::uint64_t> size_scratch(const Context& context, const ClusterKernelOptions& options);
   Status create_slots(const Context& context, const ClusterKernelOptions& options, std::uint64_t chunk);
@@ -94,6 +99,7 @@ class ClusterKernel {
   std::uint32_t max_batch_ = 1;
   std::uint64_t bound_capacity_ = 0;  // uvec2 per slot
   std::uint64_t pair_capacity_ = 0;   // uvec2 per slot
+  std::uint64_t item_chunk_ = 0;      // queries the work items and listed blocks hold
   // Declaration order = dependency order (destroyed in reverse).
   UniqueDescriptorSetLayout set_layout_;
   UniquePipelineLayout pipeline_layout_;
@@ -102,6 +108,7 @@ class ClusterKernel {
   TexelBuffer block_info_;
   TexelBuffer cluster_info_;
   TexelBuffer cluster_vectors_;
+  TexelBuffer block_vectors_;
   std::vector<SlotScratch> slots_;
   UniquePipeline bounds_;
   UniquePipeline select_;

@@ -30,36 +30,46 @@ static_assert(offsetof(ClusterPush, nprobe) == 24);
 
 // GLSL: ClusterQueryState (std430 array element; uvec2 aligned to 8).
 struct ClusterQueryState {
-  std::uint32_t seed;                // cluster evaluated first (least bound), kNoFrame if none
+  std::uint32_t seed;                // cluster evaluated first (nearest centroid), kNoFrame if none
   std::uint32_t upper_key;           // orderable key of the k-th best after the seed
   std::uint32_t rows;                // rows evaluated, read back for SearchStats
   std::uint32_t pad0;
   std::uint32_t continuing_pair[2];  // (key, frame) of the continuing frame
+  std::uint32_t items0[2];           // (first work item, count) of scan round 0
+  std::uint32_t items1[2];           // the same for round 1
   std::uint32_t pad1[2];
 };
-static_assert(sizeof(ClusterQueryState) == 32);
+static_assert(sizeof(ClusterQueryState) == 48);
 static_assert(offsetof(ClusterQueryState, rows) == 8);
 static_assert(offsetof(ClusterQueryState, continuing_pair) == 16);
+static_assert(offsetof(ClusterQueryState, items1) == 32);
 
 // Descriptor bindings of set 1 (cluster_layout.glsl); set 0 is the search
 // layout (search_layout.hpp).
 enum ClusterBinding : std::uint32_t {
   kBindingMembers = 0,         // uniform texel, R32UI
-  kBindingBlockInfo = 1,       // uniform texel, RGBA32UI
+  kBindingBlockInfo = 1,       // uniform texel, RGBA32UI, 2 per block
   kBindingClusterInfo = 2,     // uniform texel, RGBA32UI
   kBindingClusterVectors = 3,  // uniform texel, RGBA32F
-  kBindingBoundKeys = 4,       // storage
-  kBindingStates = 5,          // storage
-  kBindingBlockPairs = 6,      // storage
-  kBindingScanDispatch = 7,    // storage + indirect
-  kBindingWorkItems = 8,       // storage
-  kClusterBindingCount = 9,
+  kBindingBlockVectors = 4,    // uniform texel, RGBA32F
+  kBindingBoundKeys = 5,       // storage
+  kBindingStates = 6,          // storage
+  kBindingBlockPairs = 7,      // storage
+  kBindingScanDispatch = 8,    // storage + indirect
+  kBindingWorkItems = 9,       // storage
+  kBindingListed = 10,         // storage
+  kClusterBindingCount = 11,
 };
-inline constexpr SetShape kClusterSet{4, 5};
+inline constexpr SetShape kClusterSet{5, 6};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
 // GLSL: kRowLanes, the invocations per member block.
 inline constexpr std::uint32_t kRowLanes = 8;
+// The workgroup size of cluster_scan (and cluster_bounds), every device
+// (Vulkan guarantees 128); GLSL: kItemsPerScanGroup = kScanWorkgroup / kRowLanes.
+inline constexpr std::uint32_t kScanWorkgroup = 64;
+inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup / kRowLanes;
+static_assert(kItemsPerScanGroup == 8);
 
 // GLSL: ScanDispatch, per scan round (groups x, 1, 1, work items): the
 // indirect dispatch of cluster_scan, reset by the host before each chunk.

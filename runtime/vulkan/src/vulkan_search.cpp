@@ -103,7 +103,8 @@ struct VulkanSearch::Impl {
   UniqueCommandPool command_pool;
   UniqueQueryPool timestamps;  // 2 per slot; empty without timestamp support
   DeviceDatabase device_database;
-  BruteForceKernel kernel;
+  // Exactly one of the two: a backend builds only the kernels it runs.
+  std::optional<BruteForceKernel> brute;  // BruteForce mode
   std::vector<Slot> slots;
   std::optional<ClusterKernel> clusters;  // ClustersExact and NProbe modes
 
@@ -123,8 +124,14 @@ struct VulkanSearch::Impl {
   Status create_slots();
   Status create_cluster_kernel(const ClusterTable& table);
   Status warm_up();
+  // Set 0's scratch pairs one query needs: the brute force's per-block best
+  // pairs; the cluster kernels keep theirs in set 1 (one pair keeps the
+  // binding valid).
+  std::uint64_t scratch_pairs_per_query(std::uint32_t k) const {
+    return brute ? brute->scratch_pairs_per_query(k) : 1;
+  }
   std::uint32_t chunk_for(std::uint32_t k) const {
-    const std::uint64_t per_query = kernel.scratch_pairs_per_query(k);
+    const std::uint64_t per_query = scratch_pairs_per_query(k);
     std::uint64_t chunk = std::min<std::uint64_t>(options.max_batch, scratch_pairs / per_query);
     if (chunk >= 16) chunk -= chunk % 16;  // whole query tiles per chunk
     return static_cast<std::uint32_t>(chunk);
@@ -169,7 +176,7 @@ Status VulkanSearch::Impl::create_slots() {
   const std::uint64_t max_batch = options.max_batch;
   const std::uint32_t largest_k = k_class(options.max_k);
   const std::uint64_t storage_range = context->properties().limits.maxStorageBufferRange;
-  const std::uint64_t per_query_max = kernel.scratch_pairs_per_query(options.max_k) * sizeof(std::uint32_t) * 2;
+  const std::uint64_t per_query_max = scratch_pairs_per_query(options.max_k) * sizeof(std::uint32_t) * 2;
   std::uint64_t scratch_bytes = std::min(options.scratch_bytes, max_batch * per_query_max);
   scratch_bytes = std::max(scratch_bytes, per_query_max);  // at least one query per chunk
   if (scratch_bytes > storage_range) {
@@ -236,7 +243,7 @@ Status VulkanSearch::Impl::create_cluster_kernel(const ClusterTable& table) {
   cluster_options.scratch_bytes = options.scratch_bytes;
   cluster_options.force_staging = options.force_staging_upload;
   MMVK_ASSIGN_OR_RETURN(ClusterKernel created, ClusterKernel::create(*context, command_pool.get(), set_layout.get(),
-                                                                     shape, table, cluster_options));
+                                                                     shape, *database, table, cluster_options));
   clusters.emplace(std::move(created));
   return {};
 }
@@ -246,9 +253,9 @@ Status VulkanSearch::Impl::create_cluster_kernel(const ClusterTable& table) {
 Status VulkanSearch::Impl::warm_up() {
   const SearchStats kept_stats = stats;
   const std::optional<double> kept_seconds = last_kernel_seconds;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> variants = kernel.variant_keys();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> variants;
+  if (brute) variants = brute->variant_keys();
   if (clusters) {
-    variants.clear();
     for (const std::uint32_t kc : clusters->k_classes()) variants.emplace_back(kc, 1);
   }
   const std::span<const float> first_row = database->row(0);
@@ -278,8 +285,10 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
   MMVK_ASSIGN_OR_RETURN(impl->shape, make_kernel_shape(context, database, options));
   MMVK_TRY(impl->create_layouts());
   MMVK_TRY(impl->upload(options.force_staging_upload));
-  MMVK_ASSIGN_OR_RETURN(impl->kernel, BruteForceKernel::create(context, impl->pipeline_layout.get(), impl->shape,
-                                                               options.max_batch, options.max_k, options.max_tile));
+  if (options.mode == SearchMode::BruteForce) {
+    MMVK_ASSIGN_OR_RETURN(impl->brute, BruteForceKernel::create(context, impl->pipeline_layout.get(), impl->shape,
+                                                                options.max_batch, options.max_k, options.max_tile));
+  }
   MMVK_TRY(impl->create_slots());
   if (options.mode != SearchMode::BruteForce) MMVK_TRY(impl->create_cluster_kernel(*clusters));
   if (options.warm_up) MMVK_TRY(impl->warm_up());
@@ -306,6 +315,13 @@ std::uint32_t VulkanSearch::rows_per_invocation() const { return impl_->shape.ro
 std::uint32_t VulkanSearch::workgroup_size() const { return impl_->shape.workgroup_size; }
 
 Status VulkanSearch::warm_up() { return impl_->warm_up(); }
+
+std::vector<std::string_view> VulkanSearch::kernels() const {
+  std::vector<std::string_view> names;
+  if (impl_->brute) names = impl_->brute->kernel_names();
+  if (impl_->clusters) names = impl_->clusters->kernel_names();
+  return names;
+}
 
 Result<Ticket> VulkanSearch::submit(const QueryBatch& batch, std::uint32_t k) { return impl_->submit(batch, k, 0); }
 
@@ -381,7 +397,7 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
                           nullptr);
   const Status recorded =
       clusters ? clusters->record(*context, commands, slot_index, slot.descriptors, count, k)
-               : kernel.record(*context, commands, pipeline_layout.get(), count, k, chunk, forced_tile);
+               : brute->record(*context, commands, pipeline_layout.get(), count, k, chunk, forced_tile);
   if (!recorded) {
     vkEndCommandBuffer(commands);
     return recorded.error();

@@ -23,6 +23,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/database.hpp"
@@ -111,6 +112,11 @@ class VulkanSearch final : public SearchBackend {
   // free slot; keeps stats() and last_kernel_seconds(). create() calls it
   // unless options.warm_up is false.
   Status warm_up();
+
+  // The shaders (shaders/*.comp names) this search built pipelines for,
+  // once per (K, tile) variant: only those its mode runs (a cluster mode
+  // builds no brute-force kernel), all of which warm_up() dispatches.
+  std::vector<std::string_view> kernels() const;
 
   // GPU time of the last waited-for submit from timestamp queries, seconds;
   // nullopt when the queue has no timestamps.

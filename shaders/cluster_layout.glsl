@@ -16,14 +16,9 @@ const uint kSkip = 0xFFFFFFFFu;
 // Flags that make a frame a non-candidate (mmvk::kFrameDoNotUse |
 // kFrameEdgeExcluded | kFrameBlockTransition) when it is not continued.
 const uint kNeverCandidate = 7u;
-// Invocations per member block (cluster_layout.hpp: kRowLanes): lane i
-// evaluates the block's rows i, i + kRowLanes, ..., so the lanes of a SIMD
-// group share one block and one visit decision.
-const uint kRowLanes = 8u;
-// Work items per cluster_scan workgroup (cluster_layout.hpp:
-// kScanWorkgroup / kRowLanes); the scan is built with that workgroup size.
-const uint kScanWorkgroup = 64u;
-const uint kItemsPerScanGroup = kScanWorkgroup / kRowLanes;
+// Work items (one invocation each) per cluster_scan workgroup
+// (cluster_layout.hpp: kScanWorkgroup); the scan is built with that size.
+const uint kItemsPerScanGroup = 64u;
 
 // cluster_layout.hpp: ClusterPush (32 bytes).
 layout(push_constant) uniform ClusterPush {

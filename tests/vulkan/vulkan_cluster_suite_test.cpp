@@ -9,6 +9,7 @@
 
 #include "mmvk/backends.hpp"
 #include "mmvk/cluster_search.hpp"
+#include "mmvk/thread_pool.hpp"
 #include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/backend_data_suite.hpp"
@@ -123,6 +124,70 @@ TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
   gpu.reset();
   const std::vector<std::string> messages = context->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, the first: " << messages.front();
+}
+
+// The cluster kernels' loops (the listing and merging of member blocks per
+// query) stay within llvmpipe's 65,535 iterations at large N, where a loop
+// cut short returns wrong answers silently (shared/LAVAPIPE.md): 300k
+// frames in few clusters (thousands of member blocks), queries near the
+// data and far from it (the far ones list most blocks), k = 1 and k = 16.
+TEST(VulkanClusterSearch, LargeDatabaseStaysExact) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const Database db = synthetic_database({.frames = 300000, .clips = 64, .seed = 111, .channel_dims = {2, 2}});
+  ThreadPool pool(2);
+  KMeansParams params;
+  params.clusters = 48;
+  params.iterations = 3;
+  Result<ClusterTable> table = train_cluster_table(db, params, pool);
+  ASSERT_TRUE(table.ok()) << table.message();
+  std::vector<float> queries = synthetic_queries(db, 48, 112);
+  for (std::size_t i = 0; i < 16 * db.dims(); ++i) queries.push_back(queries[i] + (i % 2 == 0 ? 40.0f : -25.0f));
+  for (const std::uint32_t k : {1u, 16u}) {
+    SCOPED_TRACE("k " + std::to_string(k));
+    vulkan::VulkanSearchOptions options;
+    options.warm_up = false;
+    options.mode = vulkan::SearchMode::ClustersExact;
+    options.max_batch = 64;
+    options.max_k = k;
+    auto gpu = vulkan::VulkanSearch::create(*context, db, options, &*table);
+    ASSERT_TRUE(gpu.ok()) << gpu.message();
+    const std::vector<Match> expected = reference_results(db, queries, {}, 64, k);
+    expect_identical(expected, run_search(**gpu, queries, {}, 64, k), k, {}, (*gpu)->name());
+  }
+}
+
+// A backend builds the pipelines of its own mode only (warm_up() runs each):
+// the cluster modes no brute-force kernel, brute force no cluster kernel.
+TEST(VulkanClusterSearch, BuildsOnlyItsModesKernels) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const Database db = synthetic_database({.frames = 2000, .seed = 113});
+  ClusterTableCache tables;
+  Result<const ClusterTable*> table = tables.table_for(db);
+  ASSERT_TRUE(table.ok()) << table.message();
+  const auto has = [](const std::vector<std::string_view>& names, std::string_view prefix) {
+    for (const std::string_view name : names) {
+      if (name.starts_with(prefix)) return true;
+    }
+    return false;
+  };
+  for (const vulkan::SearchMode mode :
+       {vulkan::SearchMode::BruteForce, vulkan::SearchMode::ClustersExact, vulkan::SearchMode::NProbe}) {
+    vulkan::VulkanSearchOptions options;
+    options.warm_up = false;
+    options.mode = mode;
+    options.max_k = 4;
+    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
+    ASSERT_TRUE(gpu.ok()) << gpu.message();
+    const std::vector<std::string_view> kernels = (*gpu)->kernels();
+    const bool brute = mode == vulkan::SearchMode::BruteForce;
+    EXPECT_EQ(has(kernels, "brute_force_scan") || has(kernels, "topk_merge"), brute) << (*gpu)->name();
+    EXPECT_EQ(has(kernels, "cluster_"), !brute) << (*gpu)->name();
+    // K classes 1 and 4: a scan and a merge each, plus bounds and select.
+    if (!brute) {
+      EXPECT_EQ(kernels.size(), 6u);
+    }
+    EXPECT_TRUE((*gpu)->warm_up().ok());
+  }
 }
 
 TEST(VulkanClusterSearch, CreationErrors) {

@@ -15,17 +15,38 @@ namespace mmvk::vulkan::detail {
 
 namespace {
 
-// Rows per member block, evaluated by kRowLanes invocations (8 rows each):
-// the unit of block-level culling. A block is a run of a cluster's members
-// in frame order (mostly neighbouring frames), so its box is much tighter
-// than its cluster's; ClusterSearch's 16-row tiles are the same idea.
-constexpr std::uint32_t kRowsPerBlock = 64;
+// Rows per member block (one scan invocation per (query, block)), the unit
+// of block-level culling: a block is a run of a cluster's members in frame
+// order (mostly neighbouring frames), so its box is much tighter than its
+// cluster's (ClusterSearch's 16-row tiles are the same idea). The smallest
+// of these whose loops fit (block_rows_for); on the Bandai volume set (417k
+// frames, transition queries, k = 1) 32 rows visited 2.9% of the rows and
+// 64 rows 3.9%.
+constexpr std::uint32_t kBlockRows[] = {32, 64, 128, 256, 512, 1024, 2048, 4096};
 // Loop limits of one invocation (llvmpipe stops loops at 65,535 iterations
 // in total): the round-0 merge walks the clusters, lists blocks and moves
-// them (cluster_count + 2 x blocks at most), the nprobe selection walks the
-// clusters 35 times.
+// them, the round-1 merge inserts K pairs per block visited (counted as K
+// iterations in case the compiler keeps that loop): at most
+// cluster_count + (2 + K) x blocks. The nprobe selection walks the clusters
+// 35 times.
 constexpr std::uint64_t kMaxLoopIterations = 60000;
 constexpr std::uint32_t kMaxProbeClusters = 1700;
+
+std::uint64_t loop_iterations(std::uint64_t clusters, std::uint64_t blocks, std::uint32_t k_class) {
+  return clusters + (2 + std::uint64_t{k_class}) * blocks;
+}
+
+// Rows per block for `table` and the largest K class, 0 when no size fits.
+std::uint32_t block_rows_for(const ClusterTable& table, std::uint32_t k_class) {
+  for (const std::uint32_t rows : kBlockRows) {
+    std::uint64_t blocks = 0;
+    for (std::uint32_t c = 0; c < table.cluster_count; ++c) {
+      blocks += (std::uint64_t{table.offsets[c + 1] - table.offsets[c]} + rows - 1) / rows;
+    }
+    if (loop_iterations(table.cluster_count, blocks, k_class) <= kMaxLoopIterations) return rows;
+  }
+  return 0;
+}
 
 // Between any two steps of a chunk: shader writes, the dispatch-argument
 // reset (a transfer) and indirect reads are all ordered.
@@ -79,7 +100,8 @@ void pack_block(const ClusterTable& table, const Database& database, std::uint32
   ++packed.block_count;
 }
 
-PackedTable pack_table(const ClusterTable& table, const Database& database, const KernelShape& shape) {
+PackedTable pack_table(const ClusterTable& table, const Database& database, const KernelShape& shape,
+                       std::uint32_t block_rows) {
   const std::uint32_t clusters = table.cluster_count;
   const std::uint32_t dv = shape.dim_vec4s;
   const std::uint32_t dims = shape.dims;
@@ -90,8 +112,8 @@ PackedTable pack_table(const ClusterTable& table, const Database& database, cons
     const std::uint32_t first = table.offsets[c];
     const std::uint32_t end = table.offsets[c + 1];
     const std::uint32_t first_block = packed.block_count;
-    for (std::uint32_t m = first; m < end; m += kRowsPerBlock) {
-      pack_block(table, database, c, m, std::min(end, m + kRowsPerBlock), dv, packed);
+    for (std::uint32_t m = first; m < end; m += block_rows) {
+      pack_block(table, database, c, m, std::min(end, m + block_rows), dv, packed);
     }
     const TagMask tag_union = table.tag_union[c];
     const TagMask tag_intersection = table.tag_intersection[c];
@@ -134,7 +156,7 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
     return make_error("Vulkan: nprobe search supports at most " + std::to_string(kMaxProbeClusters) +
                       " clusters, the table has " + std::to_string(table.cluster_count));
   }
-  MMVK_TRY(kernel.upload_table(context, pool, database, table, options.force_staging));
+  MMVK_TRY(kernel.upload_table(context, pool, database, table, k_class(options.max_k), options.force_staging));
   MMVK_TRY(kernel.create_layouts(context, search_layout, options.slots));
   MMVK_ASSIGN_OR_RETURN(const std::uint64_t chunk, kernel.size_scratch(context, options));
   MMVK_TRY(kernel.create_slots(context, options, chunk));
@@ -143,14 +165,15 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
 }
 
 Status ClusterKernel::upload_table(const Context& context, VkCommandPool pool, const Database& database,
-                                   const ClusterTable& table, bool force_staging) {
-  const PackedTable packed = pack_table(table, database, shape_);
-  if (table.cluster_count + 2 * std::uint64_t{packed.block_count} > kMaxLoopIterations) {
-    return make_error("Vulkan: the cluster table has " + std::to_string(table.cluster_count) + " clusters in " +
-                      std::to_string(packed.block_count) + " member blocks of " + std::to_string(kRowsPerBlock) +
-                      " rows; the cluster kernels support clusters + 2 x blocks <= " +
-                      std::to_string(kMaxLoopIterations));
+                                   const ClusterTable& table, std::uint32_t largest_k_class, bool force_staging) {
+  block_rows_ = block_rows_for(table, largest_k_class);
+  if (block_rows_ == 0) {
+    return make_error("Vulkan: the cluster table (" + std::to_string(table.cluster_count) +
+                      " clusters) needs more member blocks than the cluster kernels' loops allow (clusters + (2 + " +
+                      std::to_string(largest_k_class) + ") x blocks <= " + std::to_string(kMaxLoopIterations) +
+                      "); use fewer clusters or a smaller max_k");
   }
+  const PackedTable packed = pack_table(table, database, shape_, block_rows_);
   block_count_ = packed.block_count;
   const struct {
     TexelBuffer ClusterKernel::*member;

@@ -56,6 +56,7 @@ class ClusterKernel {
   std::vector<std::string_view> kernel_names() const;
   std::uint32_t cluster_count() const { return cluster_count_; }
   std::uint32_t block_count() const { return block_count_; }
+  std::uint32_t block_rows() const { return block_rows_; }
 
   // Records the search of queries [0, batch) into `commands` with the
   // slot's scratch; `search_set` is the slot's set 0 (query buffers,
@@ -84,7 +85,7 @@ class ClusterKernel {
   };
   // The steps of create(), in order.
   Status upload_table(const Context& context, VkCommandPool pool, const Database& database, const ClusterTable& table,
-                      bool force_staging);
+                      std::uint32_t largest_k_class, bool force_staging);
   Status create_layouts(const Context& context, VkDescriptorSetLayout search_layout, std::uint32_t slots);
   Result<std::uint64_t> size_scratch(const Context& context, const ClusterKernelOptions& options);
   Status create_slots(const Context& context, const ClusterKernelOptions& options, std::uint64_t chunk);
@@ -95,6 +96,7 @@ class ClusterKernel {
   KernelShape shape_;
   std::uint32_t cluster_count_ = 0;
   std::uint32_t block_count_ = 0;
+  std::uint32_t block_rows_ = 0;  // rows per member block
   std::uint32_t nprobe_ = 0;
   std::uint32_t max_batch_ = 1;
   std::uint64_t bound_capacity_ = 0;  // uvec2 per slot

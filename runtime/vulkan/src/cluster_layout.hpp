@@ -63,13 +63,11 @@ enum ClusterBinding : std::uint32_t {
 inline constexpr SetShape kClusterSet{5, 6};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
-// GLSL: kRowLanes, the invocations per member block.
-inline constexpr std::uint32_t kRowLanes = 8;
-// The workgroup size of cluster_scan (and cluster_bounds), every device
-// (Vulkan guarantees 128); GLSL: kItemsPerScanGroup = kScanWorkgroup / kRowLanes.
+// The workgroup size of cluster_scan (one invocation per work item) and
+// cluster_bounds, on every device (Vulkan guarantees 128); GLSL:
+// kItemsPerScanGroup.
 inline constexpr std::uint32_t kScanWorkgroup = 64;
-inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup / kRowLanes;
-static_assert(kItemsPerScanGroup == 8);
+inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup;
 
 // GLSL: ScanDispatch, per scan round (groups x, 1, 1, work items): the
 // indirect dispatch of cluster_scan, reset by the host before each chunk.

@@ -44,8 +44,12 @@ struct ClusterQueryState {
   uvec2 pad1;
 };
 
-// [frames] R32UI: ClusterTable::members (frame ids, cluster by cluster).
-layout(set = 1, binding = 0) uniform usamplerBuffer members;
+// The rows in cluster order (ClusterTable::members, cluster by cluster),
+// so that a block's rows are contiguous: the scans read them in place of
+// the frame-ordered database (random gathers of the same rows were
+// latency-bound on lavapipe).
+// [members] RGBA32UI: (frame, flags, tags low 32 bits, tags high 32 bits).
+layout(set = 1, binding = 0) uniform usamplerBuffer member_meta;
 // [blocks x 2] RGBA32UI: (cluster, first member, end member, AND of the
 // members' flags), (min multiplier bits, min bias bits, 0, 0) of the
 // block's members; a cluster's members (ascending frames) split into blocks
@@ -59,22 +63,26 @@ layout(set = 1, binding = 2) uniform usamplerBuffer cluster_info;
 layout(set = 1, binding = 3) uniform samplerBuffer cluster_vectors;
 // [blocks x 2 x DV] RGBA32F: each member block's box_min, box_max.
 layout(set = 1, binding = 4) uniform samplerBuffer block_vectors;
+// [members x DV] RGBA32F: the feature rows, padded like the database's.
+layout(set = 1, binding = 5) uniform samplerBuffer member_rows;
+// [members] RG32F: (cost multiplier, cost bias).
+layout(set = 1, binding = 6) uniform samplerBuffer member_cost;
 // [chunk x clusters]: (bound key, centroid distance key), kSkip when skipped.
-layout(std430, set = 1, binding = 5) buffer BoundKeys { uvec2 bound_keys[]; };
+layout(std430, set = 1, binding = 7) buffer BoundKeys { uvec2 bound_keys[]; };
 // [max_batch] per query state, indexed by the query's batch index.
-layout(std430, set = 1, binding = 6) buffer States { ClusterQueryState states[]; };
+layout(std430, set = 1, binding = 8) buffer States { ClusterQueryState states[]; };
 // [work items x K] the best (key, frame) pairs of each work item (round 0's
 // items, then round 1's; at most chunk x blocks).
-layout(std430, set = 1, binding = 7) buffer BlockPairs { uvec2 block_pairs[]; };
+layout(std430, set = 1, binding = 9) buffer BlockPairs { uvec2 block_pairs[]; };
 // Per scan round: (workgroups x, 1, 1, work items), the indirect dispatch
 // of cluster_scan (cluster_layout.hpp: kScanDispatchReset); the host
 // zeroes x and the count before each chunk.
-layout(std430, set = 1, binding = 8) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
+layout(std430, set = 1, binding = 10) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
 // [chunk x blocks] (local query, block): the work items, each query's
 // items of a round consecutive.
-layout(std430, set = 1, binding = 9) buffer WorkItems { uvec2 work_items[]; };
+layout(std430, set = 1, binding = 11) buffer WorkItems { uvec2 work_items[]; };
 // [chunk x blocks] per query: the blocks it lists, before they get their
 // place among the work items.
-layout(std430, set = 1, binding = 10) buffer Listed { uint listed[]; };
+layout(std430, set = 1, binding = 12) buffer Listed { uint listed[]; };
 
 #endif

@@ -64,6 +64,10 @@ struct PackedTable {
   std::vector<std::array<std::uint32_t, 4>> cluster_info;  // [clusters x 3]
   std::vector<float> vectors;                              // [clusters x 3 x dim_vec4s x 4]
   std::vector<float> block_vectors;                        // [blocks x 2 x dim_vec4s x 4]
+  // The rows in member order (cluster_layout.glsl: member_meta, member_rows, member_cost).
+  std::vector<std::array<std::uint32_t, 4>> member_meta;  // [members]
+  std::vector<float> member_rows;                         // [members x dim_vec4s x 4]
+  std::vector<std::array<float, 2>> member_cost;          // [members]
   std::uint32_t block_count = 0;
 };
 
@@ -106,6 +110,19 @@ PackedTable pack_table(const ClusterTable& table, const Database& database, cons
   const std::uint32_t dv = shape.dim_vec4s;
   const std::uint32_t dims = shape.dims;
   PackedTable packed;
+  const std::size_t member_count = table.members.size();
+  packed.member_meta.resize(member_count);
+  packed.member_rows.assign(member_count * dv * 4, 0.0f);
+  packed.member_cost.resize(member_count);
+  for (std::size_t m = 0; m < member_count; ++m) {
+    const std::uint32_t frame = table.members[m];
+    const TagMask tags = database.frame_tags()[frame];
+    packed.member_meta[m] = {frame, database.frame_flags()[frame], static_cast<std::uint32_t>(tags),
+                             static_cast<std::uint32_t>(tags >> 32)};
+    packed.member_cost[m] = {database.frame_multiplier()[frame], database.frame_bias()[frame]};
+    const std::span<const float> row = database.row(frame);
+    std::copy(row.begin(), row.end(), packed.member_rows.begin() + static_cast<std::ptrdiff_t>(m * dv * 4));
+  }
   packed.cluster_info.resize(std::size_t{clusters} * 3);
   packed.vectors.assign(std::size_t{clusters} * 3 * dv * 4, 0.0f);
   for (std::uint32_t c = 0; c < clusters; ++c) {
@@ -182,7 +199,12 @@ Status ClusterKernel::upload_table(const Context& context, VkCommandPool pool, c
     std::span<const std::byte> data;
     const char* what;
   } uploads[] = {
-      {&ClusterKernel::members_, VK_FORMAT_R32_UINT, 4, bytes_of(table.members), "the cluster members"},
+      {&ClusterKernel::member_meta_, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(packed.member_meta),
+       "the cluster members"},
+      {&ClusterKernel::member_rows_, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(packed.member_rows),
+       "the rows in cluster order"},
+      {&ClusterKernel::member_cost_, VK_FORMAT_R32G32_SFLOAT, 8, bytes_of(packed.member_cost),
+       "the cost terms in cluster order"},
       {&ClusterKernel::block_info_, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(packed.block_info),
        "the member blocks"},
       {&ClusterKernel::cluster_info_, VK_FORMAT_R32G32B32A32_UINT, 16, bytes_of(packed.cluster_info),
@@ -257,9 +279,9 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
       {&SlotScratch::listed, chunk * block_count_ * 4, storage, MemoryUse::DeviceLocal, "the cluster listed blocks"},
   };
   static_assert(std::size(buffers) == kClusterSet.storage);
-  const std::array<VkBufferView, kClusterSet.texel> views = {members_.view.get(), block_info_.view.get(),
-                                                             cluster_info_.view.get(), cluster_vectors_.view.get(),
-                                                             block_vectors_.view.get()};
+  const std::array<VkBufferView, kClusterSet.texel> views = {
+      member_meta_.view.get(),     block_info_.view.get(),  cluster_info_.view.get(), cluster_vectors_.view.get(),
+      block_vectors_.view.get(),   member_rows_.view.get(), member_cost_.view.get()};
   slots_.resize(options.slots);
   for (SlotScratch& slot : slots_) {
     std::array<VkBuffer, kClusterSet.storage> handles{};

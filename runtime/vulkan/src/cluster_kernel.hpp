@@ -106,7 +106,9 @@ class ClusterKernel {
   UniqueDescriptorSetLayout set_layout_;
   UniquePipelineLayout pipeline_layout_;
   UniqueDescriptorPool descriptor_pool_;
-  TexelBuffer members_;
+  TexelBuffer member_meta_;
+  TexelBuffer member_rows_;
+  TexelBuffer member_cost_;
   TexelBuffer block_info_;
   TexelBuffer cluster_info_;
   TexelBuffer cluster_vectors_;

@@ -47,20 +47,22 @@ static_assert(offsetof(ClusterQueryState, items1) == 32);
 // Descriptor bindings of set 1 (cluster_layout.glsl); set 0 is the search
 // layout (search_layout.hpp).
 enum ClusterBinding : std::uint32_t {
-  kBindingMembers = 0,         // uniform texel, R32UI
+  kBindingMemberMeta = 0,      // uniform texel, RGBA32UI
   kBindingBlockInfo = 1,       // uniform texel, RGBA32UI, 2 per block
   kBindingClusterInfo = 2,     // uniform texel, RGBA32UI
   kBindingClusterVectors = 3,  // uniform texel, RGBA32F
   kBindingBlockVectors = 4,    // uniform texel, RGBA32F
-  kBindingBoundKeys = 5,       // storage
-  kBindingStates = 6,          // storage
-  kBindingBlockPairs = 7,      // storage
-  kBindingScanDispatch = 8,    // storage + indirect
-  kBindingWorkItems = 9,       // storage
-  kBindingListed = 10,         // storage
-  kClusterBindingCount = 11,
+  kBindingMemberRows = 5,      // uniform texel, RGBA32F
+  kBindingMemberCost = 6,      // uniform texel, RG32F
+  kBindingBoundKeys = 7,       // storage
+  kBindingStates = 8,          // storage
+  kBindingBlockPairs = 9,      // storage
+  kBindingScanDispatch = 10,   // storage + indirect
+  kBindingWorkItems = 11,      // storage
+  kBindingListed = 12,         // storage
+  kClusterBindingCount = 13,
 };
-inline constexpr SetShape kClusterSet{5, 6};
+inline constexpr SetShape kClusterSet{7, 6};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
 // The workgroup size of cluster_scan (one invocation per work item) and

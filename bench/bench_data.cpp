@@ -5,10 +5,14 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
 #include <string>
 
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/feature_schema.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/thread_pool.hpp"
 
@@ -65,16 +69,33 @@ Result<Manifest> manifest_for(DataSet set) {
   if (set == DataSet::VolumeMirrored) {
     for (ManifestClip& clip : manifest->clips) clip.mirror = true;
   }
+  if (set == DataSet::Volume104k) {
+    // Every fourth clip: a quarter of the frames, spread over every kind of
+    // motion the set holds, the same subset on every machine.
+    std::vector<ManifestClip> kept;
+    for (std::size_t c = 0; c < manifest->clips.size(); c += 4) kept.push_back(manifest->clips[c]);
+    manifest->clips = std::move(kept);
+  }
   return manifest;
 }
 
-std::unique_ptr<Database> load_or_build(DataSet set) {
-  const fs::path cache = work_dir() / (std::string(data_set_name(set)) + ".mmdb");
+// What a database is built with, beside its data set.
+struct Variant {
+  std::string cache_name;
+  std::optional<FeatureSchema> schema;  // none: the manifest's (the default)
+  bool all_candidates = false;          // edge rule clamp
+  bool animation = true;
+};
+
+std::unique_ptr<Database> load_or_build(DataSet set, const Variant& variant) {
+  const fs::path cache = work_dir() / (variant.cache_name + ".mmdb");
   if (fs::exists(cache)) {
     Result<Database> loaded = load_database(cache);
     // A cache from before the animation section (format 1) is rebuilt: the
     // controller benchmarks need poses.
-    if (loaded && loaded->animation() != nullptr) return std::make_unique<Database>(std::move(loaded.value()));
+    if (loaded && (loaded->animation() != nullptr || !variant.animation)) {
+      return std::make_unique<Database>(std::move(loaded.value()));
+    }
     std::fprintf(stderr, "bench: ignoring cache: %s\n",
                  loaded ? "it has no animation section" : loaded.message().c_str());
   }
@@ -83,11 +104,14 @@ std::unique_ptr<Database> load_or_build(DataSet set) {
     std::fprintf(stderr, "bench: %s\n", manifest.message().c_str());
     return nullptr;
   }
-  std::fprintf(stderr, "bench: building the %s database from %zu clips\n", data_set_name(set).data(),
+  if (variant.schema) manifest->schema = *variant.schema;
+  if (variant.all_candidates) manifest->edge_rule = EdgeRule::Clamp;
+  std::fprintf(stderr, "bench: building the %s database from %zu clips\n", variant.cache_name.c_str(),
                manifest->clips.size());
   ThreadPool pool;
   BuildOptions options;
   options.pool = &pool;
+  options.animation.enabled = variant.animation;
   Result<Database> built = build_database(*manifest, options);
   if (!built) {
     std::fprintf(stderr, "bench: %s\n", built.message().c_str());
@@ -107,6 +131,7 @@ std::string_view data_set_name(DataSet set) {
     case DataSet::Locomotion: return "locomotion";
     case DataSet::Volume: return "volume";
     case DataSet::VolumeMirrored: return "volume-mirrored";
+    case DataSet::Volume104k: return "volume104k";
   }
   return "unknown";
 }
@@ -115,8 +140,41 @@ const Database* database(DataSet set) {
   // Benchmarks run on one thread; the cache lives as long as the process.
   static std::map<DataSet, std::unique_ptr<Database>> cache;
   auto found = cache.find(set);
-  if (found == cache.end()) found = cache.emplace(set, load_or_build(set)).first;
+  if (found == cache.end()) {
+    Variant variant;
+    variant.cache_name = data_set_name(set);
+    found = cache.emplace(set, load_or_build(set, variant)).first;
+  }
   return found->second.get();
+}
+
+std::string_view suite_schema_name(SuiteSchema schema) {
+  switch (schema) {
+    case SuiteSchema::Default27: return "default27";
+    case SuiteSchema::Wide60: return "wide60";
+  }
+  return "unknown";
+}
+
+const Database* suite_database(DataSet set, SuiteSchema schema) {
+  static std::map<std::pair<DataSet, SuiteSchema>, std::unique_ptr<Database>> cache;
+  auto found = cache.find({set, schema});
+  if (found != cache.end()) return found->second.get();
+  Variant variant;
+  variant.cache_name = std::string(data_set_name(set)) + "-" + std::string(suite_schema_name(schema)) + "-all";
+  variant.all_candidates = true;
+  variant.animation = false;
+  std::unique_ptr<Database> built;
+  if (schema == SuiteSchema::Wide60) {
+    Result<FeatureSchema> wide = load_schema(fs::path(MMVK_BENCH_SOURCE_DIR) / "schemas" / "wide60.json");
+    if (wide) {
+      variant.schema = std::move(wide.value());
+    } else {
+      std::fprintf(stderr, "bench: %s\n", wide.message().c_str());
+    }
+  }
+  if (schema == SuiteSchema::Default27 || variant.schema) built = load_or_build(set, variant);
+  return cache.emplace(std::make_pair(set, schema), std::move(built)).first->second.get();
 }
 
 }  // namespace mmvk::bench

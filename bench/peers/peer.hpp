@@ -1,0 +1,67 @@
+// What every peer of the benchmark suite is: a SearchBackend that answers
+// plain nearest neighbour (squared L2 over the normalized features), so the
+// suite times peers and mmvk's backends through one interface.
+//
+// Peers know nothing of mmvk's per-query constraints and per-clip costs, so
+// they only accept a database in which every frame is a candidate with
+// multiplier 1 and bias 0 (bench_data's suite_database), and batches with no
+// params (every query a plain one). Under those conditions mmvk's cost
+// (search.hpp) is exactly the squared L2 distance, accumulated per channel.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "mmvk/database.hpp"
+#include "mmvk/search.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk::peers {
+
+class PeerBackend : public SearchBackend {
+ public:
+  // Host bytes of the peer's own structures (copies of the rows, trees,
+  // boxes, centroids), beyond the Database it was made from.
+  virtual std::size_t index_bytes() const = 0;
+  // True when the peer returns the reference's frames (box-scan); FAISS flat
+  // is exact up to float near-ties and says false.
+  virtual bool exact() const = 0;
+};
+
+// Error naming `peer` unless every frame is a candidate (no flags) with
+// multiplier 1 and bias 0.
+Status check_plain_database(const Database& database, std::string_view peer);
+
+// validate_search plus: no per-query params.
+Status check_plain_batch(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out,
+                         std::string_view peer);
+
+// Where each channel's dims end ([channels]), for plain_cost and box bounds.
+std::vector<std::uint32_t> channel_ends(const Database& database);
+
+// The reference's cost of `row` for `query` with default params on a plain
+// database, in its accumulation order (a float sum per channel, then the
+// channel sums in schema order), so a peer that uses it returns costs
+// bit-identical to the reference. Both spans hold dims values.
+float plain_cost(const float* row, const float* query, std::span<const std::uint32_t> channel_end);
+
+// Keeps the best k (cost, frame) pairs seen so far, sorted by match_less.
+class TopK {
+ public:
+  explicit TopK(std::uint32_t k) : k_(k) { best_.reserve(k + 1); }
+  // The cost a new candidate must not exceed to enter (infinity until k
+  // candidates are held).
+  float threshold() const;
+  void offer(std::uint32_t frame, float cost);
+  // Writes the k slots (Match{} beyond the candidates held) and clears.
+  void write(std::span<Match> out);
+
+ private:
+  std::uint32_t k_;
+  std::vector<Match> best_;
+};
+
+}  // namespace mmvk::peers

@@ -49,6 +49,14 @@ float plain_cost(const float* row, const float* query, std::span<const std::uint
   return total;
 }
 
+bool is_float_near_tie(const Database& database, std::span<const float> query, const Match& best, std::uint32_t other) {
+  if (best.frame == kNoFrame || other >= database.frame_count()) return false;
+  double scale = 0.0;
+  const std::span<const float> row = database.row(best.frame);
+  for (std::size_t d = 0; d < query.size(); ++d) scale += double(query[d]) * query[d] + double(row[d]) * row[d];
+  return double(frame_cost(database, other, query, QueryParams{})) - best.cost <= 1e-5 * scale;
+}
+
 float TopK::threshold() const {
   return best_.size() < k_ ? std::numeric_limits<float>::infinity() : best_.back().cost;
 }

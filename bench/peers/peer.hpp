@@ -48,6 +48,14 @@ std::vector<std::uint32_t> channel_ends(const Database& database);
 // bit-identical to the reference. Both spans hold dims values.
 float plain_cost(const float* row, const float* query, std::span<const std::uint32_t> channel_end);
 
+// True when `other` is, by the reference's cost, within float rounding of
+// the exact best match `best` for `query`: its cost exceeds best.cost by at
+// most 1e-5 of ||q||^2 + ||x_best||^2, the scale at which FAISS's expansion
+// ||q||^2 + ||x||^2 - 2 q.x rounds (a few hundred ulp of it). A method that
+// returns such a frame instead of the reference's lost a float near-tie,
+// not a neighbour.
+bool is_float_near_tie(const Database& database, std::span<const float> query, const Match& best, std::uint32_t other);
+
 // Keeps the best k (cost, frame) pairs seen so far, sorted by match_less.
 class TopK {
  public:

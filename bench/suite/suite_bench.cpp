@@ -12,8 +12,9 @@
 // do not repeat one query. Databases, indexes and exact answers are built
 // on the first cell that needs them and kept for the process, so a filter
 // only pays for what it selects. Counters (README.md in bench/peers):
-// us_per_query, queries_per_s, rows_fraction, recall1, recall10, db_bytes,
-// index_bytes, device_bytes, build_s, kernel_us_per_query, N, dims.
+// us_per_query, queries_per_s, rows_fraction, recall1, recall10, near_ties,
+// recall_queries, db_bytes, index_bytes, device_bytes, build_s,
+// kernel_us_per_query, N, dims.
 //
 //   build/bench/mmvk_suite --benchmark_filter='suite/locomotion/default27/.*/B:(1|1024)'
 #include <benchmark/benchmark.h>
@@ -29,6 +30,7 @@
 #include <vector>
 
 #include "bench_data.hpp"
+#include "peer.hpp"
 #include "query_streams.hpp"
 #include "suite_methods.hpp"
 #include "suite_vulkan.hpp"
@@ -46,6 +48,10 @@ constexpr std::int64_t kBatches[] = {1, 64, 1024, 8192};
 
 struct Recall {
   double at1 = 0.0, at10 = 0.0;
+  // Queries whose top 1 differs from the exact one only by a float near-tie
+  // (peers::is_float_near_tie), and the queries measured (0: exact by
+  // construction, not measured).
+  double near_ties = 0.0, queries = 0.0;
 };
 
 // Everything the cells of one (dataset, schema) share.
@@ -94,7 +100,7 @@ struct Fixture {
   // which returns the reference's frames and cost bits) over the first
   // kRecallQueries queries of the stream.
   Result<Recall> measure_recall(const std::string& name, SuiteMethod& method, QueryStream stream) {
-    if (method.exact) return Recall{1.0, 1.0};
+    if (method.exact) return Recall{.at1 = 1.0, .at10 = 1.0};
     if (auto found = recall.find({stream, name}); found != recall.end()) return found->second;
     std::vector<Match>& exact = truth[stream];
     if (exact.empty()) {
@@ -110,10 +116,15 @@ struct Fixture {
     for (std::size_t q = 0; q < kRecallQueries; ++q) {
       const std::span<const Match> want(&exact[q * kRecallK], kRecallK), got(&found[q * kRecallK], kRecallK);
       r.at1 += got[0].frame == want[0].frame;
+      if (got[0].frame != want[0].frame) {
+        const std::span<const float> query = std::span(pool(stream)).subspan(q * db->dims(), db->dims());
+        r.near_ties += peers::is_float_near_tie(*db, query, want[0], got[0].frame);
+      }
       for (const Match& m : got) {
         r.at10 += std::any_of(want.begin(), want.end(), [&](const Match& w) { return w.frame == m.frame; });
       }
     }
+    r.queries = double(kRecallQueries);
     r.at1 /= double(kRecallQueries);
     r.at10 /= double(kRecallQueries * kRecallK);
     return recall[{stream, name}] = r;
@@ -189,6 +200,8 @@ void run_cell(benchmark::State& state, DataSet set, SuiteSchema schema, QueryStr
       stats.queries == 0 ? std::numeric_limits<double>::quiet_NaN() : stats.rows_fraction(db.frame_count());
   state.counters["recall1"] = recall->at1;
   state.counters["recall10"] = recall->at10;
+  state.counters["near_ties"] = recall->near_ties;
+  state.counters["recall_queries"] = recall->queries;
   state.counters["db_bytes"] = double(db.features().size() * sizeof(float));
   state.counters["index_bytes"] = method->index_bytes;
   state.counters["device_bytes"] = method->device_bytes;

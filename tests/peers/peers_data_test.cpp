@@ -133,10 +133,9 @@ void expect_flat_agrees(bool one_at_a_time) {
       worst_cost_error = std::max(worst_cost_error, std::abs(double(got[q].cost) - best) / scale);
       if (got[q].frame == want[q].frame) continue;
       ASSERT_NE(got[q].frame, kNoFrame);
-      const float theirs = frame_cost(*db, got[q].frame, query, {});
-      EXPECT_LE(double(theirs) - best, 1e-5 * scale)
+      EXPECT_TRUE(peers::is_float_near_tie(*db, query, want[q], got[q].frame))
           << (*flat)->name() << " stream " << bench::query_stream_name(stream) << " query " << q << ": frame "
-          << got[q].frame << " costs " << theirs << ", the reference's frame " << want[q].frame << " " << best;
+          << got[q].frame << " costs " << frame_cost(*db, got[q].frame, query, {}) << ", the reference's frame " << want[q].frame << " " << best;
       ++near_ties;
     }
   }
@@ -145,6 +144,25 @@ void expect_flat_agrees(bool one_at_a_time) {
               std::string((*flat)->name()).c_str(), near_ties, queries_run, worst_cost_error);
   EXPECT_LE(near_ties, queries_run / 100) << "near-ties should be rare";
   EXPECT_LT(worst_cost_error, 1e-5);
+}
+
+TEST(PeersData, NearTieRuleAcceptsRoundingAndRefusesANeighbour) {
+  MMVK_PLAIN_DB(db);
+  ReferenceSearch reference(*db);
+  const std::vector<float> queries = bench::make_queries(*db, bench::QueryStream::Continue, 16, 7);
+  const std::vector<Match> best = search(reference, queries, 1);
+  std::size_t refused = 0;
+  for (std::size_t q = 0; q < 16; ++q) {
+    const std::span<const float> query = std::span(queries).subspan(q * db->dims(), db->dims());
+    EXPECT_TRUE(peers::is_float_near_tie(*db, query, best[q], best[q].frame));
+    // A frame half the database away: a real neighbour, not a rounding.
+    const std::uint32_t far = (best[q].frame + db->frame_count() / 2) % db->frame_count();
+    if (frame_cost(*db, far, query, {}) > best[q].cost + 1.0f) {
+      EXPECT_FALSE(peers::is_float_near_tie(*db, query, best[q], far)) << q;
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 8u);
 }
 
 TEST(PeersData, FaissFlatBatchedAgreesWithTheReferenceUpToNearTies) { expect_flat_agrees(false); }

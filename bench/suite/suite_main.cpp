@@ -3,7 +3,7 @@
 // FAISS runs on OpenMP, and GNU OpenMP's idle threads spin for a while
 // before sleeping (OMP_WAIT_POLICY unset). On a machine shared with other
 // jobs, spinning threads hold the cores the threads doing the work need:
-// measured here, faiss-flat at B = 1024 on locomotion took 7x longer than
+// measured here, faiss-flat at B = 1024 on locomotion took about 5x longer than
 // with OMP_WAIT_POLICY=passive, while mmvk's own thread pool, which sleeps
 // on a condition variable, was unaffected. libgomp reads the variable when
 // it is loaded, before main(), so the suite sets it and runs itself again

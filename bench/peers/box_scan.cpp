@@ -24,7 +24,7 @@ void fill_boxes(const Database& db, std::uint32_t frames_per_box, std::vector<fl
 
 }  // namespace
 
-BoxScan::BoxScan(const Database& database) : database_(database), channel_end_(channel_ends(database)) {
+BoxScan::BoxScan(const Database& database) : PeerBackend(database, "box-scan"), channel_end_(channel_ends(database)) {
   fill_boxes(database, kSmallBoxFrames, small_.lo, small_.hi);
   fill_boxes(database, kLargeBoxFrames, large_.lo, large_.hi);
 }

@@ -28,11 +28,7 @@ class BoxScan final : public PeerBackend {
   // `database` must outlive the backend and be plain (check_plain_database).
   static Result<std::unique_ptr<BoxScan>> create(const Database& database);
 
-  std::string_view name() const override { return "box-scan"; }
-  const Database& database() const override { return database_; }
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
-  SearchStats stats() const override { return stats_; }
-  void reset_stats() override { stats_ = {}; }
   std::size_t index_bytes() const override;
   bool exact() const override { return true; }
 
@@ -43,10 +39,8 @@ class BoxScan final : public PeerBackend {
   explicit BoxScan(const Database& database);
   float bound(const Boxes& boxes, std::size_t box, const float* query) const;
 
-  const Database& database_;
   std::vector<std::uint32_t> channel_end_;
   Boxes small_, large_;
-  SearchStats stats_;
 };
 
 }  // namespace mmvk::peers

@@ -41,18 +41,16 @@ void to_matches(const std::vector<faiss::Index::idx_t>& labels, const std::vecto
 class FaissFlat final : public PeerBackend {
  public:
   FaissFlat(const Database& database, bool one_at_a_time)
-      : database_(database), one_at_a_time_(one_at_a_time), index_(static_cast<faiss::Index::idx_t>(database.dims())) {}
+      : PeerBackend(database, one_at_a_time ? "faiss-flat-1q" : "faiss-flat"),
+        one_at_a_time_(one_at_a_time),
+        index_(static_cast<faiss::Index::idx_t>(database.dims())) {}
 
   Status fill() {
     return guarded(name(), [&] { index_.add(database_.frame_count(), database_.features().data()); });
   }
 
-  std::string_view name() const override { return one_at_a_time_ ? "faiss-flat-1q" : "faiss-flat"; }
-  const Database& database() const override { return database_; }
   std::size_t index_bytes() const override { return index_.codes.size(); }
   bool exact() const override { return false; }
-  SearchStats stats() const override { return stats_; }
-  void reset_stats() override { stats_ = {}; }
 
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override {
     MMVK_TRY(check_plain_batch(database_, batch, k, out, name()));
@@ -75,24 +73,18 @@ class FaissFlat final : public PeerBackend {
   }
 
  private:
-  const Database& database_;
   bool one_at_a_time_;
   faiss::IndexFlatL2 index_;
   std::vector<faiss::Index::idx_t> labels_;
   std::vector<float> distances_;
-  SearchStats stats_;
 };
 
 class FaissIvf final : public PeerBackend {
  public:
   FaissIvf(const Database& database, std::shared_ptr<FaissIvfIndex> index, std::uint32_t nprobe)
-      : database_(database), index_(std::move(index)), nprobe_(nprobe), name_("faiss-ivf" + std::to_string(nprobe)) {}
+      : PeerBackend(database, "faiss-ivf" + std::to_string(nprobe)), index_(std::move(index)), nprobe_(nprobe) {}
 
-  std::string_view name() const override { return name_; }
-  const Database& database() const override { return database_; }
   bool exact() const override { return false; }
-  SearchStats stats() const override { return stats_; }
-  void reset_stats() override { stats_ = {}; }
   std::size_t index_bytes() const override {
     const faiss::IndexIVFFlat& ivf = *index_->ivf;
     // The stored rows and their ids, plus the centroids.
@@ -118,13 +110,10 @@ class FaissIvf final : public PeerBackend {
   }
 
  private:
-  const Database& database_;
   std::shared_ptr<FaissIvfIndex> index_;
   std::uint32_t nprobe_;
-  std::string name_;
   std::vector<faiss::Index::idx_t> labels_;
   std::vector<float> distances_;
-  SearchStats stats_;
 };
 
 std::filesystem::path seconds_file(const std::filesystem::path& cache) {

@@ -135,17 +135,12 @@ namespace {
 class PcaKdTree final : public PeerBackend {
  public:
   PcaKdTree(const Database& database, std::shared_ptr<PcaKdTreeIndex> index, std::uint32_t candidates)
-      : database_(database),
+      : PeerBackend(database, "pca-kdtree" + std::to_string(candidates)),
         index_(std::move(index)),
         candidates_(std::min(candidates, database.frame_count())),
-        name_("pca-kdtree" + std::to_string(candidates)),
         channel_end_(channel_ends(database)) {}
 
-  std::string_view name() const override { return name_; }
-  const Database& database() const override { return database_; }
   bool exact() const override { return false; }
-  SearchStats stats() const override { return stats_; }
-  void reset_stats() override { stats_ = {}; }
   std::size_t index_bytes() const override {
     Tree& tree = *index_->tree;
     // The tree's nodes and its row index array, the projections, the axes.
@@ -173,14 +168,11 @@ class PcaKdTree final : public PeerBackend {
   }
 
  private:
-  const Database& database_;
   std::shared_ptr<PcaKdTreeIndex> index_;
   std::uint32_t candidates_;
-  std::string name_;
   std::vector<std::uint32_t> channel_end_;
   std::vector<float> projected_, distances_;
   std::vector<std::uint32_t> ids_;
-  SearchStats stats_;
 };
 
 }  // namespace

@@ -12,7 +12,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "mmvk/database.hpp"
@@ -21,14 +23,28 @@
 
 namespace mmvk::peers {
 
+// The database, the name and the counters every peer keeps.
 class PeerBackend : public SearchBackend {
  public:
+  std::string_view name() const override { return name_; }
+  const Database& database() const override { return database_; }
+  SearchStats stats() const override { return stats_; }
+  void reset_stats() override { stats_ = {}; }
+
   // Host bytes of the peer's own structures (copies of the rows, trees,
   // boxes, centroids), beyond the Database it was made from.
   virtual std::size_t index_bytes() const = 0;
   // True when the peer returns the reference's frames (box-scan); FAISS flat
   // is exact up to float near-ties and says false.
   virtual bool exact() const = 0;
+
+ protected:
+  // `database` must outlive the peer.
+  PeerBackend(const Database& database, std::string name) : database_(database), name_(std::move(name)) {}
+
+  const Database& database_;
+  std::string name_;
+  SearchStats stats_;
 };
 
 // Error naming `peer` unless every frame is a candidate (no flags) with

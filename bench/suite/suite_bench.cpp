@@ -10,8 +10,9 @@
 // Each (dataset, schema) draws a pool of 8192 queries per stream; iteration
 // i searches queries [i*B, i*B + B) of the pool, wrapping, so small batches
 // do not repeat one query. Databases, indexes and exact answers are built
-// on the first cell that needs them and kept for the process, so a filter
-// only pays for what it selects. Counters (README.md in bench/peers):
+// on the first cell that needs them, so a filter only pays for what it
+// selects; cells run (dataset, schema) by (dataset, schema) and method by
+// method, and only the current ones are kept in memory. Counters (README.md in bench/peers):
 // us_per_query, queries_per_s, rows_fraction, recall1, recall10, near_ties,
 // recall_queries, db_bytes, index_bytes, device_bytes, build_s,
 // kernel_us_per_query, N, dims.
@@ -54,13 +55,18 @@ struct Recall {
   double near_ties = 0.0, queries = 0.0;
 };
 
-// Everything the cells of one (dataset, schema) share.
+// Everything the cells of one (dataset, schema) share. Cells run in
+// registration order, method by method (see `registered`), so the fixture
+// keeps one method alive at a time: the 834k-frame sets hold hundreds of MB
+// per backend (tiled copies, FAISS's copies, lavapipe's device memory).
 struct Fixture {
   const Database* db = nullptr;
   std::unique_ptr<SuiteMethodFactory> factory;
   std::map<QueryStream, std::vector<float>> queries;
   std::map<QueryStream, std::vector<Match>> truth;  // [kRecallQueries x kRecallK]
-  std::map<std::string, std::unique_ptr<SuiteMethod>> methods;
+  std::unique_ptr<SuiteMethod> oracle;              // fast-brute, for the truth
+  std::string current_name;
+  std::unique_ptr<SuiteMethod> current;
   std::map<std::string, std::string> method_errors;
   std::map<std::pair<QueryStream, std::string>, Recall> recall;
 
@@ -72,11 +78,12 @@ struct Fixture {
 
   // nullptr after setting `error`.
   SuiteMethod* method(const std::string& name, std::string& error) {
-    if (auto found = methods.find(name); found != methods.end()) return found->second.get();
+    if (current && current_name == name) return current.get();
     if (auto failed = method_errors.find(name); failed != method_errors.end()) {
       error = failed->second;
       return nullptr;
     }
+    current.reset();  // before making the next one: one method's memory at a time
     std::fprintf(stderr, "suite: making %s over %u frames x %u dims\n", name.c_str(), db->frame_count(), db->dims());
     Result<SuiteMethod> made = factory->make(name);
     if (!made) {
@@ -84,7 +91,9 @@ struct Fixture {
       std::fprintf(stderr, "suite: %s: %s\n", name.c_str(), error.c_str());
       return nullptr;
     }
-    return (methods[name] = std::make_unique<SuiteMethod>(std::move(made.value()))).get();
+    current_name = name;
+    current = std::make_unique<SuiteMethod>(std::move(made.value()));
+    return current.get();
   }
 
   Status search(SearchBackend& backend, QueryStream stream, std::size_t first, std::size_t count, std::uint32_t k,
@@ -104,11 +113,13 @@ struct Fixture {
     if (auto found = recall.find({stream, name}); found != recall.end()) return found->second;
     std::vector<Match>& exact = truth[stream];
     if (exact.empty()) {
-      std::string error;
-      SuiteMethod* brute = this->method("fast-brute", error);
-      if (brute == nullptr) return make_error(error);
+      if (!oracle) {
+        Result<SuiteMethod> brute = factory->make("fast-brute");
+        if (!brute) return brute.error();
+        oracle = std::make_unique<SuiteMethod>(std::move(brute.value()));
+      }
       exact.resize(kRecallQueries * kRecallK);
-      MMVK_TRY(search(*brute->backend, stream, 0, kRecallQueries, kRecallK, exact));
+      MMVK_TRY(search(*oracle->backend, stream, 0, kRecallQueries, kRecallK, exact));
     }
     std::vector<Match> found(kRecallQueries * kRecallK);
     MMVK_TRY(search(*method.backend, stream, 0, kRecallQueries, kRecallK, found));
@@ -134,10 +145,14 @@ struct Fixture {
 struct Suite {
   Suite() { prepare_vulkan_context(); }  // first, so it outlives the fixtures' Vulkan backends
   ThreadPool pool;  // every core, shared by the threaded backends
-  std::map<std::pair<DataSet, SuiteSchema>, std::unique_ptr<Fixture>> fixtures;
+  // One (dataset, schema) at a time, as cells run in that order.
+  std::pair<DataSet, SuiteSchema> key;
+  std::unique_ptr<Fixture> current;
 
   Fixture* fixture(DataSet set, SuiteSchema schema) {
-    std::unique_ptr<Fixture>& f = fixtures[{set, schema}];
+    if (current && key != std::make_pair(set, schema)) current.reset();
+    key = {set, schema};
+    std::unique_ptr<Fixture>& f = current;
     if (!f) {
       f = std::make_unique<Fixture>();
       f->db = suite_database(set, schema);
@@ -211,11 +226,14 @@ void run_cell(benchmark::State& state, DataSet set, SuiteSchema schema, QueryStr
   state.counters["dims"] = db.dims();
 }
 
+// Registered dataset, schema, method, stream, batch: the order the cells
+// run in, so each method is made once per (dataset, schema) and dropped
+// before the next (Fixture). The names keep the agreed order.
 const bool registered = [] {
   for (const DataSet set : kSets) {
     for (const SuiteSchema schema : kSchemas) {
-      for (const QueryStream stream : kStreams) {
-        for (const std::string& method : suite_method_names()) {
+      for (const std::string& method : suite_method_names()) {
+        for (const QueryStream stream : kStreams) {
           const std::string name = "suite/" + std::string(data_set_name(set)) + "/" +
                                    std::string(suite_schema_name(schema)) + "/" + std::string(query_stream_name(stream)) +
                                    "/" + method;

@@ -54,6 +54,14 @@ struct DatabaseParts {
   std::vector<Clip> clips;                      // contiguous, in frame order, covering all frames
   std::vector<std::uint32_t> frame_flags;       // [frames], FrameFlag bits
   std::vector<float> features;                  // [frames x dims], normalized, row-major
+  // Per-frame tags and cost modifiers, each [frames] or empty. Empty means
+  // every frame takes its clip's value; set, they are the frames' complete
+  // values (a manifest's tag_ranges and cost_ranges: the clip's tags OR the
+  // ranges' tags, the clip's multiplier times the ranges' multipliers, the
+  // clip's bias plus the ranges' biases; database_build.hpp).
+  std::vector<TagMask> frame_tags;
+  std::vector<float> frame_multiplier;          // each finite and > 0
+  std::vector<float> frame_bias;                // each finite
   // The skeleton and per-frame poses (animation_data.hpp); absent in a
   // database built with --no-animation or loaded from a format 1 file.
   std::optional<AnimationData> animation;
@@ -62,7 +70,8 @@ struct DatabaseParts {
 class Database {
  public:
   // Validates: schema, dims, finite features, positive scales, clip ranges,
-  // tag masks within tag_names, multipliers > 0, finite biases.
+  // tag masks within tag_names, multipliers > 0, finite biases (per clip and
+  // per frame).
   static Result<Database> create(DatabaseParts parts);
 
   const FeatureSchema& schema() const { return parts_.schema; }
@@ -79,8 +88,9 @@ class Database {
   // The animation section, or null when the database has none.
   const AnimationData* animation() const { return parts_.animation ? &*parts_.animation : nullptr; }
 
-  // Per-frame metadata, [frame_count] each (the clip's values repeated, so
-  // backends index them by frame without a lookup).
+  // Per-frame metadata, [frame_count] each (the clip's values repeated, or
+  // DatabaseParts' per-frame values, so backends index them by frame without
+  // a lookup).
   std::span<const std::uint32_t> frame_flags() const { return parts_.frame_flags; }
   std::span<const std::uint32_t> frame_clip() const { return frame_clip_; }
   std::span<const TagMask> frame_tags() const { return frame_tags_; }
@@ -89,6 +99,9 @@ class Database {
   // [dims]: the largest |value| of each dimension over all rows, so a search
   // can bound a query's costs before computing them (validate_search).
   std::span<const float> max_abs_features() const { return max_abs_features_; }
+  // The largest frame_multiplier() and |frame_bias()| (for the same bound).
+  float max_multiplier() const { return max_multiplier_; }
+  float max_abs_bias() const { return max_abs_bias_; }
 
   // Mask of the named tags; an unknown name is an error that names it.
   Result<TagMask> tag_mask(std::span<const std::string> names) const;
@@ -114,6 +127,8 @@ class Database {
   std::vector<float> frame_multiplier_;
   std::vector<float> frame_bias_;
   std::vector<float> max_abs_features_;
+  float max_multiplier_ = 0.0f;
+  float max_abs_bias_ = 0.0f;
   std::uint64_t content_hash_ = 0;
 };
 

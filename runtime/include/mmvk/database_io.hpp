@@ -15,6 +15,10 @@
 //                              f32 cost bias, u32 first frame, u32 frame count
 //                         u32  frames, then frames x u32 frame flags
 //                         f32  features [frames x dims], row-major, normalized
+//                         u8   1 when per-frame modifiers follow, else 0 (version 3):
+//                              u64 tags [frames], f32 cost multiplier [frames],
+//                              f32 cost bias [frames] (the manifest's tag_ranges
+//                              and cost_ranges; without them the clips' values hold)
 //                         u8   1 when the animation section follows, else 0 (version 2)
 //                         the animation section (version 2, animation_data.hpp):
 //                              u32 joints, then per joint: str name, i32 parent,
@@ -48,9 +52,10 @@
 
 namespace mmvk {
 
-// Version 2 adds the optional animation section; version 1 files still load
-// (features only, Database::animation() null).
-inline constexpr std::uint32_t kDatabaseFormatVersion = 2;
+// Version 2 adds the optional animation section, version 3 the optional
+// per-frame tags and cost modifiers; version 1 and 2 files still load
+// (version 1: features only, Database::animation() null).
+inline constexpr std::uint32_t kDatabaseFormatVersion = 3;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 
 // The file's bytes.

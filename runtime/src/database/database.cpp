@@ -10,6 +10,36 @@ namespace mmvk {
 
 namespace {
 
+// The optional per-frame tags, multipliers and biases of DatabaseParts.
+Status validate_frame_modifiers(const DatabaseParts& parts, TagMask valid_tags) {
+  const std::size_t frames = parts.frame_flags.size();
+  auto sized = [&](std::size_t size, const char* what) -> Status {
+    if (size == 0 || size == frames) return {};
+    return make_error("database: " + std::string(what) + " has " + std::to_string(size) + " values for " +
+                      std::to_string(frames) + " frames");
+  };
+  MMVK_TRY(sized(parts.frame_tags.size(), "per-frame tags"));
+  MMVK_TRY(sized(parts.frame_multiplier.size(), "per-frame cost multiplier"));
+  MMVK_TRY(sized(parts.frame_bias.size(), "per-frame cost bias"));
+  for (std::size_t f = 0; f < parts.frame_tags.size(); ++f) {
+    if ((parts.frame_tags[f] & ~valid_tags) != 0) {
+      return make_error("database: frame " + std::to_string(f) + " has tag bits beyond the tag names");
+    }
+  }
+  for (std::size_t f = 0; f < parts.frame_multiplier.size(); ++f) {
+    const float m = parts.frame_multiplier[f];
+    if (!(m > 0.0f) || !std::isfinite(m)) {
+      return make_error("database: frame " + std::to_string(f) + ": cost multiplier must be finite and > 0");
+    }
+  }
+  for (std::size_t f = 0; f < parts.frame_bias.size(); ++f) {
+    if (!std::isfinite(parts.frame_bias[f])) {
+      return make_error("database: frame " + std::to_string(f) + ": cost bias must be finite");
+    }
+  }
+  return {};
+}
+
 Status validate_parts(const DatabaseParts& parts) {
   MMVK_TRY(parts.schema.validate());
   const std::uint32_t dims = parts.schema.dims();
@@ -64,6 +94,7 @@ Status validate_parts(const DatabaseParts& parts) {
     return make_error("database: clips cover " + std::to_string(next_frame) + " frames, the database has " +
                       std::to_string(frames));
   }
+  MMVK_TRY(validate_frame_modifiers(parts, valid_tags));
   const std::uint32_t known_flags = kFrameDoNotUse | kFrameBlockTransition | kFrameEdgeExcluded;
   for (std::size_t f = 0; f < frames; ++f) {
     if ((parts.frame_flags[f] & ~known_flags) != 0) {
@@ -105,6 +136,13 @@ Database::Database(DatabaseParts parts) : parts_(std::move(parts)) {
       frame_multiplier_[f] = clip.cost_multiplier;
       frame_bias_[f] = clip.cost_bias;
     }
+  }
+  if (!parts_.frame_tags.empty()) frame_tags_ = parts_.frame_tags;
+  if (!parts_.frame_multiplier.empty()) frame_multiplier_ = parts_.frame_multiplier;
+  if (!parts_.frame_bias.empty()) frame_bias_ = parts_.frame_bias;
+  for (std::uint32_t f = 0; f < frame_count_; ++f) {
+    max_multiplier_ = std::max(max_multiplier_, frame_multiplier_[f]);
+    max_abs_bias_ = std::max(max_abs_bias_, std::fabs(frame_bias_[f]));
   }
   max_abs_features_.assign(dims_, 0.0f);
   for (std::size_t i = 0; i < parts_.features.size(); ++i) {

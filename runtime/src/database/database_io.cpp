@@ -274,6 +274,15 @@ std::string serialize_database(const Database& database) {
   file.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
   for (std::uint32_t flags : parts.frame_flags) file.u32(flags);
   file.f32_array(parts.features);
+  const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
+  file.u8(per_frame ? 1 : 0);
+  if (per_frame) {
+    // The complete per-frame values (the Database's, which fill in the clip
+    // values for whichever array the parts left empty).
+    for (const TagMask tags : database.frame_tags()) file.u64(tags);
+    file.f32_array(database.frame_multiplier());
+    file.f32_array(database.frame_bias());
+  }
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
 
@@ -300,7 +309,7 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
                       std::to_string(kDatabaseHeaderBytes + 8) + ")");
   }
   const std::uint32_t version = read_u32_at(bytes, 8);
-  if (version != kDatabaseFormatVersion && version != 1) {
+  if (version < 1 || version > kDatabaseFormatVersion) {
     return make_error(source + ": unsupported mmvk database version " + std::to_string(version) + " (this build reads versions 1 to " +
                       std::to_string(kDatabaseFormatVersion) + ")");
   }
@@ -383,6 +392,19 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
   }
   parts.features.resize(values);
   in.f32_array(parts.features);
+  if (version >= 3) {
+    std::uint8_t per_frame = 0;
+    if (!in.u8(per_frame) || per_frame > 1) return corrupt("per-frame modifiers presence byte");
+    if (per_frame) {
+      if (std::uint64_t{frames} * 16 + 1 > in.left()) return corrupt("per-frame modifiers of " + std::to_string(frames) + " frames");
+      parts.frame_tags.resize(frames);
+      for (TagMask& tags : parts.frame_tags) (void)in.u64(tags);
+      parts.frame_multiplier.resize(frames);
+      in.f32_array(parts.frame_multiplier);
+      parts.frame_bias.resize(frames);
+      in.f32_array(parts.frame_bias);
+    }
+  }
   if (version >= 2) {
     std::uint8_t has_animation = 0;
     if (!in.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");

@@ -74,12 +74,8 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
   // Costs are float sums; a query that is finite but far outside the data
   // (or a huge weight) would turn every cost into +inf and "win" with
   // garbage. Half of FLT_MAX leaves room for the float rounding of the sums.
-  double max_multiplier = 0.0;
-  double max_abs_bias = 0.0;
-  for (const Clip& clip : database.clips()) {
-    max_multiplier = std::max(max_multiplier, double(clip.cost_multiplier));
-    max_abs_bias = std::max(max_abs_bias, std::fabs(double(clip.cost_bias)));
-  }
+  const double max_multiplier = database.max_multiplier();
+  const double max_abs_bias = database.max_abs_bias();
   const double limit = 0.5 * double(std::numeric_limits<float>::max());
   const QueryParams defaults;
   for (std::size_t q = 0; q < batch.size; ++q) {

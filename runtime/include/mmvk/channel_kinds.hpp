@@ -48,7 +48,7 @@ enum class DimsRule : std::uint8_t {
 // What a mirrored clip (manifest "mirror") does to the kind's values.
 enum class MirrorRule : std::uint8_t {
   Remeasured,  // extracted again from the mirrored motion (roles then name the mirrored joints)
-  Unchanged,   // copied unchanged from the source clip (sidecar values)
+  Unchanged,   // copied from the source clip (sidecar values), through the manifest's mirror_map when it has an entry
 };
 
 namespace detail {

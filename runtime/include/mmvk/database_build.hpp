@@ -8,7 +8,10 @@
 //     source rates are an error naming two files that disagree.
 //   - Mirroring: a clip with mirror = true is followed by its mirrored copy,
 //     a separate clip named "<name>_mirrored" with Clip::mirrored set and the
-//     same tags, flags and costs. Custom channel values are copied unchanged.
+//     same tags, flags and costs. Joints pair by mirror_pairs() with the
+//     manifest's mirror_bones over the name heuristics; custom (sidecar)
+//     channel values follow the manifest's mirror_map (copied unchanged
+//     without an entry).
 //   - Edge rule (non-looping clips): a frame whose furthest trajectory offset
 //     (round(max offset_seconds x fps) frames ahead) lies past the clip's last
 //     frame is flagged kFrameEdgeExcluded with EdgeRule::Exclude, and kept as
@@ -16,7 +19,13 @@
 //     EdgeRule::Clamp. Looping clips wrap and never get the flag.
 //   - Time ranges: frame f of a clip is in [begin, end) seconds when
 //     begin <= f / fps < end; do_not_use sets kFrameDoNotUse,
-//     block_transition sets kFrameBlockTransition.
+//     block_transition sets kFrameBlockTransition; a frame in a tag range
+//     carries its tag, and cost ranges multiply its multiplier and add to
+//     its bias (manifest.hpp). Tag and cost ranges must lie inside their
+//     clip, else the error names the manifest and the field
+//     ("db.json: clips[2].tag_ranges.jump[0]: ... lies outside the clip").
+//     With any of them, the database stores per-frame tags and costs
+//     (DatabaseParts::frame_tags and the others), which every backend reads.
 //   - Normalization statistics are taken over every frame of the database
 //     (normalization.hpp); tags are numbered in order of first appearance.
 //   - Skeletons may differ between clips as long as the schema's bones

@@ -9,15 +9,27 @@
 //   "character_root": { "source_bone": "@hips", "facing_smoothing_seconds": 0.5 },
 //   "edge_rule": "exclude" | "clamp",                    // default "exclude"
 //   "mirror": false,           // add a mirrored copy of every clip
+//   "mirror_bones": [["LeftFoot", "RightFoot"], ["@left_hand", "Hand_R"]],
+//                              // left/right pairs that override the name heuristics
+//   "mirror_map": { "phase": { "swap": [[0, 2], [1, 3]], "negate": [4] } },
+//                              // how a custom (sidecar) channel's dims mirror
 //   "clips": [
 //     { "file": "walk.bvh",    // relative paths are relative to the manifest's folder
 //       "name": "walk",        // default: the file name without extension
 //       "tags": ["walk"], "loop": false, "mirror": false,
 //       "cost_multiplier": 1.0, "cost_bias": 0.0,
 //       "do_not_use": [[0.0, 0.5]],         // [begin, end) in seconds
-//       "block_transition": [[2.0, 2.5]] }
+//       "block_transition": [[2.0, 2.5]],
+//       "tag_ranges": { "jump": [[1.0, 1.6]] },   // tags on time ranges only
+//       "cost_ranges": [ { "range": [1.0, 1.6], "cost_multiplier": 2.0, "cost_bias": 0.1 } ] }
 //   ]
 // }
+// A frame's tags are its clip's tags plus those of every tag range it lies
+// in; its cost multiplier is the clip's times those of the cost ranges it
+// lies in, its bias the clip's plus theirs. A tag or cost range must lie
+// inside its clip (begin before the clip's end, end at most one frame past
+// it, at least one frame covered); the build checks that, since only it
+// knows the clip's length, and names the manifest and field.
 // Error messages name the manifest and the field: "db.json: clips[2].loop:
 // expected true or false".
 #pragma once
@@ -47,6 +59,19 @@ struct TimeRange {
   float end_seconds = 0.0f;
 };
 
+// A tag over a time range of a clip (manifest "tag_ranges").
+struct TagRange {
+  std::string tag;
+  TimeRange range;
+};
+
+// A cost adjustment over a time range of a clip (manifest "cost_ranges").
+struct CostRange {
+  TimeRange range;
+  float cost_multiplier = 1.0f;  // > 0, multiplies the clip's
+  float cost_bias = 0.0f;        // finite, added to the clip's
+};
+
 struct ManifestClip {
   std::filesystem::path file;      // the BVH file (resolved: absolute or relative to the working directory)
   std::string name;                // unique per database is not required
@@ -57,6 +82,21 @@ struct ManifestClip {
   float cost_bias = 0.0f;          // finite
   std::vector<TimeRange> do_not_use;
   std::vector<TimeRange> block_transition;
+  std::vector<TagRange> tag_ranges;    // in the manifest's order: per tag, its ranges
+  std::vector<CostRange> cost_ranges;
+  // The clip's place in the manifest for messages ("db.json: clips[2]");
+  // empty for clips made in code.
+  std::string field;
+};
+
+// How a sidecar channel's values mirror (manifest "mirror_map"): dim d of a
+// mirrored frame is sign[d] * (dim source[d] of the source frame). "swap"
+// pairs exchange two dims, "negate" flips the sign of a dim of the result.
+// Sidecar channels without an entry are copied unchanged.
+struct SidecarMirror {
+  std::string channel;               // a custom channel of the schema
+  std::vector<std::uint32_t> source; // [custom_dims]
+  std::vector<float> sign;           // [custom_dims], +1 or -1
 };
 
 struct Manifest {
@@ -66,6 +106,8 @@ struct Manifest {
   ImportOptions import;
   CharacterRootOptions character_root;
   EdgeRule edge_rule = EdgeRule::Exclude;
+  std::vector<BonePair> mirror_bones;     // overrides mirror_pairs()' heuristics
+  std::vector<SidecarMirror> mirror_map;
   std::vector<ManifestClip> clips;
 };
 

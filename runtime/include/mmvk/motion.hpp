@@ -105,6 +105,22 @@ Result<Motion> resample(const Motion& motion, float fps);
 // partners, inconsistent sizes.
 Result<Motion> mirror(const Motion& motion);
 
+// A user's left/right pair (manifest "mirror_bones"): joint names or bone
+// roles ("@left_foot", find_bone()). A pair of one joint with itself says
+// the joint has no partner.
+struct BonePair {
+  std::string first;
+  std::string second;
+};
+
+// mirror() with a user pair table that overrides the name heuristics: each
+// joint the table names gets the table's partner; a heuristic pair that
+// involves a named joint is dropped; the other joints keep the heuristics.
+// Errors name the pair: "mirror_bones[1][0]: bone 'X' not found ...", a
+// joint named twice.
+Result<Motion> mirror(const Motion& motion, std::span<const BonePair> pairs);
+Result<std::vector<int>> mirror_pairs(const Skeleton& skeleton, std::span<const BonePair> pairs);
+
 // Index of each joint's mirror partner (itself when it has none). Names are
 // paired when swapping a side marker gives another joint's name: "Left" <->
 // "Right" (any case, anywhere: LeftUpLeg, leftEye, mixamorig:LeftFoot), a

@@ -151,7 +151,7 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
 }
 
 Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, const FootContactParams& contacts,
-                                         RotationEncoding encoding) {
+                                         RotationEncoding encoding, std::span<const BonePair> mirror_bones) {
   if (clips.empty()) return make_error("animation: no clips");
   const ClipAnimation& first = clips[0];
   const std::size_t joints = first.skeleton.size();
@@ -166,7 +166,9 @@ Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, c
   }
   AnimationData out;
   out.skeleton = first.skeleton;
-  out.mirror_pairs = mirror_pairs(out.skeleton);
+  Result<std::vector<int>> pairs = mirror_pairs(out.skeleton, mirror_bones);
+  if (!pairs.ok()) return make_error("animation: " + pairs.message());
+  out.mirror_pairs = std::move(*pairs);
   out.contact_params = contacts;
   out.encoding = encoding;
   out.contact_joints = first.contact_joints;

@@ -41,6 +41,7 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
 // (names or parents), naming both files (the build then leaves the section
 // out and passes the message on as a warning).
 Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, const FootContactParams& contacts,
-                                         RotationEncoding encoding);
+                                         RotationEncoding encoding,
+                                         std::span<const BonePair> mirror_bones = {});
 
 }  // namespace mmvk::detail

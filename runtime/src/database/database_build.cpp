@@ -25,15 +25,82 @@ struct ProcessedClip {
   std::vector<std::uint32_t> flags;  // [frames]
   float fps = 0.0f;
   detail::ClipAnimation animation;   // empty when the build stores no animation
+  std::vector<TagRange> tag_ranges;  // numbered into masks at assembly
+  // [frames] each when the clip has cost ranges, else empty (the clip's values).
+  std::vector<float> multiplier;
+  std::vector<float> bias;
 };
+
+bool in_range(std::size_t frame, float fps, const TimeRange& range) {
+  const double t = static_cast<double>(frame) / fps;
+  return t >= range.begin_seconds && t < range.end_seconds;
+}
 
 void flag_ranges(std::span<const TimeRange> ranges, float fps, std::uint32_t flag, std::vector<std::uint32_t>& flags) {
   for (const TimeRange& range : ranges) {
     for (std::size_t f = 0; f < flags.size(); ++f) {
-      const double t = static_cast<double>(f) / fps;
-      if (t >= range.begin_seconds && t < range.end_seconds) flags[f] |= flag;
+      if (in_range(f, fps, range)) flags[f] |= flag;
     }
   }
+}
+
+// A tag or cost range must cover at least one frame and end at most one frame
+// past the clip (a range written up to the clip's length in seconds is fine).
+Status check_inside(const TimeRange& range, std::uint32_t frames, float fps, const std::string& field) {
+  const double duration = double(frames) / fps;
+  std::uint32_t covered = 0;
+  for (std::uint32_t f = 0; f < frames; ++f) covered += in_range(f, fps, range) ? 1u : 0u;
+  if (covered > 0 && double(range.end_seconds) <= duration + 1.0 / fps) return {};
+  char text[200];
+  std::snprintf(text, sizeof(text), ": [%g, %g) s lies %s the clip (%u frames, %.4g s at %g fps)",
+                double(range.begin_seconds), double(range.end_seconds), covered == 0 ? "outside" : "partly outside",
+                frames, duration, double(fps));
+  return make_error(field + text);
+}
+
+// Per-frame multipliers and biases from the clip's and its cost ranges.
+Status apply_time_ranges(const ManifestClip& meta, std::uint32_t frames, float fps, ProcessedClip& out) {
+  const std::string field = meta.field.empty() ? meta.file.string() + ": clip '" + meta.name + "'" : meta.field;
+  for (std::size_t i = 0; i < meta.tag_ranges.size(); ++i) {
+    const TagRange& tag = meta.tag_ranges[i];
+    std::size_t index = 0;
+    for (std::size_t j = 0; j < i; ++j) index += meta.tag_ranges[j].tag == tag.tag ? 1 : 0;
+    MMVK_TRY(check_inside(tag.range, frames, fps,
+                          field + ".tag_ranges." + tag.tag + "[" + std::to_string(index) + "]"));
+  }
+  out.tag_ranges = meta.tag_ranges;
+  if (meta.cost_ranges.empty()) return {};
+  out.multiplier.assign(frames, meta.cost_multiplier);
+  out.bias.assign(frames, meta.cost_bias);
+  for (std::size_t i = 0; i < meta.cost_ranges.size(); ++i) {
+    const CostRange& cost = meta.cost_ranges[i];
+    MMVK_TRY(check_inside(cost.range, frames, fps, field + ".cost_ranges[" + std::to_string(i) + "].range"));
+    for (std::uint32_t f = 0; f < frames; ++f) {
+      if (!in_range(f, fps, cost.range)) continue;
+      out.multiplier[f] *= cost.cost_multiplier;
+      out.bias[f] += cost.cost_bias;
+    }
+  }
+  for (std::uint32_t f = 0; f < frames; ++f) {
+    if (!(out.multiplier[f] > 0.0f) || !std::isfinite(out.multiplier[f]) || !std::isfinite(out.bias[f])) {
+      return make_error(field + ".cost_ranges: frame " + std::to_string(f) +
+                        "'s product of multipliers or sum of biases is not finite and positive");
+    }
+  }
+  return {};
+}
+
+// The index of `tag` in `names`, adding it; errors past kMaxTags.
+Result<std::size_t> tag_index(std::vector<std::string>& names, const std::string& tag, const std::string& source,
+                              const std::string& clip) {
+  auto it = std::find(names.begin(), names.end(), tag);
+  if (it != names.end()) return static_cast<std::size_t>(it - names.begin());
+  if (names.size() == kMaxTags) {
+    return make_error(source + ": more than " + std::to_string(kMaxTags) + " distinct tags (clip '" + clip +
+                      "' adds '" + tag + "')");
+  }
+  names.push_back(tag);
+  return names.size() - 1;
 }
 
 // The plausibility rule of database_build.hpp, on one clip's raw features.
@@ -92,6 +159,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   }
   flag_ranges(meta.do_not_use, motion.fps, kFrameDoNotUse, out.flags);
   flag_ranges(meta.block_transition, motion.fps, kFrameBlockTransition, out.flags);
+  MMVK_TRY(apply_time_ranges(meta, motion.frame_count, motion.fps, out));
   out.raw = std::move(*raw);
   if (settings.animation.enabled) {
     Result<detail::ClipAnimation> animation =
@@ -107,7 +175,8 @@ bool same_rate(float a, float b) { return std::abs(a - b) <= 1e-3f * std::max(a,
 
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
-                          const AnimationBuildOptions& animation, const std::string& source) {
+                          const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
+                          const std::string& source) {
   if (clips.empty()) return make_error(source + ": no clips");
   DatabaseParts parts;
   parts.schema = schema;
@@ -122,7 +191,7 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
     std::vector<detail::ClipAnimation> animations;
     animations.reserve(clips.size());
     for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
-    Result<AnimationData> data = detail::assemble_animation(animations, animation.contacts, animation.encoding);
+    Result<AnimationData> data = detail::assemble_animation(animations, animation.contacts, animation.encoding, mirror_bones);
     if (data.ok()) {
       parts.animation = std::move(*data);
     } else if (animation.warning) {
@@ -131,20 +200,41 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
       animation.warning(source + ": " + data.message());
     }
   }
+  bool per_frame = false;  // per-frame tags and costs are stored (some clip has time ranges)
   for (ProcessedClip& processed : clips) {
     Clip clip = processed.clip;
     clip.first_frame = static_cast<std::uint32_t>(parts.frame_flags.size());
     for (const std::string& tag : processed.tags) {
-      auto it = std::find(parts.tag_names.begin(), parts.tag_names.end(), tag);
-      std::size_t index = static_cast<std::size_t>(it - parts.tag_names.begin());
-      if (it == parts.tag_names.end()) {
-        if (parts.tag_names.size() == kMaxTags) {
-          return make_error(source + ": more than " + std::to_string(kMaxTags) + " distinct tags (clip '" + clip.name +
-                            "' adds '" + tag + "')");
-        }
-        parts.tag_names.push_back(tag);
-      }
+      MMVK_ASSIGN_OR_RETURN(const std::size_t index, tag_index(parts.tag_names, tag, source, clip.name));
       clip.tags |= TagMask{1} << index;
+    }
+    // Per-frame arrays only when some clip has time ranges; the first such
+    // clip fills them in for the clips before it.
+    const bool ranged = !processed.tag_ranges.empty() || !processed.multiplier.empty();
+    if (ranged && !per_frame) {
+      per_frame = true;
+      for (const Clip& before : parts.clips) {
+        parts.frame_tags.insert(parts.frame_tags.end(), before.frame_count, before.tags);
+        parts.frame_multiplier.insert(parts.frame_multiplier.end(), before.frame_count, before.cost_multiplier);
+        parts.frame_bias.insert(parts.frame_bias.end(), before.frame_count, before.cost_bias);
+      }
+    }
+    if (per_frame) {
+      const std::size_t first = parts.frame_tags.size();
+      parts.frame_tags.insert(parts.frame_tags.end(), clip.frame_count, clip.tags);
+      for (const TagRange& range : processed.tag_ranges) {
+        MMVK_ASSIGN_OR_RETURN(const std::size_t index, tag_index(parts.tag_names, range.tag, source, clip.name));
+        for (std::uint32_t f = 0; f < clip.frame_count; ++f) {
+          if (in_range(f, processed.fps, range.range)) parts.frame_tags[first + f] |= TagMask{1} << index;
+        }
+      }
+      if (processed.multiplier.empty()) {
+        parts.frame_multiplier.insert(parts.frame_multiplier.end(), clip.frame_count, clip.cost_multiplier);
+        parts.frame_bias.insert(parts.frame_bias.end(), clip.frame_count, clip.cost_bias);
+      } else {
+        parts.frame_multiplier.insert(parts.frame_multiplier.end(), processed.multiplier.begin(), processed.multiplier.end());
+        parts.frame_bias.insert(parts.frame_bias.end(), processed.bias.begin(), processed.bias.end());
+      }
     }
     parts.features.insert(parts.features.end(), processed.raw.values.begin(), processed.raw.values.end());
     parts.frame_flags.insert(parts.frame_flags.end(), processed.flags.begin(), processed.flags.end());
@@ -174,6 +264,26 @@ struct LoadedClip {
   float source_fps = 0.0f;
   std::vector<ProcessedClip> clips;
 };
+
+// Applies the manifest's mirror map to the clip's sidecar values (in
+// place: the mirrored copy is the last user).
+void mirror_sidecars(const Manifest& manifest, std::vector<std::vector<float>>& custom) {
+  for (std::size_t i = 0, c = 0; c < manifest.schema.channels.size(); ++c) {
+    const FeatureChannel& channel = manifest.schema.channels[c];
+    if (!reads_sidecar(channel.kind)) continue;
+    std::vector<float>& values = custom[i++];
+    for (const SidecarMirror& map : manifest.mirror_map) {
+      if (map.channel != channel.name) continue;
+      const std::size_t dims = channel.custom_dims;
+      std::vector<float> row(dims);
+      for (std::size_t f = 0; f < values.size() / dims; ++f) {
+        float* frame = values.data() + f * dims;
+        for (std::size_t d = 0; d < dims; ++d) row[d] = map.sign[d] * frame[map.source[d]];
+        std::copy(row.begin(), row.end(), frame);
+      }
+    }
+  }
+}
 
 LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const AnimationBuildOptions& animation) {
   LoadedClip out;
@@ -212,8 +322,12 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
   if (!processed.ok()) return fail(processed.message());
   out.clips.push_back(std::move(*processed));
   if (meta.mirror) {
-    Result<Motion> mirrored = mirror(*motion);
-    if (!mirrored.ok()) return fail(meta.file.string() + ": mirroring: " + mirrored.message());
+    Result<Motion> mirrored = mirror(*motion, manifest.mirror_bones);
+    if (!mirrored.ok()) {
+      return fail((manifest.mirror_bones.empty() ? "" : manifest.source + ": ") + meta.file.string() +
+                  ": mirroring: " + mirrored.message());
+    }
+    mirror_sidecars(manifest, custom);
     Result<ProcessedClip> processed_mirror = process_motion(meta, *mirrored, custom, true, settings);
     if (!processed_mirror.ok()) return fail(processed_mirror.message());
     out.clips.push_back(std::move(*processed_mirror));
@@ -281,7 +395,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     for (ProcessedClip& processed : clip.clips) clips.push_back(std::move(processed));
     clip.clips.clear();
   }
-  return assemble(clips, manifest.schema, fps, options.animation, source);
+  return assemble(clips, manifest.schema, fps, options.animation, manifest.mirror_bones, source);
 }
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings) {
@@ -298,7 +412,7 @@ Result<Database> build_database_from_motions(std::span<const MotionClip> clips, 
     if (!one.ok()) return one.error();
     processed.push_back(std::move(*one));
   }
-  return assemble(processed, settings.schema, fps, settings.animation, "build_database_from_motions");
+  return assemble(processed, settings.schema, fps, settings.animation, {}, "build_database_from_motions");
 }
 
 }  // namespace mmvk

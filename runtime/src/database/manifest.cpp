@@ -38,24 +38,74 @@ Result<std::string> read_string(const Json& value, const std::string& where) {
   return value.get<std::string>();
 }
 
+Result<TimeRange> read_range(const Json& pair, const std::string& at) {
+  if (!pair.is_array() || pair.size() != 2) return make_error(at + ": expected [begin, end] in seconds");
+  Result<float> begin = json_float(pair[0], at + "[0]");
+  if (!begin.ok()) return begin.error();
+  Result<float> end = json_float(pair[1], at + "[1]");
+  if (!end.ok()) return end.error();
+  if (*begin < 0.0f || !(*end > *begin)) {
+    return make_error(at + ": expected 0 <= begin < end, got [" + std::to_string(*begin) + ", " +
+                      std::to_string(*end) + "]");
+  }
+  return TimeRange{*begin, *end};
+}
+
 Result<std::vector<TimeRange>> read_ranges(const Json& value, const std::string& where) {
   if (!value.is_array()) return make_error(where + ": expected an array of [begin, end] pairs in seconds");
   std::vector<TimeRange> ranges;
   for (std::size_t i = 0; i < value.size(); ++i) {
-    const std::string at = where + "[" + std::to_string(i) + "]";
-    const Json& pair = value[i];
-    if (!pair.is_array() || pair.size() != 2) return make_error(at + ": expected [begin, end] in seconds");
-    Result<float> begin = json_float(pair[0], at + "[0]");
-    if (!begin.ok()) return begin.error();
-    Result<float> end = json_float(pair[1], at + "[1]");
-    if (!end.ok()) return end.error();
-    if (*begin < 0.0f || !(*end > *begin)) {
-      return make_error(at + ": expected 0 <= begin < end, got [" + std::to_string(*begin) + ", " +
-                        std::to_string(*end) + "]");
-    }
-    ranges.push_back({*begin, *end});
+    Result<TimeRange> range = read_range(value[i], where + "[" + std::to_string(i) + "]");
+    if (!range.ok()) return range.error();
+    ranges.push_back(*range);
   }
   return ranges;
+}
+
+Result<float> read_multiplier(const Json& value, const std::string& where) {
+  Result<float> multiplier = json_float(value, where);
+  if (multiplier.ok() && !(*multiplier > 0.0f)) return make_error(where + ": must be > 0");
+  return multiplier;
+}
+
+Result<std::vector<TagRange>> read_tag_ranges(const Json& value, const std::string& where) {
+  if (!value.is_object()) return make_error(where + ": expected an object {\"tag\": [[begin, end], ...]}");
+  std::vector<TagRange> out;
+  for (const auto& item : value.items()) {
+    if (item.key().empty()) return make_error(where + ": empty tag name");
+    Result<std::vector<TimeRange>> ranges = read_ranges(item.value(), where + "." + item.key());
+    if (!ranges.ok()) return ranges.error();
+    for (const TimeRange& range : *ranges) out.push_back({item.key(), range});
+  }
+  return out;
+}
+
+Result<std::vector<CostRange>> read_cost_ranges(const Json& value, const std::string& where) {
+  if (!value.is_array()) return make_error(where + ": expected an array of {\"range\": [begin, end], \"cost_multiplier\", \"cost_bias\"}");
+  std::vector<CostRange> out;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string at = where + "[" + std::to_string(i) + "]";
+    const Json& object = value[i];
+    if (!object.is_object()) return make_error(at + ": expected an object with \"range\"");
+    MMVK_TRY(check_fields(object, at, {"range", "cost_multiplier", "cost_bias"}));
+    if (!object.contains("range")) return make_error(at + ".range: missing");
+    Result<TimeRange> range = read_range(object["range"], at + ".range");
+    if (!range.ok()) return range.error();
+    CostRange cost;
+    cost.range = *range;
+    if (object.contains("cost_multiplier")) {
+      Result<float> m = read_multiplier(object["cost_multiplier"], at + ".cost_multiplier");
+      if (!m.ok()) return m.error();
+      cost.cost_multiplier = *m;
+    }
+    if (object.contains("cost_bias")) {
+      Result<float> b = json_float(object["cost_bias"], at + ".cost_bias");
+      if (!b.ok()) return b.error();
+      cost.cost_bias = *b;
+    }
+    out.push_back(cost);
+  }
+  return out;
 }
 
 // Assigns a parsed value to an existing target or returns its error; one
@@ -71,6 +121,7 @@ Result<std::vector<TimeRange>> read_ranges(const Json& value, const std::string&
 Result<ManifestClip> parse_clip(const Json& object, const std::string& where, const std::filesystem::path& base_dir) {
   if (object.is_string()) {
     ManifestClip clip;
+    clip.field = where;
     clip.file = base_dir / object.get<std::string>();
     clip.name = clip.file.stem().string();
     return clip;
@@ -78,8 +129,9 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (!object.is_object()) return make_error(where + ": expected an object (or a file name)");
   MMVK_TRY(check_fields(object, where,
                         {"file", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias", "do_not_use",
-                         "block_transition"}));
+                         "block_transition", "tag_ranges", "cost_ranges"}));
   ManifestClip clip;
+  clip.field = where;
   if (!object.contains("file")) return make_error(where + ".file: missing");
   std::string file;
   MMVK_READ(file, read_string(object["file"], where + ".file"));
@@ -100,8 +152,7 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (object.contains("loop")) MMVK_READ(clip.loop, read_bool(object["loop"], where + ".loop"));
   if (object.contains("mirror")) MMVK_READ(clip.mirror, read_bool(object["mirror"], where + ".mirror"));
   if (object.contains("cost_multiplier")) {
-    MMVK_READ(clip.cost_multiplier, json_float(object["cost_multiplier"], where + ".cost_multiplier"));
-    if (!(clip.cost_multiplier > 0.0f)) return make_error(where + ".cost_multiplier: must be > 0");
+    MMVK_READ(clip.cost_multiplier, read_multiplier(object["cost_multiplier"], where + ".cost_multiplier"));
   }
   if (object.contains("cost_bias")) MMVK_READ(clip.cost_bias, json_float(object["cost_bias"], where + ".cost_bias"));
   if (object.contains("do_not_use")) {
@@ -110,7 +161,101 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (object.contains("block_transition")) {
     MMVK_READ(clip.block_transition, read_ranges(object["block_transition"], where + ".block_transition"));
   }
+  if (object.contains("tag_ranges")) {
+    MMVK_READ(clip.tag_ranges, read_tag_ranges(object["tag_ranges"], where + ".tag_ranges"));
+  }
+  if (object.contains("cost_ranges")) {
+    MMVK_READ(clip.cost_ranges, read_cost_ranges(object["cost_ranges"], where + ".cost_ranges"));
+  }
   return clip;
+}
+
+Result<std::vector<BonePair>> read_bone_pairs(const Json& value, const std::string& where) {
+  if (!value.is_array()) return make_error(where + ": expected an array of [left, right] bone names");
+  std::vector<BonePair> out;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string at = where + "[" + std::to_string(i) + "]";
+    const Json& pair = value[i];
+    if (!pair.is_array() || pair.size() != 2) return make_error(at + ": expected [left, right] bone names");
+    BonePair bones;
+    MMVK_READ(bones.first, read_string(pair[0], at + "[0]"));
+    MMVK_READ(bones.second, read_string(pair[1], at + "[1]"));
+    if (bones.first.empty()) return make_error(at + "[0]: empty bone name");
+    if (bones.second.empty()) return make_error(at + "[1]: empty bone name");
+    out.push_back(std::move(bones));
+  }
+  return out;
+}
+
+Result<std::uint32_t> read_dim(const Json& value, std::uint32_t dims, const std::string& where) {
+  if (!value.is_number_integer() || value.get<std::int64_t>() < 0 || value.get<std::int64_t>() >= dims) {
+    return make_error(where + ": expected a dim index in [0, " + std::to_string(dims) + ")");
+  }
+  return static_cast<std::uint32_t>(value.get<std::int64_t>());
+}
+
+Result<SidecarMirror> read_sidecar_mirror(const Json& value, const FeatureChannel& channel, const std::string& where) {
+  if (!value.is_object()) return make_error(where + ": expected an object with \"swap\" and/or \"negate\"");
+  MMVK_TRY(check_fields(value, where, {"swap", "negate"}));
+  const std::uint32_t dims = channel.custom_dims;
+  SidecarMirror out;
+  out.channel = channel.name;
+  out.sign.assign(dims, 1.0f);
+  for (std::uint32_t d = 0; d < dims; ++d) out.source.push_back(d);
+  std::vector<bool> swapped(dims, false);
+  if (value.contains("swap")) {
+    const Json& swaps = value["swap"];
+    if (!swaps.is_array()) return make_error(where + ".swap: expected an array of [dim, dim] pairs");
+    for (std::size_t i = 0; i < swaps.size(); ++i) {
+      const std::string at = where + ".swap[" + std::to_string(i) + "]";
+      if (!swaps[i].is_array() || swaps[i].size() != 2) return make_error(at + ": expected [dim, dim]");
+      std::uint32_t a = 0;
+      std::uint32_t b = 0;
+      MMVK_READ(a, read_dim(swaps[i][0], dims, at + "[0]"));
+      MMVK_READ(b, read_dim(swaps[i][1], dims, at + "[1]"));
+      if (a == b) return make_error(at + ": a dim cannot swap with itself");
+      if (swapped[a] || swapped[b]) {
+        return make_error(at + ": dim " + std::to_string(swapped[a] ? a : b) + " is already in an earlier swap");
+      }
+      swapped[a] = swapped[b] = true;
+      out.source[a] = b;
+      out.source[b] = a;
+    }
+  }
+  if (value.contains("negate")) {
+    const Json& negate = value["negate"];
+    if (!negate.is_array()) return make_error(where + ".negate: expected an array of dims");
+    for (std::size_t i = 0; i < negate.size(); ++i) {
+      const std::string at = where + ".negate[" + std::to_string(i) + "]";
+      std::uint32_t d = 0;
+      MMVK_READ(d, read_dim(negate[i], dims, at));
+      if (out.sign[d] < 0.0f) return make_error(at + ": dim " + std::to_string(d) + " is listed twice");
+      out.sign[d] = -1.0f;
+    }
+  }
+  return out;
+}
+
+Result<std::vector<SidecarMirror>> read_mirror_map(const Json& value, const FeatureSchema& schema,
+                                                   const std::string& where) {
+  if (!value.is_object()) return make_error(where + ": expected an object {\"channel\": {\"swap\", \"negate\"}}");
+  std::vector<SidecarMirror> out;
+  for (const auto& item : value.items()) {
+    const std::string at = where + "." + item.key();
+    const FeatureChannel* channel = nullptr;
+    for (const FeatureChannel& c : schema.channels) {
+      if (c.name == item.key()) channel = &c;
+    }
+    if (!channel) return make_error(at + ": the schema has no channel named '" + item.key() + "'");
+    if (!reads_sidecar(channel->kind)) {
+      return make_error(at + ": channel '" + item.key() + "' is a " + std::string(channel_kind_name(channel->kind)) +
+                        " channel, measured again on the mirrored motion; only sidecar (custom) channels take a mirror map");
+    }
+    Result<SidecarMirror> mirror = read_sidecar_mirror(item.value(), *channel, at);
+    if (!mirror.ok()) return mirror.error();
+    out.push_back(std::move(*mirror));
+  }
+  return out;
 }
 
 bool is_bvh(const std::filesystem::path& path) {
@@ -128,7 +273,8 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   if (!parsed.ok()) return parsed.error();
   const Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"clips\"");
-  MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "clips"}));
+  MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "mirror_bones",
+                                          "mirror_map", "clips"}));
 
   Manifest manifest;
   manifest.source = name;
@@ -208,6 +354,12 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   }
   bool mirror_all = false;
   if (root.contains("mirror")) MMVK_READ(mirror_all, read_bool(root["mirror"], at + "mirror"));
+  if (root.contains("mirror_bones")) {
+    MMVK_READ(manifest.mirror_bones, read_bone_pairs(root["mirror_bones"], at + "mirror_bones"));
+  }
+  if (root.contains("mirror_map")) {
+    MMVK_READ(manifest.mirror_map, read_mirror_map(root["mirror_map"], manifest.schema, at + "mirror_map"));
+  }
   if (!root.contains("clips") || !root["clips"].is_array()) {
     return make_error(at + "clips: expected an array of clips");
   }

@@ -22,6 +22,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "mmvk/character.hpp"
 #include "mmvk/motion.hpp"
 
 namespace mmvk {
@@ -144,7 +145,43 @@ std::vector<int> mirror_pairs(const Skeleton& skeleton) {
   return pairs;
 }
 
-Result<Motion> mirror(const Motion& motion) {
+Result<std::vector<int>> mirror_pairs(const Skeleton& skeleton, std::span<const BonePair> table) {
+  std::vector<int> pairs = mirror_pairs(skeleton);
+  if (table.empty()) return pairs;
+  const std::size_t n = skeleton.size();
+  std::vector<int> named(n, -1);  // the table's partner of each joint it names
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const std::string field = "mirror_bones[" + std::to_string(i) + "]";
+    int ends[2] = {-1, -1};
+    for (int k = 0; k < 2; ++k) {
+      const std::string& bone = k == 0 ? table[i].first : table[i].second;
+      Result<int> index = find_bone(skeleton, bone);
+      if (!index.ok()) return make_error(field + "[" + std::to_string(k) + "]: " + index.message());
+      ends[k] = *index;
+    }
+    for (int k = 0; k < 2; ++k) {
+      const std::size_t j = static_cast<std::size_t>(ends[k]);
+      if (named[j] >= 0 && !(ends[0] == ends[1] && k == 1)) {
+        return make_error(field + "[" + std::to_string(k) + "]: joint " + skeleton.names[j] +
+                          " is already in an earlier pair");
+      }
+      named[j] = ends[1 - k];
+    }
+  }
+  // Heuristic partners of named joints lose their pair; named joints take
+  // the table's. The result stays an involution.
+  for (std::size_t j = 0; j < n; ++j) {
+    if (named[j] < 0 && named[static_cast<std::size_t>(pairs[j])] >= 0) pairs[j] = static_cast<int>(j);
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    if (named[j] >= 0) pairs[j] = named[j];
+  }
+  return pairs;
+}
+
+Result<Motion> mirror(const Motion& motion) { return mirror(motion, {}); }
+
+Result<Motion> mirror(const Motion& motion, std::span<const BonePair> table) {
   const Skeleton& skeleton = motion.skeleton;
   const std::size_t n = skeleton.size();
   if (skeleton.parents.size() != n || skeleton.rest_offsets.size() != n) {
@@ -153,7 +190,7 @@ Result<Motion> mirror(const Motion& motion) {
   if (motion.local_positions.size() != motion.frame_count * n || motion.local_rotations.size() != motion.frame_count * n) {
     return make_error("mirror: local transforms are not sized frame_count x joints");
   }
-  const std::vector<int> pairs = mirror_pairs(skeleton);
+  MMVK_ASSIGN_OR_RETURN(const std::vector<int> pairs, mirror_pairs(skeleton, table));
   for (std::size_t j = 0; j < n; ++j) {
     const int parent = skeleton.parents[j];
     if (parent >= static_cast<int>(j)) return make_error("mirror: joint " + skeleton.names[j] + " follows its child");

@@ -99,9 +99,10 @@ int run_inspect(Args args) {
   for (const Clip& clip : db.clips()) {
     mirrored += clip.mirrored;
     looping += clip.loop;
-    for (std::size_t t = 0; t < tag_frames.size(); ++t) {
-      if (clip.tags & (TagMask{1} << t)) tag_frames[t] += clip.frame_count;
-    }
+  }
+  // Per frame: tags on time ranges (manifest tag_ranges) cover part of a clip.
+  for (const TagMask tags : db.frame_tags()) {
+    for (std::size_t t = 0; t < tag_frames.size(); ++t) tag_frames[t] += (tags >> t) & 1u;
   }
   const std::vector<RawDimStats> raw = raw_statistics(db);
   const FeatureSchema& schema = db.schema();

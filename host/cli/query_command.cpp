@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "mmvk/database_io.hpp"
 #include "mmvk/explain.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/pose_query.hpp"
 #include "mmvk/query_builder.hpp"
 #include "mmvk/thread_pool.hpp"
 
@@ -33,11 +35,16 @@ constexpr const char* kQueryUsage =
     "usage: mmvk query db.mmdb --queries q.f32 [--normalized] [--backend NAME] [--k K]\n"
     "                  [--threads N] [--out results.tsv] [query options]\n"
     "                  [--explain [--frames F,F,...]]\n"
+    "       mmvk query db.mmdb --pose-targets targets.json [the same options]\n"
     "\n"
     "Reads B queries as raw little-endian float32 [B x dims] (dims and their order\n"
     "as in `mmvk export`'s sidecar). Values are raw features, normalized here with\n"
     "the database's offsets and scales, or already normalized with --normalized.\n"
     "(--features is a synonym of --queries.)\n"
+    "--pose-targets: one pose-matching query instead, from end-effector targets\n"
+    "  {\"targets\": [{\"bone\": \"@left_foot\", \"position\": [x, y, z], \"velocity\": [x, y, z]}]}\n"
+    "  (character space, metres and m/s; see docs/search.md): only the targeted\n"
+    "  channels are weighted; prints each target's distance from the result.\n"
     "\n"
     "--backend NAME, one of:\n";
 
@@ -48,7 +55,7 @@ constexpr const char* kQueryUsageOptions =
     "--k K: results per query, 1..16 (default 1). --threads N: 0 = all cores, at most 1024.\n"
     "\n"
     "query options (applied to every query):\n"
-    "  --continuing F, --continuing-bias X, --exclusion-window N,\n"
+    "  --continuing F, --continuing-bias X, --continuing-multiplier X, --exclusion-window N,\n"
     "  --require TAG,TAG  --exclude TAG,TAG  --weights CHANNEL=W,CHANNEL=W\n"
     "\n"
     "Output (--out, default stdout), tab-separated, '#' lines are comments:\n"
@@ -176,6 +183,9 @@ Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
   if (const auto text = args.value("--continuing-bias")) {
     MMVK_ASSIGN_OR_RETURN(params.continuing_bias, parse_float("--continuing-bias", *text));
   }
+  if (const auto text = args.value("--continuing-multiplier")) {
+    MMVK_ASSIGN_OR_RETURN(params.continuing_multiplier, parse_float("--continuing-multiplier", *text));
+  }
   if (const auto text = args.value("--exclusion-window")) {
     MMVK_ASSIGN_OR_RETURN(params.exclusion_window, parse_u32("--exclusion-window", *text));
   }
@@ -222,7 +232,7 @@ int run_query(Args args) {
   const auto parsed = parse_args("query", args,
                                  {"--queries", "--features", "--backend", "--k", "--threads", "--out", "--frames",
                                   "--frame", "--clusters", "--nprobe", "--continuing", "--continuing-bias",
-                                  "--exclusion-window", "--require", "--exclude", "--weights"},
+                                  "--continuing-multiplier", "--exclusion-window", "--require", "--exclude", "--weights", "--pose-targets"},
                                  {"--normalized", "--explain", "--help", "-h"});
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
@@ -230,7 +240,8 @@ int run_query(Args args) {
     return 0;
   }
   const auto queries_path = parsed->value("--queries") ? parsed->value("--queries") : parsed->value("--features");
-  if (parsed->positional.size() != 1 || !queries_path) {
+  const auto pose_path = parsed->value("--pose-targets");
+  if (parsed->positional.size() != 1 || !queries_path == !pose_path) {
     std::fputs(usage_text().c_str(), stderr);
     return 2;
   }
@@ -252,10 +263,21 @@ int run_query(Args args) {
   }
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db) return fail(db.message());
-  Result<std::vector<float>> features = read_f32_rows(*queries_path, db->dims());
+  std::vector<PoseTarget> pose_targets;
+  std::optional<PoseQuery> pose;
+  if (pose_path) {
+    Result<std::vector<PoseTarget>> targets = load_pose_targets(*pose_path);
+    if (!targets) return fail(targets.message());
+    pose_targets = std::move(*targets);
+    Result<PoseQuery> built = build_pose_query(*db, pose_targets, *pose_path);
+    if (!built) return fail(built.message());
+    pose = std::move(*built);
+  }
+  Result<std::vector<float>> features =
+      pose ? Result<std::vector<float>>(pose->features) : read_f32_rows(*queries_path, db->dims());
   if (!features) return fail(features.message());
   const std::size_t count = features->size() / db->dims();
-  if (!parsed->has("--normalized")) {
+  if (!pose && !parsed->has("--normalized")) {
     std::vector<float> raw = *features;
     for (std::size_t q = 0; q < count; ++q) {
       db->normalize(std::span<const float>(raw).subspan(q * db->dims(), db->dims()),
@@ -264,6 +286,12 @@ int run_query(Args args) {
   }
   Result<QueryParams> params = query_params(*db, *parsed);
   if (!params) return fail(params.message());
+  if (pose) {
+    // --weights may reweigh the targeted channels; the others stay off.
+    for (std::size_t c = 0; c < db->schema().channels.size(); ++c) {
+      if (pose->params.channel_weights[c] == 0.0f) params->channel_weights[c] = 0.0f;
+    }
+  }
   const std::vector<QueryParams> all_params(count, *params);
 
   // --explain's frames are checked before any work, so that a typo does not
@@ -309,6 +337,25 @@ int run_query(Args args) {
     std::fputs(text.c_str(), stdout);
   }
 
+  if (pose && results[0].frame != kNoFrame) {
+    const std::vector<PoseTargetError> errors = pose_target_errors(*db, results[0].frame, pose_targets);
+    std::string text = "pose match: frame " + std::to_string(results[0].frame) + "\n";
+    char line[200];
+    for (std::size_t t = 0; t < errors.size(); ++t) {
+      std::snprintf(line, sizeof(line), "  %-20s", pose_targets[t].bone.c_str());
+      text += line;
+      if (errors[t].position_metres >= 0.0f) {
+        std::snprintf(line, sizeof(line), " position off by %.4f m", double(errors[t].position_metres));
+        text += line;
+      }
+      if (errors[t].velocity_metres_per_second >= 0.0f) {
+        std::snprintf(line, sizeof(line), " velocity off by %.4f m/s", double(errors[t].velocity_metres_per_second));
+        text += line;
+      }
+      text += "\n";
+    }
+    std::fputs(text.c_str(), stderr);
+  }
   if (parsed->has("--explain")) {
     Result<Explanation> explanation = explain_query(*db, std::span<const float>(*features).first(db->dims()),
                                                     all_params[0], explain_frames, k);

@@ -58,7 +58,8 @@ Status check_inside(const TimeRange& range, std::uint32_t frames, float fps, con
   return make_error(field + text);
 }
 
-// Per-frame multipliers and biases from the clip's and its cost ranges.
+// Checks that the clip's tag and cost ranges lie inside it, keeps its tag
+// ranges for assembly, and computes per-frame multipliers and biases.
 Status apply_time_ranges(const ManifestClip& meta, std::uint32_t frames, float fps, ProcessedClip& out) {
   const std::string field = meta.field.empty() ? meta.file.string() + ": clip '" + meta.name + "'" : meta.field;
   for (std::size_t i = 0; i < meta.tag_ranges.size(); ++i) {
@@ -191,7 +192,8 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
     std::vector<detail::ClipAnimation> animations;
     animations.reserve(clips.size());
     for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
-    Result<AnimationData> data = detail::assemble_animation(animations, animation.contacts, animation.encoding, mirror_bones);
+    Result<AnimationData> data =
+        detail::assemble_animation(animations, animation.contacts, animation.encoding, mirror_bones);
     if (data.ok()) {
       parts.animation = std::move(*data);
     } else if (animation.warning) {

@@ -4,8 +4,8 @@
 //    (the threshold is found by a binary search over the 32-bit distance
 //    keys: 32 counting loops over the clusters, so cluster_count is capped
 //    for llvmpipe's loop limit).
-//  - evaluates the continuing frame (cost with continuing_bias), which the
-//    cluster scans skip, as ClusterSearch seeds it;
+//  - evaluates the continuing frame (cost with continuing_multiplier and
+//    continuing_bias), which the cluster scans skip, as ClusterSearch seeds it;
 //  - picks the seed: the eligible cluster of least (centroid distance, id),
 //    ClusterSearch's seed_nearest (the least bound was a worse seed: many
 //    clusters whose box holds the query tie at 0), and lists its blocks for

@@ -55,8 +55,8 @@ void load_query(uint query, out vec4 q[DV], out float w[CHANNELS]) {
   [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[c] = query_weights[query * CHANNELS + c];
 }
 
-// The (cost, frame) pair of query `query`'s continuing frame, continuing_bias
-// included, or (kNone, kNone) when it has none (validate_search keeps it
+// The (cost, frame) pair of query `query`'s continuing frame, continuing_multiplier
+// and continuing_bias included, or (kNone, kNone) when it has none (validate_search keeps it
 // below the frame count otherwise), it is not a candidate or its cost is
 // NaN. The scans skip this frame: it is the only row with an extra cost term
 // and exemptions from the rules, so it is evaluated once per query.
@@ -70,7 +70,10 @@ uvec2 continuing_pair(uint query) {
   float w[CHANNELS];
   [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(frame * DV + v));
   load_query(query, q, w);
-  precise float cost = row_cost(x, q, w, texelFetch(frame_cost, int(frame)).xy) + p.continuing_bias;
+  // mmvk::frame_cost's order: (multiplier * total + bias) * continuing_multiplier
+  // + continuing_bias, each step rounded (precise: no fused multiply-add).
+  precise float cost = row_cost(x, q, w, texelFetch(frame_cost, int(frame)).xy) * p.continuing_multiplier;
+  cost = cost + p.continuing_bias;
   return isnan(cost) ? uvec2(kNone, kNone) : uvec2(orderable_bits(cost), frame);
 }
 

@@ -25,7 +25,7 @@ struct QueryGpu {
   uint clip_count;         // that clip's frame count
   uint clip_loop;          // 1 when that clip loops
   float continuing_bias;
-  uint pad0;
+  float continuing_multiplier;
 };
 
 // search_layout.hpp: SearchPush (32 bytes). Kernels with their own push

@@ -3,7 +3,7 @@
 // sorted by (cost, frame). The block loop runs block_count (<= 16k)
 // iterations; the per-block loop is unrolled (llvmpipe's loop limit).
 // With ADD_CONTINUING (brute_force_scan.comp, which skips it), it also
-// evaluates each query's continuing frame, continuing_bias included.
+// evaluates each query's continuing frame, continuing_multiplier and continuing_bias included.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require

@@ -128,6 +128,40 @@ TEST(QueryBuilder, SetsChannelsByNameAndNormalizes) {
   EXPECT_FALSE(set_channel_weight(db.schema(), params, "channel0", -1.0f).ok());
 }
 
+// continuing_multiplier scales the continuing frame's whole cost (bias_i
+// included) before continuing_bias is added; both steps rounded in float.
+TEST(FrameCost, ContinuingMultiplierComesBeforeTheContinuingBias) {
+  const Database db = synthetic_database({.frames = 300, .clips = 3, .seed = 5, .constraints = true});
+  const std::vector<float> query = synthetic_queries(db, 1, 6);
+  QueryParams p;
+  p.continuing_frame = 150;
+  p.continuing_bias = -0.25f;
+  QueryParams plain = p;
+  plain.continuing_frame = kNoFrame;
+  for (const float multiplier : {0.0f, 0.3f, 1.0f, 1.7f}) {
+    p.continuing_multiplier = multiplier;
+    float expected = frame_cost(db, 150, query, plain);
+    expected = expected * multiplier;
+    expected = expected + p.continuing_bias;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(frame_cost(db, 150, query, p)), std::bit_cast<std::uint32_t>(expected))
+        << multiplier;
+    // Only the continuing frame.
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(frame_cost(db, 149, query, p)),
+              std::bit_cast<std::uint32_t>(frame_cost(db, 149, query, plain)));
+  }
+  // The explanation shows it, with the same cost.
+  p.continuing_multiplier = 0.5f;
+  const std::vector<std::uint32_t> named = {150};
+  Result<Explanation> e = explain_query(db, query, p, named, 1);
+  ASSERT_TRUE(e.ok()) << e.message();
+  const FrameExplanation& f = e->frames.back();
+  EXPECT_TRUE(f.continuing);
+  EXPECT_EQ(f.continuing_multiplier, 0.5f);
+  EXPECT_EQ(std::bit_cast<std::uint32_t>(f.cost), std::bit_cast<std::uint32_t>(frame_cost(db, 150, query, p)));
+  const std::string text = format_explanation(db, *e);
+  EXPECT_NE(text.find("x continuing_multiplier 0.5 + continuing_bias -0.25"), std::string::npos) << text;
+}
+
 TEST(Explain, BreaksDownTheWinnerAndNamesReasons) {
   const Database db = synthetic_database({.frames = 3000, .seed = 17, .constraints = true});
   const Clip& clip = db.clips()[3];  // loops; tags run and idle

@@ -260,6 +260,42 @@ TYPED_TEST_P(BackendSuite, ContinuingBiasNegativeAndPositive) {
   this->check(db, queries, close, 8, 4);
 }
 
+// The continuing frame's cost is (multiplier * total + bias) *
+// continuing_multiplier + continuing_bias, each step rounded: a multiplier
+// of 0 leaves only the bias (staying wins), others compete.
+TYPED_TEST_P(BackendSuite, ContinuingMultiplierScalesBeforeTheBias) {
+  const Database db = synthetic_database({.frames = 3000, .seed = 31, .constraints = true});
+  std::unique_ptr<SearchBackend> backend = this->make(db);
+  ASSERT_NE(backend, nullptr);
+  constexpr std::size_t kCount = 16;
+  const std::vector<float> queries = synthetic_queries(db, kCount, 32, 0.05f);
+  std::vector<QueryParams> params(kCount);
+  const float multipliers[] = {0.0f, 0.5f, 0.9f, 1.0f, 1.1f, 2.0f, 0.25f, 4.0f};
+  for (std::size_t q = 0; q < kCount; ++q) {
+    params[q].continuing_frame = db.clips()[5].first_frame + 10 + static_cast<std::uint32_t>(7 * q);
+    params[q].continuing_multiplier = multipliers[q % 8];
+    params[q].continuing_bias = q < 8 ? -1.0e-3f : 0.25f;
+  }
+  const std::vector<Match> got = run_search(*backend, queries, params, kCount, 4);
+  expect_identical(reference_results(db, queries, params, kCount, 4), got, 4, params, backend->name());
+  for (std::size_t q = 0; q < kCount; ++q) {
+    const std::span<const float> query = std::span<const float>(queries).subspan(q * db.dims(), db.dims());
+    if (params[q].continuing_multiplier == 0.0f && q < 8 && is_candidate(db, params[q].continuing_frame, params[q])) {
+      EXPECT_EQ(got[q * 4].frame, params[q].continuing_frame) << describe(params[q]);
+    }
+    for (std::size_t r = 0; r < 4; ++r) {
+      if (got[q * 4 + r].frame != params[q].continuing_frame) continue;
+      QueryParams plain = params[q];
+      plain.continuing_frame = kNoFrame;
+      float expected = frame_cost(db, params[q].continuing_frame, query, plain);
+      expected = expected * params[q].continuing_multiplier;
+      expected = expected + params[q].continuing_bias;
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(got[q * 4 + r].cost), std::bit_cast<std::uint32_t>(expected))
+          << describe(params[q]);
+    }
+  }
+}
+
 TYPED_TEST_P(BackendSuite, ChannelWeightsIncludingZero) {
   const Database db = synthetic_database({.frames = 3000, .seed = 29});
   const std::vector<float> queries = synthetic_queries(db, 24, 30);
@@ -444,6 +480,11 @@ TYPED_TEST_P(BackendSuite, BadInputIsAnError) {
   params[0] = QueryParams{};
   params[0].continuing_bias = std::numeric_limits<float>::quiet_NaN();
   EXPECT_NE(error_of(queries, params, 2, 1, out).find("continuing_bias"), std::string::npos);
+  params[0] = QueryParams{};
+  params[0].continuing_multiplier = -0.5f;
+  EXPECT_NE(error_of(queries, params, 2, 1, out).find("continuing_multiplier"), std::string::npos);
+  params[0].continuing_multiplier = std::numeric_limits<float>::infinity();
+  EXPECT_NE(error_of(queries, params, 2, 1, out).find("continuing_multiplier"), std::string::npos);
   // Still usable after errors.
   params[0] = QueryParams{};
   EXPECT_EQ(error_of(queries, params, 2, 1, out), "<ok>");
@@ -453,7 +494,8 @@ REGISTER_TYPED_TEST_SUITE_P(BackendSuite, RandomDataMatchesReference, OddChannel
                             FindsTheUniqueMinimum, FlagsAreNeverResultsUnlessContinued,
                             BlockTransitionWithAndWithoutContinuingFrame, TagMasks,
                             ExclusionWindowWrapsInLoopingClips, MultiplierAndBiasEnterTheCost,
-                            ContinuingBiasNegativeAndPositive, ChannelWeightsIncludingZero, TiesGoToTheLowerFrameId,
+                            ContinuingBiasNegativeAndPositive, ContinuingMultiplierScalesBeforeTheBias,
+                            ChannelWeightsIncludingZero, TiesGoToTheLowerFrameId,
                             KGreaterThanOneAndNonePadding, NoCandidateReturnsNone, BatchSizes,
                             RandomParamsAndKMatchReference, RepeatedCallsAndStats, BadInputIsAnError);
 

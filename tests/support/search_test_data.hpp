@@ -152,6 +152,10 @@ inline std::vector<QueryParams> random_params(const Database& db, std::size_t co
     if (choice(rng) < 5) {
       p.continuing_frame = frame(rng);
       p.continuing_bias = 4.0f * uniform(rng) - 2.0f;
+      // From the frame rather than the generator, so the draws (and every
+      // other test's data) stay as they were before the multiplier existed.
+      const float multipliers[] = {1.0f, 0.5f, 0.8f, 1.25f, 0.0f, 1.0f};
+      p.continuing_multiplier = multipliers[p.continuing_frame % 6];
       p.exclusion_window = choice(rng) < 4 ? choice(rng) * 3 : 0;
     }
     const int tags = choice(rng);
@@ -184,7 +188,8 @@ inline std::string describe(const Match& m) {
 inline std::string describe(const QueryParams& p) {
   std::ostringstream out;
   out << "continuing_frame=" << (p.continuing_frame == kNoFrame ? std::string("none") : std::to_string(p.continuing_frame))
-      << " continuing_bias=" << p.continuing_bias << " exclusion_window=" << p.exclusion_window
+      << " continuing_bias=" << p.continuing_bias << " continuing_multiplier=" << p.continuing_multiplier
+      << " exclusion_window=" << p.exclusion_window
       << " require_all=" << p.require_all << " exclude_any=" << p.exclude_any;
   return out.str();
 }
@@ -213,6 +218,7 @@ inline std::vector<Match> reference_results(const Database& db, std::span<const 
   for (const QueryParams& p : params) {  // field by field: no padding bytes
     add(&p.continuing_frame, sizeof(p.continuing_frame));
     add(&p.continuing_bias, sizeof(p.continuing_bias));
+    add(&p.continuing_multiplier, sizeof(p.continuing_multiplier));
     add(&p.exclusion_window, sizeof(p.exclusion_window));
     add(&p.require_all, sizeof(p.require_all));
     add(&p.exclude_any, sizeof(p.exclude_any));

@@ -75,6 +75,7 @@ struct ControllerParams {
   float max_correction_yaw = 0.6f;        // radians
   // Search options applied to every query (per-character tags: query_params()).
   float continuing_bias = 0.0f;
+  float continuing_multiplier = 1.0f;  // finite, >= 0 (QueryParams::continuing_multiplier)
   std::uint32_t exclusion_window = 0;
   std::uint32_t max_batch = 1024;  // queries per backend call (VulkanSearchOptions::max_batch)
 };
@@ -157,7 +158,7 @@ class CrowdController {
   std::uint64_t ticks() const { return ticks_; }
 
   // Per-character query options (tags, weights); the controller overwrites
-  // continuing_frame, continuing_bias and exclusion_window.
+  // continuing_frame, continuing_bias, continuing_multiplier and exclusion_window.
   std::span<QueryParams> query_params() { return query_params_; }
 
   // Per-character output, [B] unless noted.

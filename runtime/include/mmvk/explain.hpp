@@ -51,7 +51,8 @@ struct FrameExplanation {
   float bias = 0.0f;             // the clip's
   bool continuing = false;       // this is the query's continuing frame
   float continuing_bias = 0.0f;  // the query's, when this is the continuing frame
-  float cost = 0.0f;             // frame_cost(): multiplier * total + bias (+ continuing_bias)
+  float continuing_multiplier = 1.0f;  // the query's, when this is the continuing frame
+  float cost = 0.0f;             // frame_cost(): multiplier * total + bias (then * continuing_multiplier + continuing_bias)
 };
 
 struct Explanation {

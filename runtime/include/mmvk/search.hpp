@@ -5,8 +5,10 @@
 //   total_i = sum over channels c in schema order of  w_c * s_ic,
 //             s_ic = sum over dims d of c in order of (x_id - q_d)^2,
 //             accumulated in float from 0.0f, without FP contraction;
-//   cost_i  = multiplier_i * total_i + bias_i
-//             (+ continuing_bias, added last, when i is the continuing frame).
+//   cost_i  = multiplier_i * total_i + bias_i;
+//   when i is the continuing frame, then
+//   cost_i  = cost_i * continuing_multiplier + continuing_bias
+//             (two float operations in that order, not fused).
 // Results are the best k frames sorted by (cost, frame id): equal costs go to
 // the lower frame id.
 #pragma once
@@ -32,6 +34,11 @@ struct QueryParams {
   std::uint32_t continuing_frame = kNoFrame;
   // Added to the continuing frame's cost (negative favours staying).
   float continuing_bias = 0.0f;
+  // Multiplies the continuing frame's cost before continuing_bias is added
+  // (finite, >= 0; below 1 favours staying while the cost is positive, as
+  // Motion Symphony's favour-current or UE PoseSearch's continuing-pose
+  // cost bias in multiplicative form).
+  float continuing_multiplier = 1.0f;
   // Frames within +-exclusion_window of the continuing frame in the same clip
   // (wrapping for looping clips) are not candidates; the continuing frame
   // itself stays one.

@@ -68,6 +68,9 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
     }
   }
   if (!std::isfinite(params.continuing_bias)) return make_error("crowd controller: continuing_bias must be finite");
+  if (!std::isfinite(params.continuing_multiplier) || params.continuing_multiplier < 0.0f) {
+    return make_error("crowd controller: continuing_multiplier must be finite and >= 0");
+  }
   if (params.max_batch == 0) return make_error("crowd controller: max_batch must be at least 1");
   Result<QueryAssembler> assembler = QueryAssembler::create(database);
   if (!assembler.ok()) return make_error("crowd controller: " + assembler.message());
@@ -380,6 +383,7 @@ void CrowdController::assemble(ThreadPool& pool) {
       p = query_params_[b];
       p.continuing_frame = frames_[b];
       p.continuing_bias = params_.continuing_bias;
+      p.continuing_multiplier = params_.continuing_multiplier;
       p.exclusion_window = params_.exclusion_window;
       continuing_[i] = frames_[b];
     }

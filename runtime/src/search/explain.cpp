@@ -36,7 +36,10 @@ FrameExplanation explain_frame(const Database& db, std::uint32_t frame, std::spa
   out.multiplier = db.frame_multiplier()[frame];
   out.bias = db.frame_bias()[frame];
   out.continuing = frame == params.continuing_frame;
-  if (out.continuing) out.continuing_bias = params.continuing_bias;
+  if (out.continuing) {
+    out.continuing_bias = params.continuing_bias;
+    out.continuing_multiplier = params.continuing_multiplier;
+  }
   out.cost = frame_cost(db, frame, query, params);
   return out;
 }
@@ -126,8 +129,13 @@ std::string format_explanation(const Database& db, const Explanation& e) {
       append("  %-28s weight %-9.6g sum %-13.9g weighted %.9g\n", c.name.c_str(), double(c.weight), double(c.sum),
              double(c.weighted));
     }
-    append("  total %.9g x multiplier %.9g + bias %.9g", double(f.total), double(f.multiplier), double(f.bias));
-    if (f.continuing) append(" + continuing_bias %.9g", double(f.continuing_bias));
+    if (f.continuing) {
+      append("  (total %.9g x multiplier %.9g + bias %.9g) x continuing_multiplier %.9g + continuing_bias %.9g",
+             double(f.total), double(f.multiplier), double(f.bias), double(f.continuing_multiplier),
+             double(f.continuing_bias));
+    } else {
+      append("  total %.9g x multiplier %.9g + bias %.9g", double(f.total), double(f.multiplier), double(f.bias));
+    }
     append(" = cost %.9g\n", double(f.cost));
   }
   return text;

@@ -10,7 +10,7 @@ namespace {
 
 // An upper bound of |cost| over every frame for one query, in double (which
 // cannot overflow here): multiplier * sum_c w_c * sum_d (|q_d| + max|row_d|)^2
-// + |bias| + |continuing bias|.
+// + |bias|, times the continuing multiplier when above 1, + |continuing bias|.
 double cost_bound(const Database& database, std::span<const float> query, const QueryParams& params,
                   double max_multiplier, double max_abs_bias) {
   const FeatureSchema& schema = database.schema();
@@ -26,7 +26,8 @@ double cost_bound(const Database& database, std::span<const float> query, const 
     }
     total += double(params.channel_weights[c]) * channel;
   }
-  return max_multiplier * total + max_abs_bias + std::fabs(double(params.continuing_bias));
+  const double base = max_multiplier * total + max_abs_bias;
+  return base * std::max(1.0, double(params.continuing_multiplier)) + std::fabs(double(params.continuing_bias));
 }
 
 }  // namespace
@@ -64,6 +65,9 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
                         std::to_string(database.frame_count()) + " frames)");
     }
     if (!std::isfinite(p.continuing_bias)) return make_error(where + "continuing_bias is not finite");
+    if (!std::isfinite(p.continuing_multiplier) || p.continuing_multiplier < 0.0f) {
+      return make_error(where + "continuing_multiplier must be finite and >= 0");
+    }
     for (std::size_t c = 0; c < channels; ++c) {
       if (!std::isfinite(p.channel_weights[c]) || p.channel_weights[c] < 0.0f) {
         return make_error(where + "weight of channel '" + database.schema().channels[c].name +
@@ -127,7 +131,10 @@ float frame_cost(const Database& database, std::uint32_t frame, std::span<const 
     total += params.channel_weights[c] * channel_sum;
   }
   float cost = database.frame_multiplier()[frame] * total + database.frame_bias()[frame];
-  if (frame == params.continuing_frame) cost += params.continuing_bias;
+  if (frame == params.continuing_frame) {
+    cost = cost * params.continuing_multiplier;
+    cost += params.continuing_bias;
+  }
   return cost;
 }
 

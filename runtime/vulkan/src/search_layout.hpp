@@ -23,11 +23,12 @@ struct QueryGpu {
   std::uint32_t clip_count;
   std::uint32_t clip_loop;
   float continuing_bias;
-  std::uint32_t pad0;
+  float continuing_multiplier;
 };
 static_assert(sizeof(QueryGpu) == 48);
 static_assert(offsetof(QueryGpu, window_clip) == 24);
 static_assert(offsetof(QueryGpu, continuing_bias) == 40);
+static_assert(offsetof(QueryGpu, continuing_multiplier) == 44);
 
 // GLSL: SearchPush (push constants of every search kernel).
 struct SearchPush {

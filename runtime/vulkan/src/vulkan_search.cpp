@@ -369,6 +369,7 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
       gpu.clip_loop = clip.loop ? 1u : 0u;
     }
     gpu.continuing_bias = p.continuing_bias;
+    gpu.continuing_multiplier = p.continuing_multiplier;
     params[q] = gpu;
     for (std::uint32_t c = 0; c < shape.channels; ++c) {
       weights[std::size_t{q} * shape.channels + c] = p.channel_weights[channel_of_weight[c]];

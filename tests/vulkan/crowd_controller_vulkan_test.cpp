@@ -1,7 +1,8 @@
 // The crowd controller on Vulkan (lavapipe in CI) against the reference
 // backend on Bandai locomotion: 50 characters, 2 s at 30 Hz, identical
 // chosen frames every tick, synchronously and on the deferred (async) path,
-// with batches split over more chunks than the search has slots.
+// with batches split over more chunks than the search has slots; and with a
+// continuing_multiplier (fewer jumps, the same frames on both).
 #include <gtest/gtest.h>
 
 #include "mmvk/reference_search.hpp"
@@ -14,9 +15,9 @@
 namespace mmvk {
 namespace {
 
-test::CrowdRun run_sync(const Database& db, SearchBackend& backend, std::uint32_t max_batch) {
+test::CrowdRun run_sync(const Database& db, SearchBackend& backend, std::uint32_t max_batch,
+                        ControllerParams params = {}) {
   ThreadPool pool(2);
-  ControllerParams params;
   params.max_batch = max_batch;
   Result<CrowdController> controller = CrowdController::create(db, test::kCrowdCharacters, params);
   EXPECT_TRUE(controller.ok()) << controller.message();
@@ -75,6 +76,34 @@ TEST(CrowdControllerVulkan, SameFramesAsTheReferenceEveryTick) {
   const test::CrowdRun actual_deferred = run_deferred(*db, async);
   EXPECT_EQ(actual_deferred.totals.no_candidate, 0u);
   EXPECT_TRUE(expected_deferred.frames == actual_deferred.frames) << first_difference(expected_deferred, actual_deferred);
+}
+
+TEST(CrowdControllerVulkan, ContinuingMultiplierSameFramesAndFewerJumps) {
+  MMVK_REQUIRE_DATA_DIR(dir);
+  MMVK_VULKAN_CONTEXT(context, {});
+  Result<Database> db = test::build_locomotion(dir);
+  ASSERT_TRUE(db.ok()) << db.message();
+  ReferenceSearch reference(*db);
+  vulkan::VulkanSearchOptions options;
+  options.max_k = 1;
+  options.max_batch = 64;
+  Result<std::unique_ptr<vulkan::VulkanSearch>> gpu = vulkan::VulkanSearch::create(*context, *db, options);
+  ASSERT_TRUE(gpu.ok()) << gpu.message();
+  ControllerParams favour;
+  favour.continuing_multiplier = 0.6f;
+  const test::CrowdRun plain = run_sync(*db, reference, 64);
+  const test::CrowdRun expected = run_sync(*db, reference, 64, favour);
+  const test::CrowdRun actual = run_sync(*db, **gpu, 64, favour);
+  EXPECT_EQ(actual.totals.no_candidate, 0u);
+  EXPECT_TRUE(expected.frames == actual.frames) << first_difference(expected, actual);
+  std::printf("jumps over the run: %u with continuing_multiplier 1, %u with 0.6\n", plain.totals.jumps,
+              expected.totals.jumps);
+  EXPECT_LT(expected.totals.jumps, plain.totals.jumps);
+
+  favour.continuing_multiplier = -1.0f;
+  Result<CrowdController> refused = CrowdController::create(*db, 4, favour);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.message(), "crowd controller: continuing_multiplier must be finite and >= 0");
 }
 
 }  // namespace

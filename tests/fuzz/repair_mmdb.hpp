@@ -17,8 +17,11 @@ inline void repair_mmdb(std::string& bytes) {
   if (bytes.size() < kDatabaseHeaderBytes + kChecksumBytes) return;
   std::memcpy(bytes.data(), "MMVKDB\n\0", 8);
   // Keep a version the loader knows (the fuzzer may flip it back to others
-  // through the corpus; the plain target covers those).
-  const std::uint32_t version = kDatabaseFormatVersion;
+  // through the corpus; the plain target covers those): the seed's own when
+  // known, since versions 2 and 3 lay the payload out differently.
+  std::uint32_t version = 0;
+  std::memcpy(&version, bytes.data() + 8, 4);
+  if (version < 1 || version > kDatabaseFormatVersion) version = kDatabaseFormatVersion;
   std::memcpy(bytes.data() + 8, &version, 4);
   const std::uint64_t payload = bytes.size() - kDatabaseHeaderBytes - kChecksumBytes;
   std::memcpy(bytes.data() + 16, &payload, 8);

@@ -15,7 +15,8 @@
 //                              f32 cost bias, u32 first frame, u32 frame count
 //                         u32  frames, then frames x u32 frame flags
 //                         f32  features [frames x dims], row-major, normalized
-//                         u8   1 when per-frame modifiers follow, else 0 (version 3):
+//                         u8   1: per-frame modifiers follow (version 3 only, which
+//                              is written only for a database that has them):
 //                              u64 tags [frames], f32 cost multiplier [frames],
 //                              f32 cost bias [frames] (the manifest's tag_ranges
 //                              and cost_ranges; without them the clips' values hold)
@@ -52,9 +53,10 @@
 
 namespace mmvk {
 
-// Version 2 adds the optional animation section, version 3 the optional
-// per-frame tags and cost modifiers; version 1 and 2 files still load
-// (version 1: features only, Database::animation() null).
+// Version 2 adds the optional animation section, version 3 the per-frame
+// tags and cost modifiers (written only for a database that has them, so
+// others stay version 2 files); version 1 and 2 files still load (version 1:
+// features only, Database::animation() null).
 inline constexpr std::uint32_t kDatabaseFormatVersion = 3;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 

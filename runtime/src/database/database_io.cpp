@@ -247,7 +247,10 @@ std::string serialize_database(const Database& database) {
   Writer file;
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
-  file.u32(kDatabaseFormatVersion);
+  // Version 3 only when the per-frame section is needed: a database without
+  // time ranges stays a version 2 file that older builds read.
+  const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
+  file.u32(per_frame ? kDatabaseFormatVersion : 2u);
   file.u32(0);
   file.u64(0);
   file.str(schema_to_json(parts.schema));
@@ -274,9 +277,8 @@ std::string serialize_database(const Database& database) {
   file.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
   for (std::uint32_t flags : parts.frame_flags) file.u32(flags);
   file.f32_array(parts.features);
-  const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
-  file.u8(per_frame ? 1 : 0);
   if (per_frame) {
+    file.u8(1);
     // The complete per-frame values (the Database's, which fill in the clip
     // values for whichever array the parts left empty).
     for (const TagMask tags : database.frame_tags()) file.u64(tags);

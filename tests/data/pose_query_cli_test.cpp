@@ -1,6 +1,6 @@
 // `mmvk query --pose-targets` on a real database: the result, the per-target
 // distances and the explanation (only the targeted channels weighted), and
-// bad targets files named with their field.
+// bad targets files named with their field; --continuing-multiplier.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -49,6 +49,21 @@ TEST_F(PoseQueryCli, PrintsTheMatchTheDistancesAndTheExplanation) {
   EXPECT_NE(result.output.find("hip_velocity                 weight 0 "), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("left_foot_velocity           weight 0 "), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("right_foot_velocity          weight 1 "), std::string::npos) << result.output;
+}
+
+// --continuing-multiplier reaches the search and the explanation.
+TEST_F(PoseQueryCli, ContinuingMultiplierIsExplained) {
+  const fs::path targets = write_targets(R"({"targets": [{"bone": "@left_foot", "position": [0.1, 0.1, 0.25]}]})");
+  const test::CommandResult result =
+      run_command(mmvk_ + " query " + db_ + " --pose-targets " + targets.string() +
+                  " --continuing 40 --continuing-multiplier 0.5 --continuing-bias -0.25 --explain --frames 40");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("x continuing_multiplier 0.5 + continuing_bias -0.25 = cost"), std::string::npos)
+      << result.output;
+  const test::CommandResult bad = run_command(mmvk_ + " query " + db_ + " --pose-targets " + targets.string() +
+                                              " --continuing 40 --continuing-multiplier -1");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("continuing_multiplier must be finite and >= 0"), std::string::npos) << bad.output;
 }
 
 TEST_F(PoseQueryCli, BadTargetsAreNamed) {

@@ -9,7 +9,8 @@
 //
 // Counters: queries/s; rows_fraction (rows whose full cost was evaluated,
 // per query and frame); row_dims/s (evaluated rows x dims per second, the
-// throughput to compare with the machine's limit, see machine/fma_peak).
+// throughput to compare with the machine's limit, see calibration/fma_peak in
+// calibration_bench.cpp).
 // The reference runs one iteration at B = 1024 and at the large size.
 #include <benchmark/benchmark.h>
 
@@ -25,10 +26,6 @@
 #include "mmvk/fast_search.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "query_streams.hpp"
-
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#endif
 
 namespace mmvk::bench {
 
@@ -159,38 +156,6 @@ void register_search_benchmarks(const std::string& label, DatabaseProvider provi
 }
 
 namespace {
-
-// The machine's single-thread FMA throughput (8-lane FMA, 10 independent
-// chains), for the fraction-of-peak figure: multiply by the core count.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target("avx2,fma"))) float fma_loop(std::int64_t iterations) {
-  __m256 acc[10];
-  for (int i = 0; i < 10; ++i) acc[i] = _mm256_set1_ps(float(i));
-  const __m256 a = _mm256_set1_ps(0.999f), b = _mm256_set1_ps(0.001f);
-  for (std::int64_t it = 0; it < iterations; ++it) {
-    for (int i = 0; i < 10; ++i) acc[i] = _mm256_fmadd_ps(acc[i], a, b);
-    // Keeps the compiler from collapsing the loop.
-    for (int i = 0; i < 10; ++i) asm volatile("" : "+x"(acc[i]));
-  }
-  __m256 sum = acc[0];
-  for (int i = 1; i < 10; ++i) sum = _mm256_add_ps(sum, acc[i]);
-  float lanes[8];
-  _mm256_storeu_ps(lanes, sum);
-  return lanes[0];
-}
-
-void fma_peak(benchmark::State& state) {
-  if (!__builtin_cpu_supports("fma") || !__builtin_cpu_supports("avx2")) {
-    state.SkipWithError("no AVX2 + FMA on this CPU");
-    return;
-  }
-  constexpr std::int64_t kIterations = 1 << 20;
-  for (auto _ : state) benchmark::DoNotOptimize(fma_loop(kIterations));
-  // 10 chains x 8 lanes x 2 flops per iteration.
-  state.counters["flops/s"] = benchmark::Counter(double(kIterations) * 160.0, benchmark::Counter::kIsIterationInvariantRate);
-}
-BENCHMARK(fma_peak)->Name("machine/fma_peak_1thread")->UseRealTime();
-#endif
 
 const bool registered = [] {
   register_search_benchmarks("synthetic22k", [] {

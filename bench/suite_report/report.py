@@ -5,6 +5,7 @@ as it is) and the SVG plots in bench/plots/."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -76,7 +77,8 @@ def _run_lines(machine, data, argv):
             lines.append("Left out of this preset, and why:")
             lines += [f"- {s}" for s in run["skipped"]]
         lines.append("")
-    lines.append("Report: `" + " ".join(["bench/report"] + argv) + "`.")
+    shown = [os.path.relpath(a) if os.path.isabs(a) else a for a in argv]
+    lines.append("Report: `" + " ".join(["bench/report"] + shown) + "`.")
     return lines
 
 

@@ -93,8 +93,11 @@ class Cell:
         return (self.dataset, self.schema, self.stream, self.method, self.batch)
 
     def get(self, name):
+        """A counter as a float; None when absent or NaN (not measured)."""
         value = self.counters.get(name)
-        return None if value is None else float(value)
+        if value is None or value != value:
+            return None
+        return float(value)
 
     @property
     def us_per_query(self):

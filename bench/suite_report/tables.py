@@ -71,13 +71,32 @@ class Index:
         return None
 
 
+def seconds(value):
+    """A build time: small ones as a bound rather than a string of zeros."""
+    if not value:
+        return DASH
+    return "< 0.001" if value < 1e-3 else sig(value)
+
+
+def speedup(methods, method, baseline="fast-brute", prefer=1024):
+    """(ratio, batch): baseline's µs/query over method's, at B = `prefer`
+    when both have it, else at the largest batch both have."""
+    mine = {c.batch: c.us_per_query for c in methods.get(method, []) if not c.error and c.us_per_query}
+    base = {c.batch: c.us_per_query for c in methods.get(baseline, []) if not c.error and c.us_per_query}
+    common = set(mine) & set(base)
+    if not common:
+        return None, None
+    batch = prefer if prefer in common else max(common)
+    return base[batch] / mine[batch], batch
+
+
 def group_table(methods):
-    """One table: a row per method, µs/query per batch, the rest at the
-    method's largest batch."""
-    batches = sorted({c.batch for cells in methods.values() for c in cells} | set())
+    """One table: a row per method, µs/query per batch, its speed against
+    fast-brute, the rest at the method's largest batch."""
+    batches = sorted({c.batch for cells in methods.values() for c in cells})
     batches = [b for b in BATCHES if b in batches] + [b for b in batches if b not in BATCHES]
     header = (["method"] + [f"µs/q B={b}" for b in batches] +
-              ["best q/s", "rows eval.", "recall@1", "recall@10", "host MiB (db + index)", "device MiB", "build s",
+              ["x fast-brute", "best q/s", "rows eval.", "recall@1", "recall@10", "host MiB (db + index)", "device MiB", "build s",
                "kernel µs/q"])
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     notes = []
@@ -93,6 +112,8 @@ def group_table(methods):
                 notes.append(f"`{method}` B={b}: {cell.error}")
             else:
                 row.append(sig(cell.us_per_query))
+        ratio, at = speedup(methods, method)
+        row.append(DASH if ratio is None else f"{ratio:.2f}x" + ("" if at == 1024 else f" (B={at})"))
         best = max((c for c in cells.values() if not c.error and c.queries_per_s), key=lambda c: c.queries_per_s,
                    default=None)
         last = _largest_batch(cells.values())
@@ -105,7 +126,7 @@ def group_table(methods):
                 host = (last.get("db_bytes") or 0) + (last.get("index_bytes") or 0)
             row += [percent(last.get("rows_fraction")), sig(last.get("recall1"), 4), sig(last.get("recall10"), 4),
                     mib(host), mib(last.get("device_bytes")) if last.get("device_bytes") else DASH,
-                    sig(last.get("build_s")) if last.get("build_s") else DASH,
+                    seconds(last.get("build_s")),
                     sig(last.get("kernel_us_per_query")) if last.get("kernel_us_per_query") else DASH]
         lines.append("| " + " | ".join(row) + " |")
     return lines, notes

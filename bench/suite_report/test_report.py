@@ -190,9 +190,13 @@ class RunSuiteSelectionTest(unittest.TestCase):
         select, _ = self.run_suite.PRESETS["full"]
         self.assertFalse(select("volume", "default27", "transition", "reference", 1024)[0])
         self.assertFalse(select("volume-mirrored", "default27", "transition", "vulkan-brute", 8192)[0])
+        single_query = ("reference", "box-scan", "pca-kdtree300", "faiss-flat-1q")
         for method in COST:
-            if method not in ("reference", "faiss-flat-1q") and not method.startswith("vulkan"):
-                self.assertTrue(select("volume", "default27", "transition", method, 8192)[0], method)
+            # The headline slice: every method at B = 1024 but the reference,
+            # B = 8192 for the batched CPU methods and FAISS flat / IVF.
+            self.assertEqual(select("volume", "default27", "transition", method, 1024)[0], method != "reference")
+            batched = method not in single_query and not method.startswith("vulkan")
+            self.assertEqual(select("volume", "default27", "transition", method, 8192)[0], batched, method)
         for dataset in N:
             self.assertTrue(select(dataset, "default27", "transition", "clusters", 1024)[0], dataset)
 

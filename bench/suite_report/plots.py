@@ -31,6 +31,9 @@ _COLOURS = {
 }
 _MARKERS = "osD^v<>ph*X"
 _RECALL_TARGET = 0.99
+# What the number after an approximate method's name is (the point labels).
+_PARAMETER = {"nprobe": "clusters probed", "vulkan-nprobe": "clusters probed", "faiss-ivf": "lists probed",
+              "pca-kdtree": "candidates"}
 
 
 def style(method):
@@ -120,7 +123,7 @@ def qps_vs_batch(index, path, schema="default27", stream="transition"):
         ax.set_title(_n_title(index, dataset))
         ax.grid(True, which="major", alpha=0.3)
     _finish(fig, axes, path, f"Throughput against batch size — {stream} stream, {schema} schema (higher is better)\n"
-            "approximate methods at their cheapest setting with recall@1 ≥ 0.99")
+            "approximate methods at their cheapest setting with recall@1 ≥ 0.99 at B = 1024, else their most accurate")
     return True
 
 
@@ -151,7 +154,7 @@ def recall_vs_time(index, path, schema="default27", stream="transition", batch=1
                 xs = [c.us_per_query for _, c in points]
                 ys = [c.get(counter) for _, c in points]
                 st = style(points[0][0])
-                label = family if exact else f"{family} (N = parameter)"
+                label = family if exact else f"{family}<{_PARAMETER.get(family, 'setting')}>"
                 ax.plot(xs, ys, label=label, markersize=6 if exact else 4,
                         linestyle="none" if exact else st["linestyle"], marker=st["marker"], color=st["color"])
                 if not exact:
@@ -166,7 +169,7 @@ def recall_vs_time(index, path, schema="default27", stream="transition", batch=1
             ax.grid(True, which="major", alpha=0.3)
     _finish(fig, [a for r in axes for a in r], path,
             f"Recall against time — {stream} stream, {schema} schema, B = {batch} (up and left is better)\n"
-            "point labels: nprobe, IVF nprobe, KD-tree candidates; dash-dot line: recall 0.99")
+            "point labels: the setting (clusters or lists probed, KD-tree candidates); dash-dot line: recall 0.99")
     return True
 
 

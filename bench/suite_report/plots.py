@@ -104,6 +104,11 @@ def _n_title(index, dataset):
 
 def qps_vs_batch(index, path, schema="default27", stream="transition"):
     datasets = _panels(index, schema, stream)
+    # Only the sets measured at three batches or more, where a curve says
+    # something (the scale series has two).
+    swept = [d for d in datasets
+             if len({c.batch for cells in index.groups[(d, schema, stream)].values() for c in cells}) >= 3]
+    datasets = swept or datasets
     if not datasets:
         return False
     fig, axes = plt.subplots(1, len(datasets), figsize=(3.6 * len(datasets), 3.6), squeeze=False)

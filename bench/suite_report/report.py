@@ -99,6 +99,12 @@ def section(data, machine, argv, plots_rel, plots_made):
         out += ["**Plots**", ""]
         out += [f"- [{what}]({plots_rel}/{name})" for name, what in made]
         out += [""] + [f"![{what}]({plots_rel}/{name})" for name, what in made] + [""]
+    duel = tables.head_to_head(index)
+    if duel:
+        out += ["### Head to head (volume, default27, transition, B = 1024)", "",
+                "Time per query against mmvk's exact cluster search (below 1: faster than it). Exact methods all "
+                "return the reference's answers (FAISS flat up to float near-ties); approximate ones at their "
+                "cheapest setting that finds the exact top-1 for at least 99% of the queries.", ""] + duel + [""]
     head = tables.headline(index, machine, "volume", "default27", "transition")
     if head:
         out += ["### Against the machine's limit (volume, default27, transition)", "",

@@ -238,3 +238,38 @@ def faiss_agreement(index):
         return []
     return ["| data set | schema | stream | method | B | recall@1 | top-1 differs (of 1024 queries) | of which near-ties |",
             "|---|---|---|---|---|---|---|---|"] + lines
+
+
+def head_to_head(index, dataset="volume", schema="default27", stream="transition", batch=1024, target=0.99):
+    """The comparisons the suite is for, at one cell of the matrix: every
+    exact method's µs/query against mmvk's exact cluster search, and per
+    approximate family the cheapest setting reaching recall@1 >= target."""
+    methods = index.groups.get((dataset, schema, stream), {})
+    at = {m: c for m, cells in methods.items() for c in cells if c.batch == batch and not c.error and c.us_per_query}
+    if "clusters" not in at:
+        return []
+    base = at["clusters"].us_per_query
+    lines = ["| exact method | µs/query | time / mmvk `clusters` |", "|---|---|---|"]
+    for method in sorted(at, key=method_order):
+        family, _, _, exact = method_info(method)
+        if exact:
+            lines.append(f"| `{method}` | {sig(at[method].us_per_query)} | {at[method].us_per_query / base:.2f} |")
+    lines += ["", f"| approximate family | cheapest setting with recall@1 ≥ {target} | µs/query | recall@1 | "
+              "time / mmvk `clusters` |", "|---|---|---|---|---|"]
+    families = {}
+    for method, cell in at.items():
+        family, param, _, exact = method_info(method)
+        if not exact and param is not None:
+            families.setdefault(family, []).append((method, cell))
+    for family in sorted(families, key=lambda f: method_order(families[f][0][0])):
+        options = families[family]
+        good = [(m, c) for m, c in options if (c.get("recall1") or 0) >= target]
+        if good:
+            method, cell = min(good, key=lambda mc: mc[1].us_per_query)
+            lines.append(f"| {family} | `{method}` | {sig(cell.us_per_query)} | {sig(cell.get('recall1'), 4)} | "
+                         f"{cell.us_per_query / base:.2f} |")
+        else:
+            method, cell = max(options, key=lambda mc: mc[1].get("recall1") or 0)
+            lines.append(f"| {family} | none (best: `{method}`) | {sig(cell.us_per_query)} | "
+                         f"{sig(cell.get('recall1'), 4)} | {cell.us_per_query / base:.2f} |")
+    return lines

@@ -57,6 +57,9 @@ def _machine_lines(machine, data):
         lines.append(f"- Vulkan: {m.vulkan}.")
     else:
         lines.append(f"- Vulkan: none in this run ({m.vulkan_error or 'no calibration/vulkan_device cell'}).")
+    policies = sorted({c["omp_wait_policy"] for c in data.contexts if c.get("omp_wait_policy")})
+    if policies:
+        lines.append(f"- OpenMP (FAISS, OpenBLAS): `OMP_WAIT_POLICY={', '.join(policies)}`.")
     load = ", ".join(f"{x:.1f}" for x in m.load_avg) if m.load_avg else "?"
     lines.append(f"- Load average at the start of the first file: {load}; Google Benchmark's date: {m.date or '?'}.")
     return lines

@@ -232,12 +232,12 @@ def faiss_agreement(index):
                 queries = cell.get("recall_queries") or (1024 if cell.source == "suite" else cell.batch)
                 differs = round((1 - cell.get("recall1")) * queries)
                 ties = cell.get("near_ties")
-                lines.append(f"| {key[0]} | {key[1]} | {key[2]} | `{method}` | {cell.batch} | {sig(cell.get('recall1'), 4)}"
+                lines.append(f"| {key[0]} | {key[1]} | {key[2]} | `{method}` | {sig(cell.get('recall1'), 4)}"
                              f" | {differs} | {DASH if ties is None else int(ties)} |")
     if not lines:
         return []
-    return ["| data set | schema | stream | method | B | recall@1 | top-1 differs (of 1024 queries) | of which near-ties |",
-            "|---|---|---|---|---|---|---|---|"] + lines
+    return ["| data set | schema | stream | method | recall@1 | top-1 differs (of 1024 queries) | of which near-ties |",
+            "|---|---|---|---|---|---|---|"] + lines
 
 
 def head_to_head(index, dataset="volume", schema="default27", stream="transition", batch=1024, target=0.99):

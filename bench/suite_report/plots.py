@@ -128,7 +128,7 @@ def qps_vs_batch(index, path, schema="default27", stream="transition"):
         ax.set_title(_n_title(index, dataset))
         ax.grid(True, which="major", alpha=0.3)
     _finish(fig, axes, path, f"Throughput against batch size — {stream} stream, {schema} schema (higher is better)\n"
-            "approximate methods at their cheapest setting with recall@1 ≥ 0.99 at B = 1024, else their most accurate")
+            "approximate: cheapest setting with recall@1 ≥ 0.99 (else most accurate)")
     return True
 
 

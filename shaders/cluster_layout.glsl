@@ -19,6 +19,8 @@ const uint kNeverCandidate = 7u;
 // Work items (one invocation each) per cluster_scan workgroup
 // (cluster_layout.hpp: kScanWorkgroup); the scan is built with that size.
 const uint kItemsPerScanGroup = 64u;
+// scan_dispatch entry of round 0's tiled scan (round 1's is the next one).
+const uint kTileDispatchEntry = 2u;
 
 // cluster_layout.hpp: ClusterPush (32 bytes).
 layout(push_constant) uniform ClusterPush {
@@ -29,7 +31,7 @@ layout(push_constant) uniform ClusterPush {
   uint cluster_count;
   uint block_count;    // member blocks over all clusters
   uint nprobe;         // 0: exact; else clusters probed per query (< cluster_count)
-  uint pad0;
+  uint tile;           // work items per scan tile (cluster_sort, cluster_scan)
 } pc;
 
 // cluster_layout.hpp: ClusterQueryState (48 bytes, std430).
@@ -74,15 +76,33 @@ layout(std430, set = 1, binding = 8) buffer States { ClusterQueryState states[];
 // [work items x K] the best (key, frame) pairs of each work item (round 0's
 // items, then round 1's; at most chunk x blocks).
 layout(std430, set = 1, binding = 9) buffer BlockPairs { uvec2 block_pairs[]; };
-// Per scan round: (workgroups x, 1, 1, work items), the indirect dispatch
-// of cluster_scan (cluster_layout.hpp: kScanDispatchReset); the host
-// zeroes x and the count before each chunk.
-layout(std430, set = 1, binding = 10) buffer ScanDispatch { uvec4 scan_dispatch[2]; };
+// Per scan round r: [r] = (workgroups x, 1, 1, work items), the indirect
+// dispatch of cluster_sort's per-item steps, counted while listing; [2 + r]
+// = (workgroups x, 1, 1, tiles), cluster_scan's, written by cluster_sort's
+// prefix step (cluster_layout.hpp: kScanDispatchReset); the host zeroes
+// them before each chunk.
+layout(std430, set = 1, binding = 10) buffer ScanDispatch { uvec4 scan_dispatch[4]; };
 // [chunk x blocks] (local query, block): the work items, each query's
 // items of a round consecutive.
 layout(std430, set = 1, binding = 11) buffer WorkItems { uvec2 work_items[]; };
 // [chunk x blocks] per query: the blocks it lists, before they get their
 // place among the work items.
 layout(std430, set = 1, binding = 12) buffer Listed { uint listed[]; };
+// The work items of a round sorted by block (cluster_sort.comp), so that a
+// scan invocation evaluates one block for a tile of the queries that visit
+// it (a row loaded once per tile, not once per query). Words, with
+// B = block_count:
+//   [0, 2B)             per round, the items listing each block (zeroed by
+//                       the host before each chunk)
+//   [2B, 3B + 1)        the first sorted position of each block's items
+//   [3B + 1, 4B + 2)    the first tile of each block's items
+//   [4B + 2 + 2i]       item i's rank among its block's items
+//   [4B + 2 + 2j + 1]   the item at sorted position j of the round
+layout(std430, set = 1, binding = 13) buffer BlockSort { uint block_sort[]; };
+uint sort_fill(uint round, uint b) { return round * pc.block_count + b; }
+uint sort_item_start(uint b) { return 2u * pc.block_count + b; }
+uint sort_tile_start(uint b) { return 3u * pc.block_count + 1u + b; }
+uint sort_rank(uint item) { return 4u * pc.block_count + 2u + 2u * item; }
+uint sort_sorted(uint position) { return 4u * pc.block_count + 3u + 2u * position; }
 
 #endif

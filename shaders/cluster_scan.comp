@@ -1,10 +1,13 @@
 // Cluster search, pass 3 (twice per chunk, indirect): one invocation per
-// work item (query, member block) evaluates the block's rows and writes the
-// query's best K (key, frame) pairs of the block at the item's place in
-// block_pairs. The work items are dense (only visited blocks are listed),
-// so the lanes of a SIMD group are all busy, on different blocks (an
-// earlier layout split a block over 8 lanes and merged them through shared
-// memory and a barrier: 1.35x slower end to end on lavapipe).
+// tile, a member block and up to pc.tile work items (query, block) that
+// visit it (cluster_sort.comp sorted the round's items by block), evaluates
+// the block's rows for the tile's queries held in registers and writes each
+// item's best K (key, frame) pairs at the item's place in block_pairs.
+// Batch by block: the row's texel fetches (features, metadata, cost terms)
+// are shared by the tile, as in the brute-force scan; one invocation per
+// (query, block) was gather-bound (about 7M rows/s on lavapipe). Lanes of a
+// SIMD group work on different blocks (splitting a block over 8 lanes and
+// merging through shared memory was 1.35x slower on lavapipe).
 //  round 0: the seed cluster's blocks (listed by cluster_select);
 //  round 1: the blocks, of every other cluster, whose bound key is <= the
 //           k-th best key after round 0 (listed by cluster_merge round 0).
@@ -22,54 +25,96 @@
 #include "search_cost.glsl"
 #include "top_k.glsl"
 
+layout(constant_id = 3) const uint T = 1;  // work items per tile (= pc.tile)
+
+#define kInfinity uintBitsToFloat(0x7F800000u)
+
+// The block of tile `tile`: the last block whose first tile is <= it (a
+// block with no items has the same first tile as the next one).
+uint tile_block(uint tile) {
+  uint lo = 0u;
+  uint hi = pc.block_count - 1u;
+  while (lo < hi) {
+    const uint mid = (lo + hi + 1u) >> 1u;
+    if (block_sort[sort_tile_start(mid)] <= tile) {
+      lo = mid;
+    } else {
+      hi = mid - 1u;
+    }
+  }
+  return lo;
+}
+
 void main() {
-  const uint local_item = gl_GlobalInvocationID.x;
-  if (local_item >= scan_dispatch[pc.round].w) return;
-  const uint item = (pc.round == 0u ? 0u : scan_dispatch[0].w) + local_item;
-  const uvec2 work = work_items[item];
-  const uint query = pc.query_base + work.x;
-  const uvec4 info = texelFetch(block_info, int(work.y * 2u));
-  vec4 q[DV];
-  float w[CHANNELS];
-  load_query(query, q, w);
-  const QueryGpu p = query_params[query];
-  // The candidate rules as in the brute force, branch-free: flagged rows get
-  // a NaN bias, the tags and the exclusion window (which holds the
-  // continuing frame, evaluated by cluster_select) are integer operations.
-  const uvec4 skipped = skipped_ranges(p);
+  const uint tile = gl_GlobalInvocationID.x;
+  if (tile >= scan_dispatch[kTileDispatchEntry + pc.round].w) return;
+  const uint round_base = pc.round == 0u ? 0u : scan_dispatch[0].w;
+  const uint block = tile_block(tile);
+  const uint first = block_sort[sort_item_start(block)] + (tile - block_sort[sort_tile_start(block)]) * T;
+  const uint count = min(T, block_sort[sort_item_start(block + 1u)] - first);
+  const uvec4 info = texelFetch(block_info, int(block * 2u));
+
+  // Slots past the tile's count repeat its last item (not written).
+  uint item[T];
+  vec4 q[T][DV];
+  float w[T][CHANNELS];
+  uvec4 tags[T];     // (require lo, require hi, exclude lo, exclude hi)
+  uvec4 skipped[T];  // skipped_ranges(): the exclusion window and the continuing frame
   // K = 1: the running best; a frame of kNone is an empty slot. Rows run in
   // descending frame order (a block's members ascend), so `cost <= best`
   // keeps the lowest frame among ties, accepts an infinite cost into an
   // empty slot and rejects NaN.
-  float best_cost = uintBitsToFloat(0x7F800000u);
-  uint best_frame = kNone;
+  float best_cost[T];
+  uint best_frame[T];
   // K > 1: the best K, sorted, and the cost of the last (+inf while empty).
-  uvec2 best[K];
-  clear_pairs(best);
-  float worst = uintBitsToFloat(0x7F800000u);
+  uvec2 best[T][K];
+  float worst[T];
+  [[unroll]] for (uint t = 0; t < T; ++t) {
+    item[t] = block_sort[sort_sorted(round_base + first + min(t, count - 1u))];
+    const uint query = pc.query_base + work_items[item[t]].x;
+    load_query(query, q[t], w[t]);
+    const QueryGpu p = query_params[query];
+    tags[t] = uvec4(p.require_lo, p.require_hi, p.exclude_lo, p.exclude_hi);
+    skipped[t] = skipped_ranges(p);
+    best_cost[t] = kInfinity;
+    best_frame[t] = kNone;
+    clear_pairs(best[t]);
+    worst[t] = kInfinity;
+  }
+
   for (uint m = info.z; m > info.y;) {
     --m;
     const uvec4 meta = texelFetch(member_meta, int(m));  // (frame, flags, tags lo, tags hi)
     const uint r = meta.x;
     vec2 scale_bias = texelFetch(member_cost, int(m)).xy;
+    // The candidate rules as in the brute force, branch-free: flagged rows
+    // get a NaN bias, the tags and the exclusion window are integer
+    // operations.
     if ((meta.y & kNeverCandidate) != 0u) scale_bias.y = uintBitsToFloat(0x7FC00000u);
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(member_rows, int(m * DV + v));
-    const float cost = row_cost(x, q, w, scale_bias);
-    const uint rejected = ((meta.z & p.require_lo) ^ p.require_lo) | ((meta.w & p.require_hi) ^ p.require_hi) |
-                          (meta.z & p.exclude_lo) | (meta.w & p.exclude_hi) |
-                          uint(r - skipped.x <= skipped.y) | uint(r - skipped.z <= skipped.w);
-    if (K == 1u) {
-      const bool better = rejected == 0u && cost <= best_cost;
-      best_cost = better ? cost : best_cost;
-      best_frame = better ? r : best_frame;
-    } else if (rejected == 0u && !(cost > worst)) {
-      insert_row(best, worst, cost, r);
+    [[unroll]] for (uint t = 0; t < T; ++t) {
+      const float cost = row_cost(x, q[t], w[t], scale_bias);
+      const uint rejected = ((meta.z & tags[t].x) ^ tags[t].x) | ((meta.w & tags[t].y) ^ tags[t].y) |
+                            (meta.z & tags[t].z) | (meta.w & tags[t].w) |
+                            uint(r - skipped[t].x <= skipped[t].y) | uint(r - skipped[t].z <= skipped[t].w);
+      if (K == 1u) {
+        const bool better = rejected == 0u && cost <= best_cost[t];
+        best_cost[t] = better ? cost : best_cost[t];
+        best_frame[t] = better ? r : best_frame[t];
+      } else if (rejected == 0u && !(cost > worst[t])) {
+        insert_row(best[t], worst[t], cost, r);
+      }
     }
   }
-  if (K == 1u) {
-    block_pairs[item] = best_frame == kNone ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost), best_frame);
-  } else {
-    [[unroll]] for (uint j = 0; j < K; ++j) block_pairs[item * K + j] = best[j];
+
+  [[unroll]] for (uint t = 0; t < T; ++t) {
+    if (t >= count) break;
+    if (K == 1u) {
+      block_pairs[item[t]] =
+          best_frame[t] == kNone ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost[t]), best_frame[t]);
+    } else {
+      [[unroll]] for (uint j = 0; j < K; ++j) block_pairs[item[t] * K + j] = best[t][j];
+    }
   }
 }

@@ -112,6 +112,7 @@ TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
   options.max_batch = 100;
   options.max_k = 4;
   options.scratch_bytes = 16 << 10;  // a few queries per chunk
+  options.cluster_scratch_bytes = 16 << 10;
   auto created = vulkan::VulkanSearch::create(*context, db, options, *table);
   ASSERT_TRUE(created.ok()) << created.message();
   std::unique_ptr<vulkan::VulkanSearch> gpu = std::move(created).value();
@@ -156,6 +157,52 @@ TEST(VulkanClusterSearch, LargeDatabaseStaysExact) {
   }
 }
 
+// The scan evaluates a block once for a tile of the queries that visit it
+// (cluster_sort.comp sorts the work items by block): many queries near the
+// same few rows fill whole tiles and leave partial ones, and the queries of
+// one tile differ in tags, exclusion windows and continuing frames. Exact
+// for k = 1, 4 and 16, in one chunk and in chunks of a few queries, under
+// the validation layer.
+TEST(VulkanClusterSearch, TiledScanOverSharedBlocksStaysExact) {
+  vulkan::ContextOptions context_options;
+  context_options.validation = true;
+  MMVK_VULKAN_CONTEXT(context, context_options);
+  const Database db = synthetic_database({.frames = 5000, .seed = 121, .constraints = true});
+  ClusterTableCache tables;
+  Result<const ClusterTable*> table = tables.table_for(db);
+  ASSERT_TRUE(table.ok()) << table.message();
+  constexpr std::uint32_t kBatch = 203;  // 7 bases x 29: tiles of 8 full and partial
+  const std::vector<float> bases = synthetic_queries(db, 7, 122, 0.05f);
+  std::vector<float> queries;
+  for (std::uint32_t i = 0; i < kBatch; ++i) {
+    const std::size_t base = std::size_t{i % 7} * db.dims();
+    for (std::uint32_t d = 0; d < db.dims(); ++d) {
+      queries.push_back(bases[base + d] + 1e-3f * static_cast<float>((i * 7 + d * 3) % 11));
+    }
+  }
+  const std::vector<QueryParams> params = random_params(db, kBatch, 123);
+  for (const std::uint64_t cluster_scratch : {std::uint64_t{512} << 20, std::uint64_t{64} << 10}) {
+    vulkan::VulkanSearchOptions options;
+    options.warm_up = false;
+    options.mode = vulkan::SearchMode::ClustersExact;
+    options.max_batch = kBatch;
+    options.max_k = 16;
+    options.cluster_scratch_bytes = cluster_scratch;
+    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
+    ASSERT_TRUE(gpu.ok()) << gpu.message();
+    for (const std::uint32_t k : {1u, 4u, 16u}) {
+      SCOPED_TRACE("k " + std::to_string(k) + ", cluster scratch " + std::to_string(cluster_scratch));
+      const std::vector<Match> expected = reference_results(db, queries, params, kBatch, k);
+      expect_identical(expected, run_search(**gpu, queries, params, kBatch, k), k, params, (*gpu)->name());
+      const std::vector<Match> expected_plain = reference_results(db, queries, {}, kBatch, k);
+      expect_identical(expected_plain, run_search(**gpu, queries, {}, kBatch, k), k, {}, (*gpu)->name());
+    }
+    EXPECT_LT((*gpu)->stats().rows_fraction(db.frame_count()), 0.9);
+  }
+  const std::vector<std::string> messages = context->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, the first: " << messages.front();
+}
+
 // A backend builds the pipelines of its own mode only (warm_up() runs each):
 // the cluster modes no brute-force kernel, brute force no cluster kernel.
 TEST(VulkanClusterSearch, BuildsOnlyItsModesKernels) {
@@ -182,9 +229,10 @@ TEST(VulkanClusterSearch, BuildsOnlyItsModesKernels) {
     const bool brute = mode == vulkan::SearchMode::BruteForce;
     EXPECT_EQ(has(kernels, "brute_force_scan") || has(kernels, "topk_merge"), brute) << (*gpu)->name();
     EXPECT_EQ(has(kernels, "cluster_"), !brute) << (*gpu)->name();
-    // K classes 1 and 4: a scan and a merge each, plus bounds and select.
+    // K classes 1 and 4: a scan and a merge each, plus bounds, select and
+    // the block sort's three steps.
     if (!brute) {
-      EXPECT_EQ(kernels.size(), 6u);
+      EXPECT_EQ(kernels.size(), 9u);
     }
     EXPECT_TRUE((*gpu)->warm_up().ok());
   }

@@ -32,6 +32,11 @@ constexpr std::uint32_t kBlockRows[] = {32, 64, 128, 256, 512, 1024, 2048, 4096}
 constexpr std::uint64_t kMaxLoopIterations = 60000;
 constexpr std::uint32_t kMaxProbeClusters = 1700;
 
+// Work items per cluster_scan tile (one block, up to this many queries in
+// registers; pad slots repeat a query): K = 1 keeps two registers per
+// query, K > 1 keeps K pairs, as the brute force's tiles.
+std::uint32_t scan_tile(std::uint32_t k_class) { return k_class == 1 ? 8 : 4; }
+
 std::uint64_t loop_iterations(std::uint64_t clusters, std::uint64_t blocks, std::uint32_t k_class) {
   return clusters + (2 + std::uint64_t{k_class}) * blocks;
 }
@@ -242,13 +247,21 @@ Result<std::uint64_t> ClusterKernel::size_scratch(const Context& context, const 
   const std::uint64_t pairs_per_query = std::uint64_t{block_count_} * k_class(options.max_k);
   // Bound keys, block pairs, work items (8 bytes each) and listed blocks
   // (4 bytes): a query lists each block at most once over both rounds.
-  const std::uint64_t per_query_bytes = (pairs_per_query + clusters) * 8 + std::uint64_t{block_count_} * 12;
+  // The block sort: a rank and a sorted position per work item, and a
+  // header of 4 words per block.
+  const std::uint64_t sort_header = block_sort_header_words(block_count_) * 4;
+  const std::uint64_t sort_per_query = std::uint64_t{block_count_} * kBlockSortWordsPerItem * 4;
+  const std::uint64_t per_query_bytes =
+      (pairs_per_query + clusters) * 8 + std::uint64_t{block_count_} * 12 + sort_per_query;
+  if (sort_header + sort_per_query > range) {
+    return make_error("Vulkan: one query's cluster block sort exceeds maxStorageBufferRange");
+  }
   std::uint64_t chunk = std::clamp<std::uint64_t>(options.scratch_bytes / per_query_bytes, 1, options.max_batch);
   // The indirect scans: every block of the chunk visited must stay within
   // maxComputeWorkGroupCount[0] workgroups.
   const std::uint64_t items_per_group = kItemsPerScanGroup;
   chunk = std::min({chunk, range / (pairs_per_query * 8), range / (clusters * 8),
-                    range / (std::uint64_t{block_count_} * 8),
+                    range / (std::uint64_t{block_count_} * 8), (range - sort_header) / sort_per_query,
                     std::uint64_t{limits.maxComputeWorkGroupCount[1]},
                     std::uint64_t{limits.maxComputeWorkGroupCount[0]} * items_per_group / block_count_});
   if (chunk == 0) return make_error("Vulkan: one query's cluster scratch exceeds maxStorageBufferRange");
@@ -277,6 +290,9 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
        "the cluster scan dispatch arguments"},
       {&SlotScratch::work_items, chunk * block_count_ * 8, storage, MemoryUse::DeviceLocal, "the cluster work items"},
       {&SlotScratch::listed, chunk * block_count_ * 4, storage, MemoryUse::DeviceLocal, "the cluster listed blocks"},
+      {&SlotScratch::block_sort,
+       (block_sort_header_words(block_count_) + chunk * block_count_ * kBlockSortWordsPerItem) * 4,
+       storage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::DeviceLocal, "the cluster block sort"},
   };
   static_assert(std::size(buffers) == kClusterSet.storage);
   const std::array<VkBufferView, kClusterSet.texel> views = {
@@ -303,10 +319,16 @@ Status ClusterKernel::create_pipelines(const Context& context, std::uint32_t max
   MMVK_ASSIGN_OR_RETURN(bounds_,
                         create_compute_pipeline(context, layout, "cluster_bounds", shape_spec(grid_shape, 1)));
   MMVK_ASSIGN_OR_RETURN(select_, create_compute_pipeline(context, layout, "cluster_select", shape_spec(shape_, 1)));
+  for (std::uint32_t step = 0; step < std::size(sort_); ++step) {
+    std::vector<SpecValue> spec = shape_spec(grid_shape, 1);
+    spec.push_back({kSpecSortStep, step});
+    MMVK_ASSIGN_OR_RETURN(sort_[step], create_compute_pipeline(context, layout, "cluster_sort", spec));
+  }
   for (const std::uint32_t k : {1u, 4u, 16u}) {
     if (k > k_class(max_k)) break;
-    MMVK_ASSIGN_OR_RETURN(UniquePipeline scan,
-                          create_compute_pipeline(context, layout, "cluster_scan", shape_spec(grid_shape, k)));
+    std::vector<SpecValue> scan_spec = shape_spec(grid_shape, k);
+    scan_spec.push_back({kSpecTile, scan_tile(k)});
+    MMVK_ASSIGN_OR_RETURN(UniquePipeline scan, create_compute_pipeline(context, layout, "cluster_scan", scan_spec));
     MMVK_ASSIGN_OR_RETURN(UniquePipeline merge,
                           create_compute_pipeline(context, layout, "cluster_merge", shape_spec(shape_, k)));
     variants_.push_back(Variant{k, std::move(scan), std::move(merge)});
@@ -321,7 +343,8 @@ std::vector<std::uint32_t> ClusterKernel::k_classes() const {
 }
 
 std::vector<std::string_view> ClusterKernel::kernel_names() const {
-  std::vector<std::string_view> names = {"cluster_bounds", "cluster_select"};
+  std::vector<std::string_view> names = {"cluster_bounds", "cluster_select", "cluster_sort", "cluster_sort",
+                                         "cluster_sort"};
   for (std::size_t v = 0; v < variants_.size(); ++v) {
     names.push_back("cluster_scan");
     names.push_back("cluster_merge");
@@ -356,12 +379,14 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
   const std::uint32_t items_per_group = kItemsPerScanGroup;
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);
-    ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, 0};
+    ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, scan_tile(kc)};
     const std::uint32_t query_groups = (count + wg - 1) / wg;
     // The previous chunk's last merge read the scratch this chunk rewrites.
     if (base != 0) full_barrier(commands);
     vkCmdUpdateBuffer(commands, scratch.scan_dispatch.buffer.get(), 0, sizeof(kScanDispatchReset),
                       kScanDispatchReset.data());
+    // Both rounds' per-block item counters.
+    vkCmdFillBuffer(commands, scratch.block_sort.buffer.get(), 0, std::uint64_t{block_count_} * 2 * 4, 0);
     MMVK_TRY(dispatch(context, commands, bounds_.get(), layout, push,
                       (cluster_count_ + kScanWorkgroup - 1) / kScanWorkgroup, count, "cluster_bounds"));
     full_barrier(commands);
@@ -373,10 +398,20 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
         (std::uint64_t{count} * block_count_ + items_per_group - 1) / items_per_group;
     for (std::uint32_t round = 0; round < 2; ++round) {
       push.round = round;
+      // The work items (and so the group counts) were listed on the GPU:
+      // sorted by block (rank, prefix sums, scatter), then scanned by tile.
+      for (std::uint32_t step = 0; step < std::size(sort_); ++step) {
+        full_barrier(commands);
+        if (step == 1) {
+          MMVK_TRY(dispatch(context, commands, sort_[step].get(), layout, push, 1, 1, "cluster_sort"));
+        } else {
+          MMVK_TRY(dispatch_indirect(context, commands, sort_[step].get(), layout, push, scratch.scan_dispatch,
+                                     round * kScanDispatchStride, max_scan_groups, "cluster_sort"));
+        }
+      }
       full_barrier(commands);
-      // The work items (and so the group count) were listed on the GPU.
       MMVK_TRY(dispatch_indirect(context, commands, variant->scan.get(), layout, push, scratch.scan_dispatch,
-                                 round * kScanDispatchStride, max_scan_groups, "cluster_scan"));
+                                 (kTileDispatchEntry + round) * kScanDispatchStride, max_scan_groups, "cluster_scan"));
       full_barrier(commands);
       MMVK_TRY(dispatch(context, commands, variant->merge.get(), layout, push, query_groups, 1, "cluster_merge"));
     }

@@ -2,12 +2,15 @@
 // ClustersExact and NProbe modes: the ClusterTable uploaded once (set 1 of
 // the cluster pipelines), per-slot scratch, and the recording of a batch.
 //
-// Per chunk of queries, six dispatches (two indirect):
+// Per chunk of queries, twelve dispatches (eight indirect):
 //   cluster_bounds  (cluster, query): lower bound key per cluster, kSkip for
 //                   clusters without candidates; centroid distance (nprobe)
 //   cluster_select  (query): nprobe selection, the seed cluster (least
 //                   bound), the continuing frame's pair
-//   cluster_scan    round 0 (8 lanes per listed block, indirect): the seed
+//   cluster_sort    per round, 3 steps: the listed work items sorted by
+//                   block (a counting sort), tiles of up to scan_tile(K)
+//                   items of one block
+//   cluster_scan    round 0 (one invocation per tile, indirect): the seed
 //                   cluster's blocks (listed by cluster_select)
 //   cluster_merge   round 0 (query): the k-th best so far = upper bound;
 //                   lists the blocks of clusters with bound <= upper bound
@@ -38,7 +41,7 @@ struct ClusterKernelOptions {
   std::uint32_t max_k = 1;
   std::uint32_t slots = 1;
   std::uint32_t nprobe = 0;               // 0 = exact; >= cluster_count is exact too
-  std::uint64_t scratch_bytes = 32 << 20;  // per slot: bound keys + block pairs
+  std::uint64_t scratch_bytes = std::uint64_t{512} << 20;  // per slot: VulkanSearchOptions::cluster_scratch_bytes
   bool force_staging = false;
 };
 
@@ -76,6 +79,7 @@ class ClusterKernel {
     Buffer scan_dispatch;  // 2 x (groups x, 1, 1, items): indirect args of the scans
     Buffer work_items;     // [chunk x blocks] (local query, block)
     Buffer listed;         // [chunk x blocks] blocks listed per query
+    Buffer block_sort;     // the work items sorted by block (cluster_layout.glsl: BlockSort)
     VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
   };
   struct Variant {
@@ -116,6 +120,7 @@ class ClusterKernel {
   std::vector<SlotScratch> slots_;
   UniquePipeline bounds_;
   UniquePipeline select_;
+  UniquePipeline sort_[3];  // cluster_sort steps: rank, prefix sums, scatter
   std::vector<Variant> variants_;
 };
 

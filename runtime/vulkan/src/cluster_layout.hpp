@@ -21,7 +21,7 @@ struct ClusterPush {
   std::uint32_t cluster_count;
   std::uint32_t block_count;
   std::uint32_t nprobe;
-  std::uint32_t pad0;
+  std::uint32_t tile;  // work items per scan tile
 };
 static_assert(sizeof(ClusterPush) == 32);
 static_assert(sizeof(ClusterPush) <= 128, "Vulkan guarantees only 128 bytes of push constants");
@@ -60,9 +60,10 @@ enum ClusterBinding : std::uint32_t {
   kBindingScanDispatch = 10,   // storage + indirect
   kBindingWorkItems = 11,      // storage
   kBindingListed = 12,         // storage
-  kClusterBindingCount = 13,
+  kBindingBlockSort = 13,      // storage
+  kClusterBindingCount = 14,
 };
-inline constexpr SetShape kClusterSet{7, 6};
+inline constexpr SetShape kClusterSet{7, 7};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
 // The workgroup size of cluster_scan (one invocation per work item) and
@@ -71,10 +72,18 @@ static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() =
 inline constexpr std::uint32_t kScanWorkgroup = 64;
 inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup;
 
-// GLSL: ScanDispatch, per scan round (groups x, 1, 1, work items): the
-// indirect dispatch of cluster_scan, reset by the host before each chunk.
-inline constexpr std::array<std::uint32_t, 8> kScanDispatchReset = {0, 1, 1, 0, 0, 1, 1, 0};
-inline constexpr std::uint64_t kScanDispatchStride = 16;  // bytes per round (a uvec4)
-static_assert(sizeof(kScanDispatchReset) == 2 * kScanDispatchStride);
+// GLSL: ScanDispatch, (groups x, 1, 1, count) per scan round for the
+// per-item sort steps, then per round for the tiled scan; reset by the
+// host before each chunk.
+inline constexpr std::array<std::uint32_t, 16> kScanDispatchReset = {0, 1, 1, 0, 0, 1, 1, 0,
+                                                                     0, 1, 1, 0, 0, 1, 1, 0};
+inline constexpr std::uint64_t kScanDispatchStride = 16;  // bytes per entry (a uvec4)
+inline constexpr std::uint32_t kTileDispatchEntry = 2;    // entry of round 0's tiled scan
+static_assert(sizeof(kScanDispatchReset) == 4 * kScanDispatchStride);
+
+// GLSL: BlockSort, words before the per-item pairs (4 x blocks + 2), and
+// words per work item (rank, sorted item).
+inline constexpr std::uint64_t block_sort_header_words(std::uint64_t blocks) { return 4 * blocks + 2; }
+inline constexpr std::uint64_t kBlockSortWordsPerItem = 2;
 
 }  // namespace mmvk::vulkan::detail

@@ -22,11 +22,12 @@ enum SpecId : std::uint32_t {
   kSpecWorkgroupSize = 0,
   kSpecDimVec4s = 1,
   kSpecDims = 2,
-  kSpecTile = 3,   // brute_force_scan only
+  kSpecTile = 3,   // brute_force_scan, cluster_scan
   kSpecK = 4,
   kSpecChannels = 5,
   kSpecEndMask0 = 6,  // .. kSpecEndMask0 + 3
   kSpecMergeContinuing = 10,  // topk_merge only: evaluate the continuing frame
+  kSpecSortStep = 11,         // cluster_sort only: which of its steps
 };
 inline constexpr std::uint32_t kMaxKernelDims = 128;            // four 32-bit end masks
 inline constexpr std::uint32_t kMaxRowsPerInvocation = 32768;  // llvmpipe's loop limit is 65,535

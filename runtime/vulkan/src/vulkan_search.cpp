@@ -240,7 +240,7 @@ Status VulkanSearch::Impl::create_cluster_kernel(const ClusterTable& table) {
   cluster_options.max_k = options.max_k;
   cluster_options.slots = options.slots;
   cluster_options.nprobe = options.mode == SearchMode::NProbe ? options.nprobe : 0;
-  cluster_options.scratch_bytes = options.scratch_bytes;
+  cluster_options.scratch_bytes = options.cluster_scratch_bytes;
   cluster_options.force_staging = options.force_staging_upload;
   MMVK_ASSIGN_OR_RETURN(ClusterKernel created, ClusterKernel::create(*context, command_pool.get(), set_layout.get(),
                                                                      shape, *database, table, cluster_options));

@@ -22,7 +22,8 @@ using ContextSource = std::function<Result<Context*>()>;
 
 // `context` must outlive the registry and every backend made from it.
 // `base` supplies the options a BackendSpec does not carry (slots,
-// rows_per_invocation, scratch_bytes, force_staging_upload); mode, nprobe,
+// rows_per_invocation, scratch_bytes, cluster_scratch_bytes,
+// force_staging_upload); mode, nprobe,
 // max_batch, max_k, max_tile and warm_up come from the name and the spec.
 // Error when one of the names is already registered.
 Status add_backends(BackendRegistry& registry, Context& context, const VulkanSearchOptions& base = {});

@@ -11,13 +11,19 @@
 // then moves them to consecutive work items reserved with one atomic (so
 // the merge finds them as a range); returns (first item, count), the first
 // counted from item 0 of round 0. The group count is
-// ceil(items / kItemsPerScanGroup), raised by each reservation's share.
+// min(ceil(items / kItemsPerScanGroup), kMaxIndirectGroups), raised by each
+// reservation's share.
 uvec2 move_listed(uint round, uint local_query, uint count) {
   if (count == 0u) return uvec2(0u, 0u);
   const uint first = atomicAdd(scan_dispatch[round].w, count);
   const uint g = kItemsPerScanGroup;
   const uint groups = (first + count + g - 1u) / g - (first + g - 1u) / g;
-  if (groups != 0u) atomicAdd(scan_dispatch[round].x, groups);
+  if (groups != 0u) {
+    // Adds then clamps: whatever the interleaving, x ends at
+    // min(total groups, kMaxIndirectGroups).
+    atomicAdd(scan_dispatch[round].x, groups);
+    atomicMin(scan_dispatch[round].x, kMaxIndirectGroups);
+  }
   const uint base = round == 0u ? first : scan_dispatch[0].w + first;
   const uint row = local_query * pc.block_count;
   for (uint i = 0u; i < count; ++i) work_items[base + i] = uvec2(local_query, listed[row + i]);

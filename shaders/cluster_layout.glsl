@@ -19,6 +19,11 @@ const uint kNeverCandidate = 7u;
 // Work items (one invocation each) per cluster_scan workgroup
 // (cluster_layout.hpp: kScanWorkgroup); the scan is built with that size.
 const uint kItemsPerScanGroup = 64u;
+// Most workgroups of an indirect cluster dispatch (Vulkan's minimum of
+// maxComputeWorkGroupCount[0], cluster_layout.hpp: kMaxIndirectGroups);
+// past it, invocations take several items (a grid-stride loop), so a
+// chunk is not capped by its worst-case item count.
+const uint kMaxIndirectGroups = 65535u;
 // scan_dispatch entry of round 0's tiled scan (round 1's is the next one).
 const uint kTileDispatchEntry = 2u;
 

@@ -45,9 +45,9 @@ uint tile_block(uint tile) {
   return lo;
 }
 
-void main() {
-  const uint tile = gl_GlobalInvocationID.x;
-  if (tile >= scan_dispatch[kTileDispatchEntry + pc.round].w) return;
+// Evaluates tile `tile` (main: one per invocation, more with a grid stride
+// past kMaxIndirectGroups workgroups).
+void scan_tile(uint tile) {
   const uint round_base = pc.round == 0u ? 0u : scan_dispatch[0].w;
   const uint block = tile_block(tile);
   const uint first = block_sort[sort_item_start(block)] + (tile - block_sort[sort_tile_start(block)]) * T;
@@ -117,4 +117,10 @@ void main() {
       [[unroll]] for (uint j = 0; j < K; ++j) block_pairs[item[t] * K + j] = best[t][j];
     }
   }
+}
+
+void main() {
+  const uint tiles = scan_dispatch[kTileDispatchEntry + pc.round].w;
+  const uint stride = gl_NumWorkGroups.x * kItemsPerScanGroup;
+  for (uint tile = gl_GlobalInvocationID.x; tile < tiles; tile += stride) scan_tile(tile);
 }

@@ -3,6 +3,7 @@
 // that cluster_scan evaluates each block once for a tile of up to pc.tile
 // queries that visit it (batch by block: a row is loaded once per tile,
 // where a scan per (query, block) loaded it once per query).
+// Per-item steps loop with a grid stride past kMaxIndirectGroups groups.
 //  STEP 0 (per item, indirect on the round's item count): the item's rank
 //         among its block's items (an atomic counter per block);
 //  STEP 1 (one invocation): exclusive prefix sums over the blocks of the
@@ -37,18 +38,20 @@ void main() {
     }
     block_sort[sort_item_start(pc.block_count)] = items;
     block_sort[sort_tile_start(pc.block_count)] = tiles;
-    scan_dispatch[kTileDispatchEntry + round] =
-        uvec4((tiles + kItemsPerScanGroup - 1u) / kItemsPerScanGroup, 1u, 1u, tiles);
+    const uint groups = min((tiles + kItemsPerScanGroup - 1u) / kItemsPerScanGroup, kMaxIndirectGroups);
+    scan_dispatch[kTileDispatchEntry + round] = uvec4(groups, 1u, 1u, tiles);
     return;
   }
-  const uint local_item = gl_GlobalInvocationID.x;
-  if (local_item >= scan_dispatch[round].w) return;
-  const uint item = round_base + local_item;
-  const uint block = work_items[item].y;
-  if (STEP == 0u) {
-    block_sort[sort_rank(item)] = atomicAdd(block_sort[sort_fill(round, block)], 1u);
-  } else {
-    const uint position = block_sort[sort_item_start(block)] + block_sort[sort_rank(item)];
-    block_sort[sort_sorted(round_base + position)] = item;
+  const uint items = scan_dispatch[round].w;
+  const uint stride = gl_NumWorkGroups.x * kItemsPerScanGroup;
+  for (uint local_item = gl_GlobalInvocationID.x; local_item < items; local_item += stride) {
+    const uint item = round_base + local_item;
+    const uint block = work_items[item].y;
+    if (STEP == 0u) {
+      block_sort[sort_rank(item)] = atomicAdd(block_sort[sort_fill(round, block)], 1u);
+    } else {
+      const uint position = block_sort[sort_item_start(block)] + block_sort[sort_rank(item)];
+      block_sort[sort_sorted(round_base + position)] = item;
+    }
   }
 }

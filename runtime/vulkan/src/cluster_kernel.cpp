@@ -257,13 +257,12 @@ Result<std::uint64_t> ClusterKernel::size_scratch(const Context& context, const 
     return make_error("Vulkan: one query's cluster block sort exceeds maxStorageBufferRange");
   }
   std::uint64_t chunk = std::clamp<std::uint64_t>(options.scratch_bytes / per_query_bytes, 1, options.max_batch);
-  // The indirect scans: every block of the chunk visited must stay within
-  // maxComputeWorkGroupCount[0] workgroups.
-  const std::uint64_t items_per_group = kItemsPerScanGroup;
+  // The indirect dispatches are capped at kMaxIndirectGroups workgroups
+  // (the kernels loop past it), so the item count does not cap the chunk
+  // (it did: 314 queries at 417k frames, too few to share blocks).
   chunk = std::min({chunk, range / (pairs_per_query * 8), range / (clusters * 8),
                     range / (std::uint64_t{block_count_} * 8), (range - sort_header) / sort_per_query,
-                    std::uint64_t{limits.maxComputeWorkGroupCount[1]},
-                    std::uint64_t{limits.maxComputeWorkGroupCount[0]} * items_per_group / block_count_});
+                    std::uint64_t{limits.maxComputeWorkGroupCount[1]}});
   if (chunk == 0) return make_error("Vulkan: one query's cluster scratch exceeds maxStorageBufferRange");
   bound_capacity_ = chunk * clusters;
   pair_capacity_ = chunk * pairs_per_query;
@@ -392,10 +391,9 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
     full_barrier(commands);
     MMVK_TRY(dispatch(context, commands, select_.get(), layout, push, query_groups, 1, "cluster_select"));
     // A round lists each (query, block) at most once, so its work items
-    // need at most this many workgroups (the chunk cap keeps it within the
-    // device's limit).
-    const std::uint64_t max_scan_groups =
-        (std::uint64_t{count} * block_count_ + items_per_group - 1) / items_per_group;
+    // need at most this many workgroups, capped (the kernels loop past it).
+    const std::uint64_t max_scan_groups = std::min<std::uint64_t>(
+        (std::uint64_t{count} * block_count_ + items_per_group - 1) / items_per_group, kMaxIndirectGroups);
     for (std::uint32_t round = 0; round < 2; ++round) {
       push.round = round;
       // The work items (and so the group counts) were listed on the GPU:

@@ -79,6 +79,10 @@ inline constexpr std::array<std::uint32_t, 16> kScanDispatchReset = {0, 1, 1, 0,
                                                                      0, 1, 1, 0, 0, 1, 1, 0};
 inline constexpr std::uint64_t kScanDispatchStride = 16;  // bytes per entry (a uvec4)
 inline constexpr std::uint32_t kTileDispatchEntry = 2;    // entry of round 0's tiled scan
+// GLSL: kMaxIndirectGroups, the most workgroups of an indirect cluster
+// dispatch (Vulkan's minimum maxComputeWorkGroupCount[0]); the kernels
+// loop past it.
+inline constexpr std::uint32_t kMaxIndirectGroups = 65535;
 static_assert(sizeof(kScanDispatchReset) == 4 * kScanDispatchStride);
 
 // GLSL: BlockSort, words before the per-item pairs (4 x blocks + 2), and

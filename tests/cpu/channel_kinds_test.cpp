@@ -20,7 +20,15 @@ FeatureChannel sample_channel(const ChannelKindInfo& info) {
   channel.name = std::string(info.name) + "_channel";
   channel.kind = info.kind;
   if (has_field(info.fields, ChannelField::Bone)) channel.bone = "@left_foot";
-  if (has_field(info.fields, ChannelField::SecondBone)) channel.second_bone = "@right_foot";
+  if (has_field(info.fields, ChannelField::SecondBone)) {
+    // A second bone hangs below the first (limb_vector: the limb's end).
+    channel.bone = "@left_upper_leg";
+    channel.second_bone = "@left_foot";
+  }
+  if (has_field(info.fields, ChannelField::Curves)) {
+    channel.curves = {"@left_foot.height", "@right_foot.speed"};
+    channel.window_seconds = 0.25f;
+  }
   if (has_field(info.fields, ChannelField::Offsets)) channel.offsets_seconds = {0.25f, 0.5f, 1.0f};
   if (has_field(info.fields, ChannelField::Dims)) channel.custom_dims = 4;
   channel.weight = 1.5f;
@@ -52,8 +60,9 @@ TEST(ChannelKinds, EveryEntryIsCompleteAndFoundByName) {
 TEST(ChannelKinds, RulesAgreeWithFields) {
   for (const ChannelKindInfo& info : channel_kinds()) {
     SCOPED_TRACE(info.name);
-    // Offsets <=> one group of labels per offset <=> the edge rule applies.
+    // Offsets <=> one group of labels per offset; curves <=> one group per curve.
     EXPECT_EQ(has_field(info.fields, ChannelField::Offsets), info.dims_rule == DimsRule::LabelsPerOffset);
+    EXPECT_EQ(has_field(info.fields, ChannelField::Curves), info.dims_rule == DimsRule::LabelsPerCurve);
     EXPECT_EQ(uses_trajectory_offsets(info.kind), has_field(info.fields, ChannelField::Offsets));
     // Declared width <=> sidecar values <=> no labels.
     EXPECT_EQ(has_field(info.fields, ChannelField::Dims), info.dims_rule == DimsRule::Declared);
@@ -74,6 +83,7 @@ TEST(ChannelKinds, LabelsNameEveryDimOnce) {
       case DimsRule::Labels: expected = static_cast<std::uint32_t>(info.labels.size()); break;
       case DimsRule::LabelsPerOffset: expected = static_cast<std::uint32_t>(3 * info.labels.size()); break;
       case DimsRule::Declared: expected = 4; break;
+      case DimsRule::LabelsPerCurve: expected = static_cast<std::uint32_t>(2 * info.labels.size()); break;
     }
     ASSERT_EQ(channel.dims(), expected);
     ASSERT_GT(expected, 0u);
@@ -114,6 +124,8 @@ TEST(ChannelKinds, EveryKindRoundTripsThroughJson) {
     EXPECT_EQ(b.second_bone, a.second_bone);
     EXPECT_EQ(b.offsets_seconds, a.offsets_seconds);
     EXPECT_EQ(b.custom_dims, a.custom_dims);
+    EXPECT_EQ(b.curves, a.curves);
+    EXPECT_EQ(b.window_seconds, a.window_seconds);
     EXPECT_EQ(b.weight, a.weight);
     EXPECT_EQ(b.normalization, a.normalization);
     EXPECT_EQ(parsed->dims(), schema.dims());
@@ -134,6 +146,7 @@ TEST(ChannelKinds, MissingFieldsAreNamed) {
         {ChannelField::SecondBone, [](FeatureChannel& c) { c.second_bone.clear(); }, "second_bone is missing"},
         {ChannelField::Offsets, [](FeatureChannel& c) { c.offsets_seconds.clear(); }, "offsets_seconds is empty"},
         {ChannelField::Dims, [](FeatureChannel& c) { c.custom_dims = 0; }, "dims must be > 0"},
+        {ChannelField::Curves, [](FeatureChannel& c) { c.curves.clear(); }, "curves is empty"},
     };
     for (const Case& test : cases) {
       if (!has_field(info.fields, test.field)) continue;
@@ -223,8 +236,8 @@ TEST(ChannelKinds, EveryKindExtractsFiniteValuesInItsColumns) {
         ASSERT_EQ(three->values[std::size_t{f} * three->dims + 3 + n + d], bone);
       }
     }
-    EXPECT_EQ(one->past_end != std::vector<std::uint8_t>(motion.frame_count, 0), uses_trajectory_offsets(info.kind))
-        << "only trajectory kinds run past a non-looping clip's end";
+    EXPECT_EQ(one->past_end != std::vector<std::uint8_t>(motion.frame_count, 0), follows_edge_rule(info.kind))
+        << "only kinds reading other frames (trajectory offsets, phase windows) run past a non-looping clip's edges";
   }
 }
 

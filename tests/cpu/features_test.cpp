@@ -147,7 +147,7 @@ TEST(Features, CustomChannelsAndErrors) {
 
   schema.channels = {foot};
   schema.channels[0].bone = "Tail";
-  Result<RawFeatures> missing = extract_features(motion, root, schema, {.loop = false, .source = "walk.bvh", .custom = {}});
+  Result<RawFeatures> missing = extract_features(motion, root, schema, {.loop = false, .source = "walk.bvh", .custom = {}, .contacts = {}});
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.message().find("walk.bvh: channel 'foot'"), std::string::npos) << missing.message();
   EXPECT_NE(missing.message().find("Tail"), std::string::npos) << missing.message();

@@ -14,12 +14,16 @@
 namespace mmvk {
 
 enum class ChannelKind : std::uint8_t {
-  TrajectoryPosition,   // future root positions (x, z) in character space, metres; 2 dims per offset
-  TrajectoryDirection,  // future facing directions (x, z) in character space; 2 dims per offset
+  TrajectoryPosition,   // past/future root positions (x, z) in character space, metres; 2 dims per offset
+  TrajectoryDirection,  // past/future facing directions (x, z) in character space; 2 dims per offset
   BonePosition,         // bone position (x, y, z) in character space, metres; 3 dims
   BoneVelocity,         // bone velocity (x, y, z) in character space, m/s; 3 dims
   RootVelocity,         // hip (source bone) velocity (x, y, z) in character space, m/s; 3 dims
   Custom,               // per-frame values from a sidecar file; `custom_dims` dims
+  RootAngularVelocity,  // the root's turning rate about +Y, rad/s, positive = turning left; 1 dim
+  FootContact,          // 0/1 per foot (left, right) from the animation's contact detection; 2 dims
+  LimbVector,           // (limb end - limb root) / limb length in character space, unitless; 3 dims
+  Phase,                // per source curve (a sin 2 pi phi, a cos 2 pi phi) of its dominant frequency; 2 dims per curve
 };
 
 // The FeatureChannel fields a kind reads (a bit set). A field a kind reads is
@@ -30,6 +34,8 @@ enum class ChannelField : std::uint8_t {
   SecondBone = 2,  // FeatureChannel::second_bone (for kinds spanning two joints)
   Offsets = 4,     // FeatureChannel::offsets_seconds: the kind samples the root trajectory at these times
   Dims = 8,        // FeatureChannel::custom_dims: the values come from a sidecar, this many per frame
+  Curves = 16,     // FeatureChannel::curves and window_seconds: the kind reads source curves over a window
+  Contacts = 32,   // no field: the kind reads the clip's foot contacts (FeatureExtractionOptions::contacts)
 };
 constexpr ChannelField operator|(ChannelField a, ChannelField b) {
   return static_cast<ChannelField>(static_cast<std::uint8_t>(a) | static_cast<std::uint8_t>(b));
@@ -43,6 +49,7 @@ enum class DimsRule : std::uint8_t {
   Labels,           // one dim per label: "name.x"
   LabelsPerOffset,  // the labels once per trajectory offset: "name[i].x"
   Declared,         // `custom_dims` dims, named by index: "name[i]"
+  LabelsPerCurve,   // the labels once per source curve: "name[i].sin"
 };
 
 // What a mirrored clip (manifest "mirror") does to the kind's values.
@@ -88,11 +95,18 @@ const ChannelKindInfo* find_channel_kind(std::string_view name);
 // The JSON names, quoted and comma-separated, for error messages.
 std::string channel_kind_list();
 
-// The kind samples the root trajectory at its offsets_seconds: its frames
-// near a clip's end fall under the edge rule, and a query's "trajectory"
-// part (as opposed to its pose) is made of such channels.
+// The kind samples the root trajectory at its offsets_seconds, and a query's
+// "trajectory" part (as opposed to its pose) is made of such channels.
 inline bool uses_trajectory_offsets(ChannelKind kind) {
   return has_field(channel_kind_info(kind).fields, ChannelField::Offsets);
+}
+
+// The kind reads frames around the current one (trajectory offsets, a phase
+// window): its frames near a non-looping clip's start or end fall under the
+// edge rule (features.hpp: edge_reach()).
+inline bool follows_edge_rule(ChannelKind kind) {
+  const ChannelField fields = channel_kind_info(kind).fields;
+  return has_field(fields, ChannelField::Offsets) || has_field(fields, ChannelField::Curves);
 }
 
 // The kind's values come from the caller (a sidecar file beside each clip,

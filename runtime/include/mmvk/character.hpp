@@ -16,8 +16,9 @@ namespace mmvk {
 // Resolves a bone reference: either an exact joint name ("Foot_L") or a role
 // written with a leading '@': "@hips", "@left_upper_leg", "@right_upper_leg",
 // "@left_lower_leg", "@right_lower_leg", "@left_foot", "@right_foot" (ankle),
-// "@left_toe", "@right_toe" (ball of the foot), "@left_hand", "@right_hand"
-// (wrist), "@head". Roles are matched against the naming conventions seen in
+// "@left_toe", "@right_toe" (ball of the foot), "@left_shoulder",
+// "@right_shoulder" (the upper arm joint, not the clavicle), "@left_hand",
+// "@right_hand" (wrist), "@head". Roles are matched against the naming conventions seen in
 // CMU (ASF lfemur/ltibia/lfoot/ltoes, cgspeed max LeftHip/LeftKnee/LeftAnkle,
 // mb LeftUpLeg/LeftLeg/LeftFoot/LeftToeBase, DAZ lThigh/lShin/lFoot), Bandai
 // Namco (UpperLeg_L/LowerLeg_L/Foot_L/Toes_L) and LAFAN1 skeletons, compared

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,8 +28,10 @@ struct FeatureChannel {
   std::string name;                     // unique within the schema
   ChannelKind kind = ChannelKind::BonePosition;
   std::string bone;                     // Bone*: joint name or role, see find_bone()
-  std::string second_bone;              // kinds spanning two joints (none yet): joint name or role
-  std::vector<float> offsets_seconds;   // Trajectory*: future times, seconds, > 0
+  std::string second_bone;              // kinds spanning two joints (LimbVector: the limb's end): joint name or role
+  std::vector<float> offsets_seconds;   // Trajectory*: times from now, seconds, != 0 (< 0: the past)
+  std::vector<std::string> curves;      // Phase: source curves, see features.hpp
+  float window_seconds = 1.0f;          // Phase: half-width of the centred window, seconds, > 0
   std::uint32_t custom_dims = 0;        // Custom: dims per frame
   float weight = 1.0f;                  // > 0; folded into the scale (scale = spread / weight)
   Normalization normalization = Normalization::GroupStd;
@@ -51,6 +54,18 @@ struct FeatureSchema {
   Status validate() const;
 };
 
+// Named limbs for LimbVector channels ("limb": "left_leg" in JSON): the
+// limb's root and end bones (roles, see find_bone()). Legs run from the hips
+// to the ankles, arms from the shoulders (the upper arm joints) to the wrists.
+struct NamedLimb {
+  std::string_view name;  // "left_leg", "right_leg", "left_arm", "right_arm"
+  std::string_view root;  // FeatureChannel::bone
+  std::string_view end;   // FeatureChannel::second_bone
+};
+std::span<const NamedLimb> named_limbs();
+const NamedLimb* find_limb(std::string_view name);  // nullptr when unknown
+std::string limb_list();                              // quoted, comma-separated, for messages
+
 // The names used in the JSON form ("trajectory_position", "group_std", ...).
 std::string_view channel_kind_name(ChannelKind kind);
 std::string_view normalization_name(Normalization mode);
@@ -62,8 +77,10 @@ FeatureSchema default_schema();
 
 // JSON form: {"channels": [{"name": ..., "kind": <a name from
 // channel_kinds(): "trajectory_position", "bone_position", "custom", ...>,
-// "bone": ..., "second_bone": ... (kinds that read it), "offsets_seconds":
-// [...], "dims": n, "weight": w, "normalization": "group_std" |
+// "bone": ..., "second_bone": ... (kinds that read it), "limb": a named limb
+// (limb_vector, instead of bone and second_bone), "offsets_seconds": [...],
+// "curves": [...], "window_seconds": s (phase), "dims": n, "weight": w,
+// "normalization": "group_std" |
 // "per_dim_std" | "mean_abs_dev" | "min_max"}]}. Errors name the field at
 // fault.
 Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_view source);

@@ -15,17 +15,36 @@
 //     or "@hips" when it is empty.
 //   - TrajectoryPosition: the root position `k` frames ahead, (x, z) in the
 //     current character space, metres; k = round(offset_seconds * fps), at
-//     least 1.
-//   - TrajectoryDirection: the root facing `k` frames ahead, (x, z) in the
-//     current character space (a unit vector).
+//     least 1 in magnitude; a negative offset looks `|k|` frames back (the
+//     past trajectory).
+//   - TrajectoryDirection: the root facing `k` frames ahead (or back), (x, z)
+//     in the current character space (a unit vector).
 //   - Custom: values copied from the caller's per-channel arrays.
+//   - RootAngularVelocity: the signed angle between the root facings of the
+//     neighbouring frames over their time (central inside the clip,
+//     one-sided on its first and last frame), rad/s, positive = turning
+//     left (from +Z towards +X).
+//   - FootContact: 1 while the foot is planted, else 0, (left, right), by
+//     the detection of foot_contacts.hpp with options.contacts (the same
+//     parameters the build gives the animation section).
+//   - LimbVector: (second_bone - bone) in character space divided by the sum
+//     of the segment lengths on the chain from bone down to second_bone, on
+//     the same frame; unitless, |v| <= 1 (1 = the limb fully stretched).
+//   - Phase (phase_features.cpp): per source curve, the dominant frequency of
+//     the curve over a centred window of +-window_seconds with its mean
+//     removed, its amplitude a and its phase phi (cycles, at the window's
+//     centre): (a sin 2 pi phi, a cos 2 pi phi) in the curve's units. A
+//     curve is "<bone>.speed" (|velocity|, m/s), "<bone>.height" (global y,
+//     m) or the dimension name of an earlier channel ("left_foot_velocity.y",
+//     its raw value).
 //
-// Future frames past the end of a clip: a looping clip wraps (its last frame
-// is followed by its first, displaced by one "cycle": the rigid ground motion
-// from frame 0 to the frame after the last, extrapolated from the last step);
-// a non-looping clip clamps to its last frame and reports the frame as
-// running past the end (the database build turns that into
-// kFrameEdgeExcluded or ignores it, depending on its edge rule).
+// Frames past the start or end of a clip (trajectory offsets, phase windows):
+// a looping clip wraps (its last frame is followed by its first, displaced by
+// one "cycle": the rigid ground motion from frame 0 to the frame after the
+// last, extrapolated from the last step; and the other way round before its
+// first frame); a non-looping clip clamps to its first or last frame and
+// reports the frame as running past an edge (the database build turns that
+// into kFrameEdgeExcluded or ignores it, depending on its edge rule).
 #pragma once
 
 #include <cstdint>
@@ -36,6 +55,7 @@
 
 #include "mmvk/character.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/foot_contacts.hpp"
 #include "mmvk/motion.hpp"
 #include "mmvk/status.hpp"
 
@@ -49,24 +69,51 @@ struct FeatureExtractionOptions {
   // custom_dims]. Must hold exactly as many arrays as the schema has Custom
   // channels.
   std::span<const std::vector<float>> custom;
+  // Foot contact detection for FootContact channels.
+  FootContactParams contacts;
 };
 
 struct RawFeatures {
   std::uint32_t frame_count = 0;
   std::uint32_t dims = 0;
   std::vector<float> values;            // [frame_count x dims], row-major, raw units
-  std::vector<std::uint8_t> past_end;   // [frame_count]: 1 when a trajectory offset ran past a non-looping clip's end
+  // [frame_count]: 1 when a trajectory offset or phase window ran past a
+  // non-looping clip's start or end (the name is older than the past trajectory)
+  std::vector<std::uint8_t> past_end;
 };
 
 // Frames ahead for a trajectory offset at `fps`: round(seconds * fps), >= 1.
 std::uint32_t offset_frames(float offset_seconds, float fps);
 
-// Largest trajectory offset of the schema in frames at `fps` (0 when the
-// schema has no trajectory channel).
+// Frames from now for a trajectory offset of either sign: offset_frames() of
+// its magnitude, negative for a negative offset.
+std::int64_t signed_offset_frames(float offset_seconds, float fps);
+
+// Largest future trajectory offset of the schema in frames at `fps` (0 when
+// the schema has no trajectory channel).
 std::uint32_t max_offset_frames(const FeatureSchema& schema, float fps);
+
+// How far the schema's channels read before and after the current frame, in
+// frames at `fps`: past trajectory offsets and phase windows reach back,
+// future offsets and phase windows ahead. A non-looping clip's frame f runs
+// past an edge when f < before or f + after > last frame.
+struct EdgeReach {
+  std::uint32_t before = 0;
+  std::uint32_t after = 0;
+};
+EdgeReach edge_reach(const FeatureSchema& schema, float fps);
+
+// Half-width of a phase window in frames: round(window_seconds * fps), >= 1.
+std::uint32_t window_frames(float window_seconds, float fps);
 
 // Extracts raw features. Bones are resolved with find_bone() on the motion's
 // skeleton; an unresolved bone is an error naming the channel and the source.
+// Further errors, naming the source, the channel and the field: a phase
+// window longer than the clip (2 x window + 1 frames > frames); on a
+// non-looping clip with past trajectory offsets, a reach before and after
+// that leaves no frame inside the edges; an unknown curve; a LimbVector whose
+// second_bone does not hang below its bone; FootContact bones that resolve
+// on neither side.
 // Preconditions: root arrays sized motion.frame_count.
 Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& root, const FeatureSchema& schema,
                                      const FeatureExtractionOptions& options);

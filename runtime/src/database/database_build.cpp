@@ -138,6 +138,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   options.loop = meta.loop;
   options.source = source;
   options.custom = custom;
+  options.contacts = settings.animation.contacts;  // foot_contact channels agree with the animation's contacts
   Result<RawFeatures> raw = extract_features(motion, *root, settings.schema, options);
   if (!raw.ok()) return raw.error();
   MMVK_TRY(check_plausible(*raw, settings.schema, motion.fps, source + ": clip '" + meta.name + "'"));

@@ -30,12 +30,21 @@ Trajectory::Trajectory(const CharacterRoot& root, std::uint32_t frames, bool loo
   }
 }
 
-GroundPose Trajectory::at(std::uint64_t j) const {
-  if (j < frames_) return pose(static_cast<std::uint32_t>(j));
-  if (!loop_) return pose(frames_ - 1);
-  GroundPose result = pose(static_cast<std::uint32_t>(j % frames_));
+GroundPose Trajectory::at(std::int64_t j) const {
+  const std::int64_t n = frames_;
+  if (j >= 0 && j < n) return pose(static_cast<std::uint32_t>(j));
+  if (!loop_) return pose(j < 0 ? 0 : frames_ - 1);
   const GroundPose first = pose(0);
-  for (std::uint64_t cycle = j / frames_; cycle > 0; --cycle) result = compose(after_last_, relative(first, result));
+  if (j >= n) {
+    GroundPose result = pose(static_cast<std::uint32_t>(j % n));
+    for (std::int64_t cycle = j / n; cycle > 0; --cycle) result = compose(after_last_, relative(first, result));
+    return result;
+  }
+  // Before frame 0: the same frame of an earlier cycle, each cycle's rigid
+  // motion undone (after_last_ maps back onto the first frame).
+  const std::int64_t cycles = (-j + n - 1) / n;
+  GroundPose result = pose(static_cast<std::uint32_t>(j + cycles * n));
+  for (std::int64_t cycle = cycles; cycle > 0; --cycle) result = compose(first, relative(after_last_, result));
   return result;
 }
 

@@ -26,15 +26,16 @@ inline glm::vec3 to_local(const glm::vec3& v, const glm::vec3& facing) {
   return {v.x * facing.z - v.z * facing.x, v.y, v.x * facing.x + v.z * facing.z};
 }
 
-// Future root poses, looping or clamped. For a looping clip the frame after
-// the last is the last advanced by the clip's final step; every further cycle
-// repeats the rigid motion from frame 0 to that frame.
+// Past and future root poses, looping or clamped. For a looping clip the
+// frame after the last is the last advanced by the clip's final step; every
+// further cycle repeats the rigid motion from frame 0 to that frame, and
+// every cycle before frame 0 undoes it.
 class Trajectory {
  public:
   Trajectory(const CharacterRoot& root, std::uint32_t frames, bool loop);
 
-  // Root pose `j` frames from the start (j may run past the end).
-  GroundPose at(std::uint64_t j) const;
+  // Root pose `j` frames from the start (j may run past either end).
+  GroundPose at(std::int64_t j) const;
 
  private:
   GroundPose pose(std::uint32_t f) const { return {root_.positions[f], root_.facings[f]}; }
@@ -50,9 +51,25 @@ struct ClipSamples {
   const Motion& motion;
   const CharacterRoot& root;
   Trajectory trajectory;
-  std::vector<glm::vec3> global;  // [frames x joints] global joint positions
+  std::vector<glm::vec3> global;      // [frames x joints] global joint positions
+  bool loop = false;
+  std::vector<std::uint8_t> contacts;  // [frames] FootContact bits, when a channel reads Contacts
 
   std::uint32_t frames() const { return motion.frame_count; }
+
+  // The clip frame a window sample `f + delta` reads: wrapped on a looping
+  // clip, clamped to the first or last frame otherwise (the edge rule).
+  std::uint32_t window_frame(std::uint32_t f, std::int64_t delta) const {
+    const std::int64_t n = frames();
+    std::int64_t g = std::int64_t{f} + delta;
+    if (loop) {
+      g %= n;
+      if (g < 0) g += n;
+    } else {
+      g = g < 0 ? 0 : (g >= n ? n - 1 : g);
+    }
+    return static_cast<std::uint32_t>(g);
+  }
 
   glm::vec3 bone_position(std::uint32_t f, int joint) const {
     return global[std::size_t{f} * motion.joint_count() + static_cast<std::size_t>(joint)];
@@ -69,6 +86,14 @@ struct ClipSamples {
   }
 };
 
+// A phase channel's source curve, resolved on one clip.
+struct CurveSource {
+  enum class Kind : std::uint8_t { Speed, Height, Column };
+  Kind kind = Kind::Speed;
+  int joint = -1;            // Speed, Height
+  std::uint32_t column = 0;  // Column: a dimension of an earlier channel
+};
+
 // One channel of one clip: its resolved inputs and where its values go.
 struct ChannelExtraction {
   const ClipSamples& clip;
@@ -76,10 +101,15 @@ struct ChannelExtraction {
   int bone = -1;                  // joint index, when the kind reads Bone
   int second_bone = -1;           // joint index, when the kind reads SecondBone
   std::span<const float> custom;  // [frames x custom_dims] sidecar values, when the kind reads Dims
+  std::span<const CurveSource> curves;  // one per channel.curves, when the kind reads Curves
+  const float* features = nullptr;      // the clip's whole matrix: column c of frame f at features[f * stride + c]
   float* out = nullptr;           // dim i of frame f goes to out[f * stride + i]
   std::uint32_t stride = 0;       // the schema's dims
 
   float* row(std::uint32_t f) const { return out + std::size_t{f} * stride; }
 };
+
+// The Phase kind's extractor (phase_features.cpp).
+void extract_phase(const ChannelExtraction& job);
 
 }  // namespace mmvk::detail

@@ -4,6 +4,9 @@
 #include "mmvk/channel_kinds.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
 
 #include "common/name_table.hpp"
 #include "features/channel_extraction.hpp"
@@ -19,9 +22,13 @@ using detail::to_local;
 
 constexpr std::string_view kXz[] = {"x", "z"};
 constexpr std::string_view kXyz[] = {"x", "y", "z"};
+constexpr std::string_view kYaw[] = {"yaw"};
+constexpr std::string_view kFeet[] = {"left", "right"};
+constexpr std::string_view kSinCos[] = {"sin", "cos"};
 
-// (x, z) of the root `offset` ahead, for every offset, in the current
-// character space: a position relative to the root or a facing direction.
+// (x, z) of the root `offset` ahead (or back, for a negative offset), for
+// every offset, in the current character space: a position relative to the
+// root or a facing direction.
 template <bool kPosition>
 void extract_trajectory(const ChannelExtraction& job) {
   const detail::ClipSamples& clip = job.clip;
@@ -30,7 +37,7 @@ void extract_trajectory(const ChannelExtraction& job) {
     const glm::vec3 facing = clip.root.facings[f];
     float* row = job.row(f);
     for (float t : job.channel.offsets_seconds) {
-      const GroundPose future = clip.trajectory.at(std::uint64_t{f} + offset_frames(t, clip.motion.fps));
+      const GroundPose future = clip.trajectory.at(std::int64_t{f} + signed_offset_frames(t, clip.motion.fps));
       const glm::vec3 local = kPosition ? to_local(future.position - origin, facing) : to_local(future.facing, facing);
       *row++ = local.x;
       *row++ = local.z;
@@ -63,6 +70,52 @@ void extract_custom(const ChannelExtraction& job) {
   for (std::uint32_t f = 0; f < job.clip.frames(); ++f) {
     const float* src = job.custom.data() + std::size_t{f} * dims;
     std::copy(src, src + dims, job.row(f));
+  }
+}
+
+// The signed angle from facing a to facing b about +Y (positive from +Z
+// towards +X, i.e. turning left), radians.
+float turn_angle(const glm::vec3& a, const glm::vec3& b) {
+  return std::atan2(a.z * b.x - a.x * b.z, a.x * b.x + a.z * b.z);
+}
+
+// Finite differences of the facing angle, central inside the clip and
+// one-sided at its ends, like bone velocities.
+void extract_root_angular_velocity(const ChannelExtraction& job) {
+  const detail::ClipSamples& clip = job.clip;
+  const std::uint32_t n = clip.frames();
+  for (std::uint32_t f = 0; f < n; ++f) {
+    const std::uint32_t a = f > 0 ? f - 1 : f;
+    const std::uint32_t b = f + 1 < n ? f + 1 : f;
+    *job.row(f) = b > a ? turn_angle(clip.root.facings[a], clip.root.facings[b]) * clip.motion.fps / float(b - a)
+                        : 0.0f;
+  }
+}
+
+void extract_foot_contact(const ChannelExtraction& job) {
+  const detail::ClipSamples& clip = job.clip;
+  for (std::uint32_t f = 0; f < clip.frames(); ++f) {
+    float* row = job.row(f);
+    row[0] = (clip.contacts[f] & kContactLeft) != 0 ? 1.0f : 0.0f;
+    row[1] = (clip.contacts[f] & kContactRight) != 0 ? 1.0f : 0.0f;
+  }
+}
+
+// Divided by the limb's length on the same frame, so a character of another
+// size (every offset scaled) gives the same values: the limb's direction and
+// how far it is stretched.
+void extract_limb_vector(const ChannelExtraction& job) {
+  const detail::ClipSamples& clip = job.clip;
+  const std::vector<int>& parents = clip.motion.skeleton.parents;
+  for (std::uint32_t f = 0; f < clip.frames(); ++f) {
+    float length = 0.0f;
+    for (int j = job.second_bone; j != job.bone; j = parents[static_cast<std::size_t>(j)]) {
+      length += glm::length(clip.bone_position(f, j) - clip.bone_position(f, parents[static_cast<std::size_t>(j)]));
+    }
+    const glm::vec3 limb = clip.bone_position(f, job.second_bone) - clip.bone_position(f, job.bone);
+    // A zero-length chain (bone == second_bone) has no direction.
+    const glm::vec3 value = length > 0.0f ? to_local(limb, clip.root.facings[f]) / length : glm::vec3(0.0f);
+    write_xyz(job.row(f), value);
   }
 }
 
@@ -134,6 +187,50 @@ constexpr ChannelKindInfo kKinds[] = {
      .plausible_limit = 0.0f,
      .limit_unit = {},
      .extract = extract_custom},
+    {.kind = ChannelKind::RootAngularVelocity,
+     .name = "root_angular_velocity",
+     .summary = "the root's turning rate about +Y, rad/s, positive = turning left",
+     .dims_rule = DimsRule::Labels,
+     .labels = kYaw,
+     .fields = ChannelField::None,
+     .default_bone = {},
+     .mirror = MirrorRule::Remeasured,  // a mirrored clip turns the other way: the values negate
+     .plausible_limit = 0.0f,  // bounded by pi x fps: a frame's turn is at most half a turn
+     .limit_unit = {},
+     .extract = extract_root_angular_velocity},
+    {.kind = ChannelKind::FootContact,
+     .name = "foot_contact",
+     .summary = "1 while the left / right foot is planted, else 0 (the animation's contact detection)",
+     .dims_rule = DimsRule::Labels,
+     .labels = kFeet,
+     .fields = ChannelField::Contacts,
+     .default_bone = {},
+     .mirror = MirrorRule::Remeasured,  // measured on the mirrored skeleton: left and right swap
+     .plausible_limit = 0.0f,
+     .limit_unit = {},
+     .extract = extract_foot_contact},
+    {.kind = ChannelKind::LimbVector,
+     .name = "limb_vector",
+     .summary = "(second_bone - bone) / limb length in character space, unitless",
+     .dims_rule = DimsRule::Labels,
+     .labels = kXyz,
+     .fields = ChannelField::Bone | ChannelField::SecondBone,
+     .default_bone = {},
+     .mirror = MirrorRule::Remeasured,  // roles name the mirrored joints: left and right limbs swap
+     .plausible_limit = 0.0f,
+     .limit_unit = {},
+     .extract = extract_limb_vector},
+    {.kind = ChannelKind::Phase,
+     .name = "phase",
+     .summary = "per curve (a sin 2 pi phi, a cos 2 pi phi) of its dominant frequency over a centred window",
+     .dims_rule = DimsRule::LabelsPerCurve,
+     .labels = kSinCos,
+     .fields = ChannelField::Curves,
+     .default_bone = {},
+     .mirror = MirrorRule::Remeasured,  // bone curves read the mirrored joints: left and right swap
+     .plausible_limit = 0.0f,
+     .limit_unit = {},
+     .extract = detail::extract_phase},
 };
 
 static_assert(detail::indexed_by(std::span<const ChannelKindInfo>(kKinds), &ChannelKindInfo::kind),

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <set>
 
+#include "common/name_table.hpp"
+
 namespace mmvk {
 
 std::uint32_t FeatureChannel::dims() const {
@@ -15,6 +17,8 @@ std::uint32_t FeatureChannel::dims() const {
       return labels * static_cast<std::uint32_t>(offsets_seconds.size());
     case DimsRule::Declared:
       return custom_dims;
+    case DimsRule::LabelsPerCurve:
+      return labels * static_cast<std::uint32_t>(curves.size());
   }
   return 0;
 }
@@ -48,6 +52,7 @@ std::string FeatureSchema::dim_name(std::uint32_t d) const {
         case DimsRule::Labels:
           return channel.name + "." + std::string(info.labels[d]);
         case DimsRule::LabelsPerOffset:
+        case DimsRule::LabelsPerCurve:
           return channel.name + "[" + std::to_string(d / labels) + "]." + std::string(info.labels[d % labels]);
         case DimsRule::Declared:
           return channel.name + "[" + std::to_string(d) + "]";
@@ -77,7 +82,15 @@ Status FeatureSchema::validate() const {
     if (has_field(info.fields, ChannelField::Offsets)) {
       if (channel.offsets_seconds.empty()) return make_error(where + ": offsets_seconds is empty");
       for (float t : channel.offsets_seconds) {
-        if (!(t > 0.0f) || !std::isfinite(t)) return make_error(where + ": offsets_seconds must be finite and > 0");
+        // Negative offsets are the past trajectory; 0 is the current frame,
+        // which is the origin of character space and carries nothing.
+        if (t == 0.0f || !std::isfinite(t)) return make_error(where + ": offsets_seconds must be finite and != 0");
+      }
+    }
+    if (has_field(info.fields, ChannelField::Curves)) {
+      if (channel.curves.empty()) return make_error(where + ": curves is empty");
+      if (!(channel.window_seconds > 0.0f) || !std::isfinite(channel.window_seconds)) {
+        return make_error(where + ": window_seconds must be finite and > 0");
       }
     }
     if (has_field(info.fields, ChannelField::Bone) && info.default_bone.empty() && channel.bone.empty()) {
@@ -92,6 +105,23 @@ Status FeatureSchema::validate() const {
   }
   return {};
 }
+
+namespace {
+
+constexpr NamedLimb kLimbs[] = {
+    {"left_leg", "@hips", "@left_foot"},
+    {"right_leg", "@hips", "@right_foot"},
+    {"left_arm", "@left_shoulder", "@left_hand"},
+    {"right_arm", "@right_shoulder", "@right_hand"},
+};
+
+}  // namespace
+
+std::span<const NamedLimb> named_limbs() { return kLimbs; }
+
+const NamedLimb* find_limb(std::string_view name) { return detail::find_named(named_limbs(), &NamedLimb::name, name); }
+
+std::string limb_list() { return detail::name_list(named_limbs(), &NamedLimb::name, '"', true); }
 
 FeatureSchema default_schema() {
   const std::vector<float> offsets = {1.0f / 3.0f, 2.0f / 3.0f, 1.0f};

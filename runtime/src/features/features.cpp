@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "features/channel_extraction.hpp"
+#include "features/foot_contacts.hpp"
 #include "mmvk/file_io.hpp"
 
 namespace mmvk {
@@ -13,6 +14,53 @@ namespace {
 
 std::string where(const FeatureExtractionOptions& options, const FeatureChannel& channel) {
   return (options.source.empty() ? std::string("clip") : options.source) + ": channel '" + channel.name + "'";
+}
+
+// True when `joint` is `ancestor` or hangs below it.
+bool hangs_below(const Skeleton& skeleton, int joint, int ancestor) {
+  for (int j = joint; j >= 0; j = skeleton.parents[static_cast<std::size_t>(j)]) {
+    if (j == ancestor) return true;
+  }
+  return false;
+}
+
+// A phase curve: the dimension name of an earlier channel, or
+// "<bone>.speed" / "<bone>.height".
+Result<detail::CurveSource> resolve_curve(const Skeleton& skeleton, const FeatureSchema& schema, std::size_t channel,
+                                          const std::string& curve) {
+  const std::uint32_t earlier = schema.offset(channel);
+  for (std::uint32_t d = 0; d < earlier; ++d) {
+    if (schema.dim_name(d) == curve) return detail::CurveSource{detail::CurveSource::Kind::Column, -1, d};
+  }
+  const std::size_t dot = curve.rfind('.');
+  const std::string quantity = dot == std::string::npos ? std::string() : curve.substr(dot + 1);
+  if (quantity != "speed" && quantity != "height") {
+    return make_error("\"" + curve + "\" is neither \"<bone>.speed\", \"<bone>.height\" nor the name of a " +
+                      "dimension of an earlier channel (e.g. \"" + (earlier > 0 ? schema.dim_name(0) : "...") + "\")");
+  }
+  Result<int> joint = find_bone(skeleton, curve.substr(0, dot));
+  if (!joint.ok()) return make_error("\"" + curve + "\": " + joint.message());
+  return detail::CurveSource{quantity == "speed" ? detail::CurveSource::Kind::Speed : detail::CurveSource::Kind::Height,
+                             *joint, 0};
+}
+
+// "channel 'x': offsets_seconds[i] (-1.5 s)" for the schema's furthest past
+// offset, empty when it has none.
+std::string past_reach_owner(const FeatureSchema& schema, float fps) {
+  std::string owner;
+  std::uint32_t furthest = 0;
+  for (const FeatureChannel& channel : schema.channels) {
+    if (!uses_trajectory_offsets(channel.kind)) continue;
+    for (std::size_t i = 0; i < channel.offsets_seconds.size(); ++i) {
+      const float t = channel.offsets_seconds[i];
+      if (t < 0.0f && offset_frames(-t, fps) > furthest) {
+        furthest = offset_frames(-t, fps);
+        owner = "channel '" + channel.name + "': offsets_seconds[" + std::to_string(i) + "] (" + std::to_string(t) +
+                " s)";
+      }
+    }
+  }
+  return owner;
 }
 
 }  // namespace
@@ -24,13 +72,41 @@ std::uint32_t offset_frames(float offset_seconds, float fps) {
   return static_cast<std::uint32_t>(frames);
 }
 
+std::int64_t signed_offset_frames(float offset_seconds, float fps) {
+  const std::int64_t frames = offset_frames(std::abs(offset_seconds), fps);
+  return offset_seconds < 0.0f ? -frames : frames;
+}
+
+std::uint32_t window_frames(float window_seconds, float fps) { return offset_frames(window_seconds, fps); }
+
 std::uint32_t max_offset_frames(const FeatureSchema& schema, float fps) {
   std::uint32_t result = 0;
   for (const FeatureChannel& channel : schema.channels) {
     if (!uses_trajectory_offsets(channel.kind)) continue;
-    for (float t : channel.offsets_seconds) result = std::max(result, offset_frames(t, fps));
+    for (float t : channel.offsets_seconds) {
+      if (t > 0.0f) result = std::max(result, offset_frames(t, fps));
+    }
   }
   return result;
+}
+
+EdgeReach edge_reach(const FeatureSchema& schema, float fps) {
+  EdgeReach reach;
+  for (const FeatureChannel& channel : schema.channels) {
+    const ChannelField fields = channel_kind_info(channel.kind).fields;
+    if (has_field(fields, ChannelField::Offsets)) {
+      for (float t : channel.offsets_seconds) {
+        std::uint32_t& side = t < 0.0f ? reach.before : reach.after;
+        side = std::max(side, offset_frames(std::abs(t), fps));
+      }
+    }
+    if (has_field(fields, ChannelField::Curves)) {
+      const std::uint32_t half = window_frames(channel.window_seconds, fps);
+      reach.before = std::max(reach.before, half);
+      reach.after = std::max(reach.after, half);
+    }
+  }
+  return reach;
 }
 
 Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& root, const FeatureSchema& schema,
@@ -52,9 +128,11 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
     int bone = -1;
     int second_bone = -1;
     std::span<const float> custom;
+    std::vector<detail::CurveSource> curves;
   };
   std::vector<Inputs> inputs(schema.channels.size());
   std::size_t custom_count = 0;
+  bool needs_contacts = false;
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
     const ChannelKindInfo& info = channel_kind_info(channel.kind);
@@ -68,7 +146,28 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
       Result<int> index = find_bone(motion.skeleton, channel.second_bone);
       if (!index.ok()) return make_error(where(options, channel) + ": second_bone: " + index.message());
       inputs[c].second_bone = *index;
+      if (has_field(info.fields, ChannelField::Bone) && !hangs_below(motion.skeleton, *index, inputs[c].bone)) {
+        return make_error(where(options, channel) + ": second_bone '" + channel.second_bone + "' (" +
+                          motion.skeleton.names[static_cast<std::size_t>(*index)] + ") does not hang below bone '" +
+                          channel.bone + "' (" + motion.skeleton.names[static_cast<std::size_t>(inputs[c].bone)] + ")");
+      }
     }
+    if (has_field(info.fields, ChannelField::Curves)) {
+      const std::uint32_t half = window_frames(channel.window_seconds, motion.fps);
+      if (std::uint64_t{2} * half + 1 > frames) {
+        return make_error(where(options, channel) + ": window_seconds " + std::to_string(channel.window_seconds) +
+                          " spans " + std::to_string(2 * half + 1) + " frames, longer than the clip (" +
+                          std::to_string(frames) + " frames)");
+      }
+      for (std::size_t i = 0; i < channel.curves.size(); ++i) {
+        Result<detail::CurveSource> curve = resolve_curve(motion.skeleton, schema, c, channel.curves[i]);
+        if (!curve.ok()) {
+          return make_error(where(options, channel) + ": curves[" + std::to_string(i) + "]: " + curve.message());
+        }
+        inputs[c].curves.push_back(*curve);
+      }
+    }
+    if (has_field(info.fields, ChannelField::Contacts)) needs_contacts = true;
     if (has_field(info.fields, ChannelField::Dims)) {
       if (custom_count < options.custom.size()) {
         const std::vector<float>& values = options.custom[custom_count];
@@ -90,7 +189,7 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
   // Global positions of every joint, [frames x joints], shared by the channels.
   const std::size_t joints = motion.joint_count();
   detail::ClipSamples clip{motion, root, detail::Trajectory(root, frames, options.loop),
-                           std::vector<glm::vec3>(std::size_t{frames} * joints)};
+                           std::vector<glm::vec3>(std::size_t{frames} * joints), options.loop, {}};
   {
     std::vector<glm::vec3> positions(joints);
     std::vector<glm::quat> rotations(joints);
@@ -101,14 +200,34 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
     }
   }
 
+  if (needs_contacts) {
+    detail::ClipContacts contacts =
+        detail::detect_foot_contacts(motion.skeleton, clip.global, frames, motion.fps, options.contacts);
+    if (contacts.joints[0] < 0 || contacts.joints[1] < 0) {
+      return make_error(source + ": foot contacts: neither the contact bones ('" + options.contacts.left_bone +
+                        "', '" + options.contacts.right_bone +
+                        "') nor the ankles (@left_foot, @right_foot) resolve on the clip's skeleton");
+    }
+    clip.contacts = std::move(contacts.bits);
+  }
+
   RawFeatures out;
   out.frame_count = frames;
   out.dims = dims;
   out.values.assign(std::size_t{frames} * dims, 0.0f);
   out.past_end.assign(frames, 0);
-  const std::uint32_t furthest = max_offset_frames(schema, motion.fps);
+  const EdgeReach reach = edge_reach(schema, motion.fps);
+  const std::string past_owner = past_reach_owner(schema, motion.fps);
+  if (!options.loop && !past_owner.empty() && std::uint64_t{reach.before} + reach.after >= frames) {
+    return make_error(source + ": " + past_owner + " reaches " +
+                      std::to_string(reach.before) + " frames back and the schema " + std::to_string(reach.after) +
+                      " ahead: no frame of the " + std::to_string(frames) +
+                      "-frame non-looping clip lies inside both edges");
+  }
   for (std::uint32_t f = 0; f < frames; ++f) {
-    if (!options.loop && furthest > 0 && std::uint64_t{f} + furthest > std::uint64_t{frames} - 1) out.past_end[f] = 1;
+    if (!options.loop && (f < reach.before || std::uint64_t{f} + reach.after > std::uint64_t{frames} - 1)) {
+      out.past_end[f] = 1;
+    }
   }
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const detail::ChannelExtraction job{.clip = clip,
@@ -116,6 +235,8 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
                                         .bone = inputs[c].bone,
                                         .second_bone = inputs[c].second_bone,
                                         .custom = inputs[c].custom,
+                                        .curves = inputs[c].curves,
+                                        .features = out.values.data(),
                                         .out = out.values.data() + schema.offset(c),
                                         .stride = dims};
     channel_kind_info(schema.channels[c].kind).extract(job);

@@ -18,8 +18,9 @@ using Json = nlohmann::json;
 
 Result<FeatureChannel> parse_channel(const Json& object, const std::string& where) {
   if (!object.is_object()) return make_error(where + ": expected an object");
-  static const std::set<std::string> kKnown = {"name",           "kind", "bone",   "second_bone",
-                                               "offsets_seconds", "dims", "weight", "normalization"};
+  static const std::set<std::string> kKnown = {"name",   "kind",          "bone",   "second_bone",    "limb",
+                                               "curves", "offsets_seconds", "dims", "window_seconds", "weight",
+                                               "normalization"};
   for (const auto& item : object.items()) {
     if (!kKnown.count(item.key())) return make_error(where + "." + item.key() + ": unknown field");
   }
@@ -46,6 +47,41 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     if (!object["second_bone"].is_string()) return make_error(where + ".second_bone: expected a string");
     channel.second_bone = object["second_bone"].get<std::string>();
   }
+  if (object.contains("limb")) {
+    // Shorthand for the limb's root and end bones (named_limbs()).
+    if (info->kind != ChannelKind::LimbVector) return make_error(where + ".limb: a " + kind + " channel reads no limb");
+    if (object.contains("bone") || object.contains("second_bone")) {
+      return make_error(where + ".limb: give either limb or bone and second_bone, not both");
+    }
+    const std::string limb = object["limb"].is_string() ? object["limb"].get<std::string>() : std::string();
+    const NamedLimb* named = find_limb(limb);
+    if (named == nullptr) {
+      return make_error(where + ".limb: unknown limb \"" + limb + "\", expected one of " + limb_list());
+    }
+    channel.bone = named->root;
+    channel.second_bone = named->end;
+  }
+  if (object.contains("curves")) {
+    if (!has_field(info->fields, ChannelField::Curves)) {
+      return make_error(where + ".curves: a " + kind + " channel reads no curves");
+    }
+    const Json& curves = object["curves"];
+    if (!curves.is_array()) return make_error(where + ".curves: expected an array of strings");
+    for (std::size_t i = 0; i < curves.size(); ++i) {
+      if (!curves[i].is_string() || curves[i].get<std::string>().empty()) {
+        return make_error(where + ".curves[" + std::to_string(i) + "]: expected a non-empty string");
+      }
+      channel.curves.push_back(curves[i].get<std::string>());
+    }
+  }
+  if (object.contains("window_seconds")) {
+    if (!has_field(info->fields, ChannelField::Curves)) {
+      return make_error(where + ".window_seconds: a " + kind + " channel has no window");
+    }
+    Result<float> window = detail::json_float(object["window_seconds"], where + ".window_seconds");
+    if (!window.ok()) return window.error();
+    channel.window_seconds = *window;
+  }
   if (object.contains("offsets_seconds")) {
     const Json& offsets = object["offsets_seconds"];
     if (!offsets.is_array()) return make_error(where + ".offsets_seconds: expected an array of numbers");
@@ -63,7 +99,7 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     if (has_field(info->fields, ChannelField::Dims)) {
       channel.custom_dims = static_cast<std::uint32_t>(dims.get<std::int64_t>());
     } else {
-      // Every field the width depends on (offsets) is read above.
+      // Every field the width depends on (offsets, curves) is read above.
       const std::int64_t expected = channel.dims();
       if (dims.get<std::int64_t>() != expected) {
         return make_error(where + ".dims: a " + kind + " channel has " + std::to_string(expected) + " dims, not " +
@@ -128,6 +164,10 @@ std::string schema_to_json(const FeatureSchema& schema) {
     if (!channel.second_bone.empty()) object["second_bone"] = channel.second_bone;
     if (has_field(info.fields, ChannelField::Offsets)) object["offsets_seconds"] = channel.offsets_seconds;
     if (has_field(info.fields, ChannelField::Dims)) object["dims"] = channel.custom_dims;
+    if (has_field(info.fields, ChannelField::Curves)) {
+      object["curves"] = channel.curves;
+      object["window_seconds"] = channel.window_seconds;
+    }
     object["weight"] = channel.weight;
     object["normalization"] = normalization_name(channel.normalization);
     channels.push_back(std::move(object));

@@ -34,7 +34,7 @@ struct RoleNames {
   std::array<std::string_view, 10> names;
 };
 
-constexpr std::array<RoleNames, 12> kRoles{{
+constexpr std::array<RoleNames, 14> kRoles{{
     {"left_upper_leg", "left upper leg (hip joint)",
      {"lfemur", "leftupleg", "upperlegl", "lthigh", "lefthip", "leftthigh", "leftupperleg", "thighl", "lupleg", "lhip"}},
     {"right_upper_leg", "right upper leg (hip joint)",
@@ -58,6 +58,15 @@ constexpr std::array<RoleNames, 12> kRoles{{
      {"lwrist", "leftwrist", "wristl", "lefthand", "handl", "lhand", "", "", "", ""}},
     {"right_hand", "right hand (wrist)",
      {"rwrist", "rightwrist", "wristr", "righthand", "handr", "rhand", "", "", "", ""}},
+    // The shoulder joint (upper arm), not the clavicle: "LeftShoulder" is the
+    // clavicle in cgspeed mb and Mixamo (whose upper arm is "LeftArm", found
+    // first) but the upper arm in cgspeed max, so it comes last.
+    {"left_shoulder", "left shoulder (upper arm)",
+     {"lhumerus", "leftarm", "upperarml", "lshldr", "leftupperarm", "larm", "lupperarm", "upperarmleft", "leftshoulder",
+      ""}},
+    {"right_shoulder", "right shoulder (upper arm)",
+     {"rhumerus", "rightarm", "upperarmr", "rshldr", "rightupperarm", "rarm", "rupperarm", "upperarmright",
+      "rightshoulder", ""}},
     {"hips", "hips (pelvis)", {"hips", "hip", "pelvis", "root", "", "", "", "", "", ""}},
 }};
 

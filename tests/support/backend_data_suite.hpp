@@ -16,6 +16,7 @@
 #include "mmvk/database_build.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/reference_search.hpp"
+#include "support/new_kinds_data.hpp"
 #include "support/search_test_data.hpp"
 #include "support/test_data.hpp"
 
@@ -116,6 +117,21 @@ TYPED_TEST_P(BackendDataSuite, LocomotionWithConstraintsMatchesReference) {
   this->check(*db, std::span<const float>(queries).first(db->dims()), std::span<const QueryParams>(params).first(1), 1, 16);
 }
 
-REGISTER_TYPED_TEST_SUITE_P(BackendDataSuite, LocomotionMatchesReference, LocomotionWithConstraintsMatchesReference);
+// Every channel kind of issue 12, on real and on random motion.
+TYPED_TEST_P(BackendDataSuite, NewChannelKindsMatchReference) {
+  MMVK_REQUIRE_DATA_DIR(data);
+  for (const Database* db : {locomotion_new_kinds_database(data), random_new_kinds_database(data)}) {
+    ASSERT_NE(db, nullptr);
+    SCOPED_TRACE(db->frame_count());
+    ASSERT_EQ(db->dims(), new_kinds_schema().dims());
+    const std::vector<float> queries = real_queries(*db, 64, 107);
+    const std::vector<QueryParams> params = random_params(*db, 64, 108);
+    this->check(*db, queries, {}, 64, 1);
+    this->check(*db, queries, params, 64, 4);
+  }
+}
+
+REGISTER_TYPED_TEST_SUITE_P(BackendDataSuite, LocomotionMatchesReference, LocomotionWithConstraintsMatchesReference,
+                            NewChannelKindsMatchReference);
 
 }  // namespace mmvk::test

@@ -5,6 +5,7 @@
 
 #include "mmvk/backends.hpp"
 #include "mmvk/vulkan/backends.hpp"
+#include "support/backend_data_suite.hpp"
 #include "support/backend_suite.hpp"
 #include "vulkan_test_env.hpp"
 
@@ -50,6 +51,8 @@ struct VulkanFactory {
 
 using VulkanBackends = ::testing::Types<VulkanFactory<false>, VulkanFactory<true>>;
 INSTANTIATE_TYPED_TEST_SUITE_P(Vulkan, BackendSuite, VulkanBackends);
+// Real features, and every channel kind (the data suite needs the motion data).
+INSTANTIATE_TYPED_TEST_SUITE_P(Vulkan, BackendDataSuite, VulkanBackends);
 
 }  // namespace
 }  // namespace mmvk::test

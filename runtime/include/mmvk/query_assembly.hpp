@@ -9,7 +9,8 @@
 //     trajectory (trajectory.hpp), turned into its current character space
 //     (origin = its root position, +Z = its facing) and normalized with the
 //     database's offsets and scales. The predictor fills the distinct
-//     offsets of all trajectory channels: trajectory_offsets().
+//     future offsets of all trajectory channels: trajectory_offsets(). Past
+//     offsets (< 0) are copied from the current frame's row, like the pose.
 //   - Every other channel (bone positions and velocities, root velocity,
 //     custom): the normalized values of the character's current database
 //     frame, copied from the feature row (as orangeduck's Motion-Matching

@@ -23,21 +23,27 @@ Result<QueryAssembler> QueryAssembler::create(const Database& database) {
     // kind table says which); every other channel is copied from the frame.
     const bool trajectory = uses_trajectory_offsets(channel.kind);
     has_positions = has_positions || channel.kind == ChannelKind::TrajectoryPosition;
-    if (!trajectory) {
-      // Adjacent pose channels merge into one copy run.
-      if (!out.copies_.empty() && out.copies_.back().begin + out.copies_.back().count == first) {
-        out.copies_.back().count += channel.dims();
+    // Adjacent copied dims merge into one copy run.
+    const auto copy = [&](std::uint32_t begin, std::uint32_t count) {
+      if (!out.copies_.empty() && out.copies_.back().begin + out.copies_.back().count == begin) {
+        out.copies_.back().count += count;
       } else {
-        out.copies_.push_back({first, channel.dims()});
+        out.copies_.push_back({begin, count});
       }
+    };
+    if (!trajectory) {
+      copy(first, channel.dims());
       continue;
     }
-    for (float t : channel.offsets_seconds) {
-      if (!(t > 0.0f)) {
-        return make_error("query assembly: channel '" + channel.name + "' has trajectory offset " + std::to_string(t) +
-                          " s; the predictor fills future offsets (> 0) only");
+    for (std::size_t i = 0; i < channel.offsets_seconds.size(); ++i) {
+      const float t = channel.offsets_seconds[i];
+      // The past trajectory is the path the character's current frame came
+      // along, so it is copied from the frame like the pose.
+      if (t < 0.0f) {
+        copy(first + 2 * static_cast<std::uint32_t>(i), 2);
+      } else if (std::find(out.offsets_.begin(), out.offsets_.end(), t) == out.offsets_.end()) {
+        out.offsets_.push_back(t);
       }
-      if (std::find(out.offsets_.begin(), out.offsets_.end(), t) == out.offsets_.end()) out.offsets_.push_back(t);
     }
   }
   if (!has_positions) {
@@ -51,6 +57,10 @@ Result<QueryAssembler> QueryAssembler::create(const Database& database) {
     if (!uses_trajectory_offsets(channel.kind)) continue;
     std::uint32_t dim = schema.offset(c);
     for (float t : channel.offsets_seconds) {
+      if (t < 0.0f) {
+        dim += 2;
+        continue;
+      }
       const auto index = static_cast<std::uint32_t>(std::find(out.offsets_.begin(), out.offsets_.end(), t) -
                                                     out.offsets_.begin());
       out.slots_.push_back({dim, index, channel.kind == ChannelKind::TrajectoryDirection});

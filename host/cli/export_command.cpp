@@ -49,7 +49,12 @@ nlohmann::json sidecar(const Database& db, const std::string& source, const std:
                          {"weight", channel.weight},   {"offset", schema.offset(c)},
                          {"dims", channel.dims()}};
     if (!channel.bone.empty()) ch["bone"] = channel.bone;
+    if (!channel.second_bone.empty()) ch["second_bone"] = channel.second_bone;
     if (!channel.offsets_seconds.empty()) ch["offsets_seconds"] = channel.offsets_seconds;
+    if (!channel.curves.empty()) {
+      ch["curves"] = channel.curves;
+      ch["window_seconds"] = channel.window_seconds;
+    }
     out["channels"].push_back(std::move(ch));
     for (std::uint32_t d = 0; d < channel.dims(); ++d) {
       groups.push_back(static_cast<std::uint32_t>(c));

@@ -167,6 +167,11 @@ int run_inspect(Args args) {
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
     std::string detail = channel.bone;
+    if (!channel.second_bone.empty()) detail += " -> " + channel.second_bone;
+    if (!channel.curves.empty()) {
+      detail = "+-" + std::to_string(channel.window_seconds).substr(0, 5) + " s:";
+      for (const std::string& curve : channel.curves) detail += " " + curve;
+    }
     if (uses_trajectory_offsets(channel.kind)) {
       detail = "offsets (s):";
       for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);

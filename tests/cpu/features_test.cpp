@@ -10,6 +10,7 @@
 #include "mmvk/database_build.hpp"
 #include "mmvk/features.hpp"
 #include "mmvk/normalization.hpp"
+#include "support/motion_fixtures.hpp"
 
 namespace mmvk {
 namespace {
@@ -44,13 +45,7 @@ Motion walker(std::uint32_t frames, float speed, float heading, float turn_rate 
   return m;
 }
 
-CharacterRoot root_of(const Motion& motion) {
-  CharacterRootOptions options;
-  options.facing_smoothing_seconds = 0.0f;
-  Result<CharacterRoot> root = compute_character_root(motion, options);
-  EXPECT_TRUE(root.ok()) << root.message();
-  return std::move(root).value();
-}
+using test::root_of;
 
 // Value of schema dimension `name` at frame f.
 float feature(const RawFeatures& raw, const FeatureSchema& schema, std::uint32_t f, std::string_view name) {

@@ -12,6 +12,7 @@
 
 #include "mmvk/database_build.hpp"
 #include "mmvk/features.hpp"
+#include "support/motion_fixtures.hpp"
 
 namespace mmvk {
 namespace {
@@ -71,13 +72,7 @@ Motion biped(const Gait& gait) {
   return m;
 }
 
-CharacterRoot root_of(const Motion& motion) {
-  CharacterRootOptions options;
-  options.facing_smoothing_seconds = 0.0f;
-  Result<CharacterRoot> root = compute_character_root(motion, options);
-  EXPECT_TRUE(root.ok()) << root.message();
-  return std::move(root).value();
-}
+using test::root_of;
 
 Result<FeatureSchema> schema_of(const std::string& channels) {
   return parse_schema_json(R"({"channels": [)" + channels + "]}", "test.json");

@@ -25,25 +25,7 @@ namespace mmvk::test {
 // The locomotion database, or nullptr (after a failure) when it cannot be
 // built. Built on first use and kept for the program's lifetime.
 inline const Database* locomotion_database(const std::filesystem::path& data) {
-  static std::unique_ptr<Database> db;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    Result<Manifest> manifest = manifest_from_directory(data / "bandai-namco-nc" / "locomotion-normal");
-    if (!manifest.ok()) {
-      ADD_FAILURE() << manifest.message();
-      return nullptr;
-    }
-    ThreadPool pool;
-    BuildOptions options;
-    options.pool = &pool;
-    Result<Database> built = build_database(*manifest, options);
-    if (!built.ok()) {
-      ADD_FAILURE() << built.message();
-      return nullptr;
-    }
-    db = std::make_unique<Database>(std::move(built).value());
-  }
+  static const std::unique_ptr<Database> db = build_locomotion(data, default_schema());
   return db.get();
 }
 

@@ -36,28 +36,29 @@ inline FeatureSchema new_kinds_schema() {
   return schema;
 }
 
+// The Bandai locomotion set built with `schema` (default options), or
+// nullptr after a failure.
+inline std::unique_ptr<Database> build_locomotion(const std::filesystem::path& data, const FeatureSchema& schema) {
+  Result<Manifest> manifest = manifest_from_directory(data / "bandai-namco-nc" / "locomotion-normal");
+  if (!manifest.ok()) {
+    ADD_FAILURE() << manifest.message();
+    return nullptr;
+  }
+  manifest->schema = schema;
+  ThreadPool pool;
+  BuildOptions options;
+  options.pool = &pool;
+  Result<Database> built = build_database(*manifest, options);
+  if (!built.ok()) {
+    ADD_FAILURE() << built.message();
+    return nullptr;
+  }
+  return std::make_unique<Database>(std::move(built).value());
+}
+
 // The locomotion set with new_kinds_schema(), built once per program.
 inline const Database* locomotion_new_kinds_database(const std::filesystem::path& data) {
-  static std::unique_ptr<Database> db;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    Result<Manifest> manifest = manifest_from_directory(data / "bandai-namco-nc" / "locomotion-normal");
-    if (!manifest.ok()) {
-      ADD_FAILURE() << manifest.message();
-      return nullptr;
-    }
-    manifest->schema = new_kinds_schema();
-    ThreadPool pool;
-    BuildOptions options;
-    options.pool = &pool;
-    Result<Database> built = build_database(*manifest, options);
-    if (!built.ok()) {
-      ADD_FAILURE() << built.message();
-      return nullptr;
-    }
-    db = std::make_unique<Database>(std::move(built).value());
-  }
+  static const std::unique_ptr<Database> db = build_locomotion(data, new_kinds_schema());
   return db.get();
 }
 

@@ -45,16 +45,8 @@ Motion walker(std::uint32_t frames, float speed, float heading, float turn_rate 
   return m;
 }
 
+using test::feature;
 using test::root_of;
-
-// Value of schema dimension `name` at frame f.
-float feature(const RawFeatures& raw, const FeatureSchema& schema, std::uint32_t f, std::string_view name) {
-  for (std::uint32_t d = 0; d < schema.dims(); ++d) {
-    if (schema.dim_name(d) == name) return raw.values[std::size_t{f} * raw.dims + d];
-  }
-  ADD_FAILURE() << "no dimension " << name;
-  return 0.0f;
-}
 
 TEST(Features, StraightWalkInCharacterSpace) {
   const FeatureSchema schema = default_schema();

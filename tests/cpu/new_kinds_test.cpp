@@ -72,6 +72,7 @@ Motion biped(const Gait& gait) {
   return m;
 }
 
+using test::feature;
 using test::root_of;
 
 Result<FeatureSchema> schema_of(const std::string& channels) {
@@ -85,14 +86,6 @@ Result<RawFeatures> extract(const Motion& motion, const FeatureSchema& schema, b
   return extract_features(motion, root_of(motion), schema, options);
 }
 
-float value(const RawFeatures& raw, const FeatureSchema& schema, std::uint32_t f, std::string_view dim) {
-  for (std::uint32_t d = 0; d < schema.dims(); ++d) {
-    if (schema.dim_name(d) == dim) return raw.values[std::size_t{f} * raw.dims + d];
-  }
-  ADD_FAILURE() << "no dimension " << dim;
-  return 0.0f;
-}
-
 TEST(PastTrajectory, LooksBackAndFollowsTheEdgeRuleAtTheStart) {
   Result<FeatureSchema> schema = schema_of(
       R"({"name": "path", "kind": "trajectory_position", "offsets_seconds": [-0.5, -0.2, 0.2]},
@@ -104,21 +97,21 @@ TEST(PastTrajectory, LooksBackAndFollowsTheEdgeRuleAtTheStart) {
   Result<RawFeatures> raw = extract(motion, *schema);
   ASSERT_TRUE(raw.ok()) << raw.message();
   // 15 frames back, 6 back, 6 ahead: 1.2 m/s straight ahead.
-  EXPECT_NEAR(value(*raw, *schema, 40, "path[0].z"), -0.6f, 1e-4f);
-  EXPECT_NEAR(value(*raw, *schema, 40, "path[1].z"), -0.24f, 1e-4f);
-  EXPECT_NEAR(value(*raw, *schema, 40, "path[2].z"), 0.24f, 1e-4f);
-  EXPECT_NEAR(value(*raw, *schema, 40, "path[0].x"), 0.0f, 1e-4f);
-  EXPECT_NEAR(value(*raw, *schema, 40, "dir[0].z"), 1.0f, 1e-5f);
+  EXPECT_NEAR(feature(*raw, *schema, 40, "path[0].z"), -0.6f, 1e-4f);
+  EXPECT_NEAR(feature(*raw, *schema, 40, "path[1].z"), -0.24f, 1e-4f);
+  EXPECT_NEAR(feature(*raw, *schema, 40, "path[2].z"), 0.24f, 1e-4f);
+  EXPECT_NEAR(feature(*raw, *schema, 40, "path[0].x"), 0.0f, 1e-4f);
+  EXPECT_NEAR(feature(*raw, *schema, 40, "dir[0].z"), 1.0f, 1e-5f);
   // Before the start: clamped to frame 0 and flagged, like the end.
-  EXPECT_NEAR(value(*raw, *schema, 5, "path[0].z"), -1.2f * 5.0f / 30.0f, 1e-4f);
+  EXPECT_NEAR(feature(*raw, *schema, 5, "path[0].z"), -1.2f * 5.0f / 30.0f, 1e-4f);
   for (std::uint32_t f = 0; f < gait.frames; ++f) {
     EXPECT_EQ(raw->past_end[f], f < 15 || f + 6 > gait.frames - 1 ? 1 : 0) << f;
   }
   // Looping: the path continues before frame 0 and nothing is flagged.
   Result<RawFeatures> looped = extract(motion, *schema, true);
   ASSERT_TRUE(looped.ok()) << looped.message();
-  EXPECT_NEAR(value(*looped, *schema, 5, "path[0].z"), -0.6f, 1e-4f);
-  EXPECT_NEAR(value(*looped, *schema, 5, "path[0].x"), 0.0f, 1e-4f);
+  EXPECT_NEAR(feature(*looped, *schema, 5, "path[0].z"), -0.6f, 1e-4f);
+  EXPECT_NEAR(feature(*looped, *schema, 5, "path[0].x"), 0.0f, 1e-4f);
   for (std::uint8_t past : looped->past_end) EXPECT_EQ(past, 0);
 
   // A database flags the start frames too.
@@ -146,12 +139,12 @@ TEST(PastTrajectory, TurningLoopIsContinuousAcrossTheStart) {
   ASSERT_TRUE(looped.ok()) << looped.message();
   // A steady turn: the point 1 s back is the same in character space on
   // every frame, whether it lies inside the clip or in the cycle before.
-  const float x = value(*looped, *schema, 100, "path[0].x");
-  const float z = value(*looped, *schema, 100, "path[0].z");
+  const float x = feature(*looped, *schema, 100, "path[0].x");
+  const float z = feature(*looped, *schema, 100, "path[0].z");
   EXPECT_GT(x, 0.05f) << "on a left turn the whole circle, past included, lies to the left";
   for (std::uint32_t f : {0u, 10u, 29u, 31u, 60u}) {
-    EXPECT_NEAR(value(*looped, *schema, f, "path[0].x"), x, 2e-3f) << f;
-    EXPECT_NEAR(value(*looped, *schema, f, "path[0].z"), z, 2e-3f) << f;
+    EXPECT_NEAR(feature(*looped, *schema, f, "path[0].x"), x, 2e-3f) << f;
+    EXPECT_NEAR(feature(*looped, *schema, f, "path[0].z"), z, 2e-3f) << f;
   }
 }
 
@@ -256,15 +249,15 @@ TEST(LimbVector, DoesNotChangeWithTheCharactersSize) {
       }
     }
     EXPECT_LT(worst, 1e-4f);
-    EXPECT_GT(std::abs(value(*scaled, *schema, 10, "hand.y") - value(*base, *schema, 10, "hand.y")), 0.05f);
+    EXPECT_GT(std::abs(feature(*scaled, *schema, 10, "hand.y") - feature(*base, *schema, 10, "hand.y")), 0.05f);
   }
   // A stretched leg points straight down with length 1 (the rest pose at frame 0).
   gait.scale = 1.0f;
   gait.swing = 0.0f;
   Result<RawFeatures> rest = extract(biped(gait), *schema);
   ASSERT_TRUE(rest.ok()) << rest.message();
-  const glm::vec3 leg(value(*rest, *schema, 0, "left_leg.x"), value(*rest, *schema, 0, "left_leg.y"),
-                      value(*rest, *schema, 0, "left_leg.z"));
+  const glm::vec3 leg(feature(*rest, *schema, 0, "left_leg.x"), feature(*rest, *schema, 0, "left_leg.y"),
+                      feature(*rest, *schema, 0, "left_leg.z"));
   EXPECT_NEAR(leg.y, -(0.05f + 0.9f) / (std::sqrt(0.1f * 0.1f + 0.05f * 0.05f) + 0.9f), 1e-5f);
   EXPECT_NEAR(leg.x, 0.1f / (std::sqrt(0.1f * 0.1f + 0.05f * 0.05f) + 0.9f), 1e-5f);
 }

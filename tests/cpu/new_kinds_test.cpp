@@ -12,6 +12,7 @@
 
 #include "mmvk/database_build.hpp"
 #include "mmvk/features.hpp"
+#include "mmvk/query_assembly.hpp"
 #include "support/motion_fixtures.hpp"
 
 namespace mmvk {
@@ -158,6 +159,37 @@ TEST(PastTrajectory, AnOffsetBeyondTheEdgesIsAnErrorNamingFileAndField) {
   EXPECT_NE(raw.message().find("channel 'path': offsets_seconds[1]"), std::string::npos) << raw.message();
   // Looping clips wrap, so any reach is fine.
   EXPECT_TRUE(extract(biped(Gait{}), *schema, true).ok());
+}
+
+TEST(PastTrajectory, CrowdQueriesCopyThePastFromTheFrame) {
+  Result<FeatureSchema> schema = schema_of(
+      R"({"name": "path", "kind": "trajectory_position", "offsets_seconds": [-0.5, 0.2, -0.2, 0.6]},
+         {"name": "foot", "kind": "bone_position", "bone": "@left_foot"})");
+  ASSERT_TRUE(schema.ok()) << schema.message();
+  Gait gait;
+  gait.turn_rate = 0.5f;
+  std::vector<MotionClip> clips(1);
+  clips[0].motion = biped(gait);
+  clips[0].meta.file = "walk.bvh";
+  clips[0].meta.name = "walk";
+  MotionBuildSettings settings;
+  settings.schema = *schema;
+  Result<Database> db = build_database_from_motions(clips, settings);
+  ASSERT_TRUE(db.ok()) << db.message();
+  Result<QueryAssembler> assembler = QueryAssembler::create(*db);
+  ASSERT_TRUE(assembler.ok()) << assembler.message();
+  // The predictor fills the future offsets only.
+  ASSERT_EQ(assembler->trajectory_offsets().size(), 2u);
+  EXPECT_EQ(assembler->trajectory_offsets()[0], 0.2f);
+  EXPECT_EQ(assembler->trajectory_offsets()[1], 0.6f);
+  const glm::vec3 positions[2] = {{0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 2.0f}};
+  const float yaws[2] = {0.0f, 0.0f};
+  std::vector<float> query(db->dims());
+  assembler->assemble(40, QueryFrame{}, positions, yaws, query);
+  for (std::uint32_t d : {0u, 1u, 4u, 5u, 8u, 9u, 10u}) EXPECT_EQ(query[d], db->row(40)[d]) << db->schema().dim_name(d);
+  const auto raw = [&](std::uint32_t d) { return query[d] * db->normalization()[d].scale + db->normalization()[d].offset; };
+  EXPECT_NEAR(raw(3), 1.0f, 1e-5f);  // path[1].z, predicted
+  EXPECT_NEAR(raw(7), 2.0f, 1e-5f);  // path[3].z, predicted
 }
 
 TEST(RootAngularVelocity, IsTheTurningRateAndNegatesWhenMirrored) {

@@ -74,6 +74,15 @@ struct ClusterSearchOptions {
   // the tile bounds make exact mode's proof of the answer cheap, and most
   // of its work is finding the answer (see the bench results in git log).
   bool probe_by_bound = false;
+  // Exact mode, B >= threads: each thread takes its queries in sub-batches
+  // and visits their clusters grouped by cluster, so the rows of a cluster
+  // are loaded once for all the sub-batch's queries that visit it (see
+  // cluster_search.cpp). Off: the one-query walk, query by query.
+  bool batch_by_cluster = true;
+  // Exact mode, B < threads: each query is split over the pool's threads
+  // (tiles of the seed cluster and candidate clusters dealt out in turn,
+  // one shared k-th best for pruning). Off: one thread per query.
+  bool split_single = true;
   // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
   // AVX-512F (as FastSearchOptions::baseline_kernels; the same kernels).
   bool baseline_kernels = false;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "search/tile_store.hpp"
@@ -17,6 +19,12 @@ constexpr std::uint32_t kLanes = detail::kLanes;  // rows per tile, boxes per pa
 std::size_t packs_of(std::size_t boxes) { return (boxes + kLanes - 1) / kLanes; }
 
 constexpr std::uint32_t kNoCluster = 0xffffffffu;
+
+// Exact batched mode: queries whose bounds are held at once per thread (their
+// bounds take kSubBatch x clusters floats), and the rounds that take one
+// candidate cluster per query before the rest are taken at once.
+constexpr std::size_t kSubBatch = 64;
+constexpr std::uint32_t kRankedRounds = 2;
 
 // Ordered by (bound, cluster); in nprobe mode `bound` is the centroid
 // distance and `lower` the lower bound.
@@ -35,6 +43,12 @@ struct Scratch {
   std::vector<float> tile_bound;                 // [tiles of the largest cluster, padded to 16]
   std::vector<double> radius_sum, radius_total;  // [clusters]
   std::array<detail::LaneHit, kLanes> hits{};
+  // Batched exact mode and the split single query.
+  std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
+  std::vector<std::uint32_t> seed, cursor, candidate_end;      // [kSubBatch]
+  std::vector<ClusterBound> candidates;                        // each query's, sorted, one after another
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (cluster, query) to visit
+  std::vector<std::uint32_t> bucket_start, bucket_fill, bucket_query;
   std::uint64_t rows = 0;
   ClusterSearchCounters counters;
 };
@@ -66,6 +80,7 @@ struct ClusterSearch::Layout {
   std::vector<bool> never_candidate;         // [clusters]: empty or all members excluded by flags
   double radius_margin = 0.0;
   std::vector<Scratch> scratch;              // [pool threads]
+  std::vector<Match> partial;                // [threads x k]: a split query's lists
 };
 
 Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& database, const ClusterTable& table,
@@ -146,6 +161,10 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.tile_bound.resize(packs_of(l.max_cluster_tiles) * kLanes);
     s.radius_sum.resize(k);
     s.radius_total.resize(k);
+    s.batch_bound.resize(kSubBatch * cluster_packs * kLanes);
+    s.seed.resize(kSubBatch);
+    s.cursor.resize(kSubBatch);
+    s.candidate_end.resize(kSubBatch);
   }
   return std::unique_ptr<ClusterSearch>(new ClusterSearch(database, pool, options, std::move(layout)));
 }
@@ -203,141 +222,368 @@ void radius_bounds(const ClusterSearch::Layout& l, const float* q, const float* 
   }
 }
 
+// One query as the walks see it.
+struct QueryView {
+  const float* q;
+  const float* w;
+  const QueryParams* params;
+  std::span<Match> best;  // sorted, k entries
+};
+
+// A k-th best shared by the threads that split one query (single-query
+// path): any k rows found by any thread bound the final k-th best from
+// above, so a tile bound strictly above the smallest thread-local k-th best
+// can be skipped by every thread.
+struct SharedThreshold {
+  std::atomic<float> value{std::numeric_limits<float>::infinity()};
+  float load() const { return value.load(std::memory_order_relaxed); }
+  void lower_to(float v) {
+    float cur = load();
+    while (v < cur && !value.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+    }
+  }
+};
+
+// What every walk needs besides the query.
+struct WalkContext {
+  const Database& db;
+  const ClusterSearch::Layout& l;
+  const ClusterSearchOptions& options;
+  detail::TileArrays tiles;
+  detail::BoxArrays tile_boxes;
+};
+
+float threshold_of(const QueryView& v, const SharedThreshold* shared) {
+  const float own = v.best.back().cost;
+  return shared == nullptr ? own : std::min(own, shared->load());
+}
+
+// Evaluates the tiles i = part, part + parts, ... of cluster c whose own
+// bound is at most the k-th best (strictly greater is skipped: a member
+// costing exactly the k-th best could still win on a lower frame id).
+void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c, std::uint32_t part = 0,
+                   std::uint32_t parts = 1, SharedThreshold* shared = nullptr) {
+  const ClusterSearch::Layout& l = x.l;
+  ++s.counters.clusters_visited;
+  const std::uint32_t first_tile = l.tile_offsets[c];
+  const std::uint32_t tiles = l.tile_offsets[c + 1] - first_tile;
+  if (x.options.tile_bound) {
+    // Members are in frame order, so a tile mostly holds neighbouring
+    // frames of a clip and its box is tight.
+    l.kernels.box_bounds(x.tile_boxes, l.tile_box_pack[c], packs_of(tiles), v.q, v.w, s.tile_bound.data());
+    s.counters.tiles_checked += tiles;
+  }
+  detail::KernelQuery kernel_query{v.q, v.w, 0.0f};
+  for (std::uint32_t i = part; i < tiles; i += parts) {
+    const float threshold = threshold_of(v, shared);
+    if (x.options.tile_bound && s.tile_bound[i] > threshold) continue;
+    const std::uint32_t tile = first_tile + i;
+    s.rows += l.tile_rows[tile];
+    kernel_query.threshold = threshold;
+    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, &tile, 1, s.hits.data());
+    for (std::size_t h = 0; h < hits; ++h) {
+      detail::offer_tile_row(x.db, *v.params, v.best, Match{l.frame[s.hits[h].slot], s.hits[h].cost});
+    }
+    if (shared != nullptr && hits != 0) shared->lower_to(v.best.back().cost);
+  }
+}
+
+bool cluster_eligible(const ClusterSearch::Layout& l, const QueryParams& params, std::uint32_t c) {
+  const ClusterTable& t = l.table;
+  return !l.never_candidate[c] && (t.tag_union[c] & params.require_all) == params.require_all &&
+         (t.tag_intersection[c] & params.exclude_any) == 0;
+}
+
+// Clears the query's list and seeds it with the continuing frame: its cost
+// carries continuing_bias (possibly negative), which no cluster bound
+// covers, so it is evaluated on its own and skipped by the tiles.
+void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
+  std::fill(v.best.begin(), v.best.end(), Match{});
+  const std::uint32_t continuing = v.params->continuing_frame;
+  if (continuing != kNoFrame && is_candidate(x.db, continuing, *v.params)) {
+    detail::insert_sorted(v.best, Match{continuing, frame_cost(x.db, continuing, {v.q, x.l.dims}, *v.params)});
+    ++s.rows;
+  }
+}
+
+// Exact mode's lower bounds of every cluster into bound[] (padded to whole
+// packs): NaN for a cluster the query rules out (never <= any threshold),
+// -inf for a bound that overflowed to NaN (proves nothing: visited first).
+// Returns the eligible cluster with the nearest centroid when seeding
+// (ties: the lower cluster id), else kNoCluster.
+std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v, float* bound) {
+  const ClusterSearch::Layout& l = x.l;
+  const ClusterTable& t = l.table;
+  const std::size_t cluster_packs = packs_of(t.cluster_count);
+  if (x.options.box_bound) {
+    l.kernels.box_bounds(l.cluster_boxes.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, bound);
+  } else {
+    std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
+  }
+  if (x.options.radius_bound) radius_bounds(l, v.q, v.w, s, bound);
+  // A tag both required and excluded rules out every frame.
+  const bool contradictory = (v.params->require_all & v.params->exclude_any) != 0;
+  std::uint32_t eligible = 0;
+  for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
+    if (contradictory || !cluster_eligible(l, *v.params, c)) {
+      bound[c] = std::numeric_limits<float>::quiet_NaN();
+    } else {
+      ++eligible;
+      if (std::isnan(bound[c])) bound[c] = -std::numeric_limits<float>::infinity();
+    }
+  }
+  if (!x.options.seed_nearest || eligible < 2) return kNoCluster;
+  l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
+  std::uint32_t nearest = kNoCluster;
+  for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
+    if (std::isnan(bound[c])) continue;
+    if (nearest == kNoCluster || s.distance[c] < s.distance[nearest]) nearest = c;
+  }
+  return nearest;
+}
+
+// Appends the clusters other than `skip` whose bound is at most `threshold`,
+// sorted by (bound, cluster).
+void collect_candidates(const float* bound, std::uint32_t clusters, std::uint32_t skip, float threshold,
+                        std::vector<ClusterBound>& out) {
+  const std::size_t begin = out.size();
+  for (std::uint32_t c = 0; c < clusters; ++c) {
+    if (c != skip && bound[c] <= threshold) out.push_back({bound[c], c, 0.0f});
+  }
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.end());
+}
+
+// The per-query walk (nprobe mode, and exact mode's fallback).
+void walk_one(const WalkContext& x, Scratch& s, const QueryView& v) {
+  const ClusterSearch::Layout& l = x.l;
+  const ClusterTable& t = l.table;
+  const ClusterSearchOptions& options = x.options;
+  const std::span<Match> best = v.best;
+  const std::size_t k = best.size();
+  s.order.clear();
+  // A tag both required and excluded rules out every frame.
+  const bool contradictory = (v.params->require_all & v.params->exclude_any) != 0;
+  for (std::uint32_t c = 0; c < t.cluster_count && !contradictory; ++c) {
+    if (cluster_eligible(l, *v.params, c)) s.order.push_back({0.0f, c, 0.0f});
+  }
+  const bool probing = options.nprobe != 0 && options.nprobe < s.order.size();
+  // Nearest-centroid seed (exact mode) or probe order (nprobe mode):
+  // channel-weighted squared centroid distances, a box bound of the
+  // zero-size boxes [centroid, centroid] with unit multipliers.
+  const bool by_centroid = probing && !options.probe_by_bound;
+  const bool seeding = !by_centroid && options.seed_nearest && s.order.size() > 1;
+  const std::size_t cluster_packs = packs_of(t.cluster_count);
+  if (by_centroid || seeding) {
+    l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
+  }
+  float* bound = s.bound.data();
+  if (!s.order.empty()) {
+    if (options.box_bound) {
+      l.kernels.box_bounds(l.cluster_boxes.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, bound);
+    } else {
+      std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
+    }
+    if (options.radius_bound) radius_bounds(l, v.q, v.w, s, bound);
+    for (ClusterBound& b : s.order) b.bound = bound[b.cluster];
+  }
+
+  if (by_centroid) {
+    // The nprobe nearest centroids, nearest first (the most likely home
+    // of the answer, so the k-th best tightens early); a probed cluster
+    // whose lower bound is above the k-th best is skipped, which never
+    // changes the result.
+    for (ClusterBound& b : s.order) {
+      b.lower = b.bound;
+      b.bound = s.distance[b.cluster];
+    }
+    std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
+    s.order.resize(options.nprobe);
+    std::sort(s.order.begin(), s.order.end());
+    for (const ClusterBound& b : s.order) {
+      if (b.lower > best[k - 1].cost) continue;
+      visit_cluster(x, s, v, b.cluster);
+    }
+    return;
+  }
+
+  // Exact: first the cluster of the nearest centroid (when seeding), to
+  // tighten the k-th best early, then every cluster in lower-bound order
+  // until the next bound is above the k-th best.
+  std::uint32_t seeded = kNoCluster;
+  std::uint32_t budget = probing ? options.nprobe : t.cluster_count;
+  if (seeding) {
+    const ClusterBound* nearest = &s.order.front();
+    for (const ClusterBound& b : s.order) {
+      if (s.distance[b.cluster] < s.distance[nearest->cluster]) nearest = &b;
+    }
+    seeded = nearest->cluster;
+    if (nearest->bound <= best[k - 1].cost) {
+      visit_cluster(x, s, v, seeded);
+      --budget;
+    }
+  }
+  // A min-heap: usually only a few clusters are visited, so popping them
+  // in order beats sorting all of them.
+  const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
+  std::make_heap(s.order.begin(), s.order.end(), heap_order);
+  for (auto heap_end = s.order.end(); heap_end != s.order.begin() && budget > 0; --heap_end) {
+    std::pop_heap(s.order.begin(), heap_end, heap_order);
+    const ClusterBound& b = *(heap_end - 1);
+    if (b.bound > best[k - 1].cost) break;
+    if (b.cluster == seeded) continue;
+    visit_cluster(x, s, v, b.cluster);
+    --budget;
+  }
+}
+
+// Visits the (cluster, query) pairs grouped by cluster, so a cluster's tiles
+// and tile boxes are loaded once for every query of the sub-batch that
+// visits it, and stay in cache between those queries. A pair is skipped when
+// the cluster's bound has risen above the query's k-th best meanwhile.
+template <class ViewOf>
+void visit_grouped(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::size_t stride) {
+  const std::uint32_t clusters = x.l.table.cluster_count;
+  s.bucket_start.assign(clusters + 1, 0);
+  for (const auto& [c, i] : s.pairs) ++s.bucket_start[c + 1];
+  for (std::uint32_t c = 0; c < clusters; ++c) s.bucket_start[c + 1] += s.bucket_start[c];
+  s.bucket_query.resize(s.pairs.size());
+  s.bucket_fill.assign(s.bucket_start.begin(), s.bucket_start.end() - 1);
+  for (const auto& [c, i] : s.pairs) s.bucket_query[s.bucket_fill[c]++] = i;
+  for (std::uint32_t c = 0; c < clusters; ++c) {
+    for (std::uint32_t at = s.bucket_start[c]; at < s.bucket_start[c + 1]; ++at) {
+      const std::uint32_t i = s.bucket_query[at];
+      const QueryView v = view_of(i);
+      if (s.batch_bound[i * stride + c] <= v.best.back().cost) visit_cluster(x, s, v, c);
+    }
+  }
+}
+
+// Exact mode over queries [first, last), in sub-batches: bounds and seeds per
+// query, then the seed clusters grouped by cluster, then each query's
+// remaining candidates (bound <= its k-th best after the seed) in rounds:
+// the next candidate of every query per round for the first rounds (the
+// most promising cluster first, as in the one-query walk), then all the
+// rest at once, each round grouped by cluster.
+template <class ViewOf>
+void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::size_t first, std::size_t last) {
+  const std::uint32_t clusters = x.l.table.cluster_count;
+  const std::size_t stride = packs_of(clusters) * kLanes;
+  for (std::size_t base = first; base < last; base += kSubBatch) {
+    const std::uint32_t n = static_cast<std::uint32_t>(std::min(kSubBatch, last - base));
+    const auto local = [&](std::uint32_t i) { return view_of(base + i); };
+    s.pairs.clear();
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const QueryView v = local(i);
+      start_query(x, s, v);
+      float* bound = s.batch_bound.data() + i * stride;
+      s.seed[i] = exact_bounds(x, s, v, bound);
+      if (s.seed[i] != kNoCluster && bound[s.seed[i]] <= v.best.back().cost) s.pairs.emplace_back(s.seed[i], i);
+    }
+    visit_grouped(x, s, local, stride);
+
+    s.candidates.clear();
+    for (std::uint32_t i = 0; i < n; ++i) {
+      s.candidate_end[i] = static_cast<std::uint32_t>(s.candidates.size());  // this query's begin, for now
+      collect_candidates(s.batch_bound.data() + i * stride, clusters, s.seed[i], local(i).best.back().cost,
+                         s.candidates);
+    }
+    for (std::uint32_t i = 0; i < n; ++i) {
+      s.cursor[i] = s.candidate_end[i];
+      s.candidate_end[i] = i + 1 < n ? s.candidate_end[i + 1] : static_cast<std::uint32_t>(s.candidates.size());
+    }
+    for (std::uint32_t round = 0;; ++round) {
+      const std::size_t take = round < kRankedRounds ? 1 : s.candidates.size();
+      s.pairs.clear();
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const float threshold = local(i).best.back().cost;
+        for (std::size_t taken = 0; taken < take && s.cursor[i] < s.candidate_end[i]; ++taken) {
+          const ClusterBound& b = s.candidates[s.cursor[i]++];
+          if (!(b.bound <= threshold)) {
+            s.cursor[i] = s.candidate_end[i];  // sorted: the rest are above it too
+            break;
+          }
+          s.pairs.emplace_back(b.cluster, i);
+        }
+      }
+      if (s.pairs.empty()) break;
+      visit_grouped(x, s, local, stride);
+    }
+  }
+}
+
+// One query split over `parts` threads: each computes the bounds (cheap),
+// takes every parts-th tile of the seed cluster and every parts-th
+// candidate cluster into a list of its own, pruning against the smallest
+// k-th best any of them has found; the lists are merged at the end.
+void walk_split(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t part, std::uint32_t parts,
+                SharedThreshold& shared) {
+  const std::uint32_t clusters = x.l.table.cluster_count;
+  std::fill(v.best.begin(), v.best.end(), Match{});
+  if (part == 0) {
+    start_query(x, s, v);
+    shared.lower_to(v.best.back().cost);
+  }
+  float* bound = s.batch_bound.data();
+  const std::uint32_t seed = exact_bounds(x, s, v, bound);
+  if (seed != kNoCluster && bound[seed] <= threshold_of(v, &shared)) visit_cluster(x, s, v, seed, part, parts, &shared);
+  s.candidates.clear();
+  collect_candidates(bound, clusters, seed, threshold_of(v, &shared), s.candidates);
+  for (std::size_t j = part; j < s.candidates.size(); j += parts) {
+    const ClusterBound& b = s.candidates[j];
+    if (b.bound > threshold_of(v, &shared)) break;
+    visit_cluster(x, s, v, b.cluster, 0, 1, &shared);
+  }
+}
+
 }  // namespace
 
 Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) {
   MMVK_TRY(validate_search(*database_, batch, k, out));
-  const Database& db = *database_;
   Layout& l = *layout_;
-  const ClusterTable& t = l.table;
   const QueryParams default_params;
   const ClusterSearchOptions options = options_;
-  const detail::TileArrays tile_arrays = l.rows.arrays();
-  const detail::BoxArrays tile_boxes = l.tile_boxes.arrays(l.rows.channel_end);
+  const WalkContext x{*database_, l, options, l.rows.arrays(), l.tile_boxes.arrays(l.rows.channel_end)};
   for (Scratch& s : l.scratch) {
     s.rows = 0;
     s.counters = {};
   }
+  const auto view_of = [&](std::size_t qi) {
+    const QueryParams& params = batch.params.empty() ? default_params : batch.params[qi];
+    return QueryView{batch.features.data() + qi * l.dims, params.channel_weights.data(), &params, out.subspan(qi * k, k)};
+  };
+  const bool exact = options.nprobe == 0;
+  const unsigned threads = pool_->thread_count();
 
-  pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
-    Scratch& s = l.scratch[thread];
-    for (std::size_t qi = first; qi < last; ++qi) {
-      const QueryParams& params = batch.params.empty() ? default_params : batch.params[qi];
-      const float* q = batch.features.data() + qi * l.dims;
-      const float* w = params.channel_weights.data();
-      const std::span<Match> best = out.subspan(qi * k, k);
-      std::fill(best.begin(), best.end(), Match{});
-      const std::uint32_t continuing = params.continuing_frame;
-      if (continuing != kNoFrame && is_candidate(db, continuing, params)) {
-        detail::insert_sorted(best, Match{continuing, frame_cost(db, continuing, {q, l.dims}, params)});
-        ++s.rows;
-      }
-
-      s.order.clear();
-      // A tag both required and excluded rules out every frame.
-      const bool contradictory = (params.require_all & params.exclude_any) != 0;
-      for (std::uint32_t c = 0; c < t.cluster_count && !contradictory; ++c) {
-        if (l.never_candidate[c]) continue;
-        if ((t.tag_union[c] & params.require_all) != params.require_all) continue;
-        if ((t.tag_intersection[c] & params.exclude_any) != 0) continue;
-        s.order.push_back({0.0f, c, 0.0f});
-      }
-      const bool probing = options.nprobe != 0 && options.nprobe < s.order.size();
-      // Nearest-centroid seed (exact mode) or probe order (nprobe mode):
-      // channel-weighted squared centroid distances, a box bound of the
-      // zero-size boxes [centroid, centroid] with unit multipliers.
-      const bool by_centroid = probing && !options.probe_by_bound;
-      const bool seeding = !by_centroid && options.seed_nearest && s.order.size() > 1;
-      const std::size_t cluster_packs = packs_of(t.cluster_count);
-      if (by_centroid || seeding) {
-        l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, q, w, s.distance.data());
-      }
-      float* bound = s.bound.data();
-      if (!s.order.empty()) {
-        if (options.box_bound) {
-          l.kernels.box_bounds(l.cluster_boxes.arrays(l.rows.channel_end), 0, cluster_packs, q, w, bound);
-        } else {
-          std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
+  if (exact && options.split_single && batch.size < threads && threads > 1) {
+    // Fewer queries than threads: each query is split over the threads.
+    const std::uint32_t parts = threads;
+    l.partial.resize(std::size_t{parts} * k);
+    for (std::size_t qi = 0; qi < batch.size; ++qi) {
+      const QueryView v = view_of(qi);
+      SharedThreshold shared;
+      pool_->parallel_for(parts, [&](std::size_t begin, std::size_t end, unsigned thread) {
+        for (std::size_t part = begin; part < end; ++part) {
+          const QueryView mine{v.q, v.w, v.params, std::span<Match>(l.partial).subspan(part * k, k)};
+          walk_split(x, l.scratch[thread], mine, static_cast<std::uint32_t>(part), parts, shared);
         }
-        if (options.radius_bound) radius_bounds(l, q, w, s, bound);
-        for (ClusterBound& b : s.order) b.bound = bound[b.cluster];
-      }
-
-      // Evaluates the tiles of cluster c whose own bound is at most the k-th
-      // best (strictly greater is skipped: a member costing exactly the k-th
-      // best could still win on a lower frame id).
-      detail::KernelQuery kernel_query{q, w, 0.0f};
-      const auto visit = [&](std::uint32_t c) {
-        ++s.counters.clusters_visited;
-        const std::uint32_t first_tile = l.tile_offsets[c];
-        const std::uint32_t tiles = l.tile_offsets[c + 1] - first_tile;
-        if (options.tile_bound) {
-          // Members are in frame order, so a tile mostly holds neighbouring
-          // frames of a clip and its box is tight.
-          l.kernels.box_bounds(tile_boxes, l.tile_box_pack[c], packs_of(tiles), q, w, s.tile_bound.data());
-          s.counters.tiles_checked += tiles;
-        }
-        for (std::uint32_t i = 0; i < tiles; ++i) {
-          if (options.tile_bound && s.tile_bound[i] > best[k - 1].cost) continue;
-          const std::uint32_t tile = first_tile + i;
-          s.rows += l.tile_rows[tile];
-          kernel_query.threshold = best[k - 1].cost;
-          const std::size_t hits = l.kernels.evaluate_tiles(tile_arrays, &kernel_query, 1, &tile, 1, s.hits.data());
-          for (std::size_t h = 0; h < hits; ++h) {
-            detail::offer_tile_row(db, params, best, Match{l.frame[s.hits[h].slot], s.hits[h].cost});
-          }
-        }
-      };
-
-      if (by_centroid) {
-        // The nprobe nearest centroids, nearest first (the most likely home
-        // of the answer, so the k-th best tightens early); a probed cluster
-        // whose lower bound is above the k-th best is skipped, which never
-        // changes the result.
-        for (ClusterBound& b : s.order) {
-          b.lower = b.bound;
-          b.bound = s.distance[b.cluster];
-        }
-        std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
-        s.order.resize(options.nprobe);
-        std::sort(s.order.begin(), s.order.end());
-        for (const ClusterBound& b : s.order) {
-          if (b.lower > best[k - 1].cost) continue;
-          visit(b.cluster);
-        }
-        continue;
-      }
-
-      // Exact: first the cluster of the nearest centroid (when seeding), to
-      // tighten the k-th best early, then every cluster in lower-bound order
-      // until the next bound is above the k-th best.
-      std::uint32_t seeded = kNoCluster;
-      std::uint32_t budget = probing ? options.nprobe : t.cluster_count;
-      if (seeding) {
-        const ClusterBound* nearest = &s.order.front();
-        for (const ClusterBound& b : s.order) {
-          if (s.distance[b.cluster] < s.distance[nearest->cluster]) nearest = &b;
-        }
-        seeded = nearest->cluster;
-        if (nearest->bound <= best[k - 1].cost) {
-          visit(seeded);
-          --budget;
-        }
-      }
-      // A min-heap: usually only a few clusters are visited, so popping them
-      // in order beats sorting all of them.
-      const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
-      std::make_heap(s.order.begin(), s.order.end(), heap_order);
-      for (auto heap_end = s.order.end(); heap_end != s.order.begin() && budget > 0; --heap_end) {
-        std::pop_heap(s.order.begin(), heap_end, heap_order);
-        const ClusterBound& b = *(heap_end - 1);
-        if (b.bound > best[k - 1].cost) break;
-        if (b.cluster == seeded) continue;
-        visit(b.cluster);
-        --budget;
-      }
+      });
+      std::sort(l.partial.begin(), l.partial.end(), match_less);
+      std::copy_n(l.partial.begin(), k, v.best.begin());
     }
-  });
+  } else {
+    pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
+      Scratch& s = l.scratch[thread];
+      if (exact && options.batch_by_cluster) {
+        walk_batched(x, s, view_of, first, last);
+        return;
+      }
+      for (std::size_t qi = first; qi < last; ++qi) {
+        const QueryView v = view_of(qi);
+        start_query(x, s, v);
+        walk_one(x, s, v);
+      }
+    });
+  }
 
   stats_.queries += batch.size;
   for (const Scratch& s : l.scratch) {

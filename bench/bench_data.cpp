@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -175,6 +176,12 @@ const Database* suite_database(DataSet set, SuiteSchema schema) {
   }
   if (schema == SuiteSchema::Default27 || variant.schema) built = load_or_build(set, variant);
   return cache.emplace(std::make_pair(set, schema), std::move(built)).first->second.get();
+}
+
+double process_cpu_seconds() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return double(now.tv_sec) + double(now.tv_nsec) * 1e-9;
 }
 
 }  // namespace mmvk::bench

@@ -41,4 +41,7 @@ std::string_view suite_schema_name(SuiteSchema schema);
 // after printing why, as database().
 const Database* suite_database(DataSet set, SuiteSchema schema);
 
+// CPU time of all the process's threads, in seconds (CLOCK_PROCESS_CPUTIME_ID).
+double process_cpu_seconds();
+
 }  // namespace mmvk::bench

@@ -121,6 +121,7 @@ void plain_loop(benchmark::State& state, DataSet set, QueryStream stream) {
   const auto [fn, isa] = pick();
   ThreadPool pool;  // all cores, as the fixture of the fast-brute rows
   std::vector<float> best(batch);
+  const double cpu_start = process_cpu_seconds();
   for (auto _ : state) {
     pool.parallel_for(batch, [&](std::size_t first, std::size_t last, unsigned) {
       for (std::size_t q = first; q < last; ++q) best[q] = std::numeric_limits<float>::infinity();
@@ -132,6 +133,8 @@ void plain_loop(benchmark::State& state, DataSet set, QueryStream stream) {
     });
     benchmark::DoNotOptimize(best.data());
   }
+  state.counters["cpu_us/q"] =
+      (process_cpu_seconds() - cpu_start) * 1e6 / (double(state.iterations()) * double(batch));
   state.SetLabel(isa);
   state.counters["queries/s"] = benchmark::Counter(double(batch), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["row_dims/s"] =

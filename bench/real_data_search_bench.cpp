@@ -9,6 +9,7 @@
 // The reference runs one iteration at the large sizes (it takes seconds).
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -34,12 +35,15 @@ struct Variant {
   std::string label;
   std::string backend;
   std::uint32_t nprobe = 0;
+  // clusters-per-query: issue 10's additions off (no grouping by cluster,
+  // no span boxes, no split single query), for before/after in one run.
+  bool per_query = false;
 };
 
 const std::vector<Variant>& variants() {
   static const std::vector<Variant> all = [] {
     std::vector<Variant> v = {{"reference", "reference"}, {"fast-brute", "fast-brute"}, {"fast-box", "fast-box"},
-                              {"clusters", "clusters"}};
+                              {"clusters", "clusters"}, {"clusters-per-query", "clusters", 0, true}};
     for (const std::uint32_t nprobe : {1u, 4u, 8u, 16u, 32u, 64u}) {
       v.push_back({"clusters-nprobe" + std::to_string(nprobe), "clusters-nprobe", nprobe});
     }
@@ -90,6 +94,11 @@ Fixture* fixture(DataSet set) {
         // Tuning switches (MMVK_BENCH_PROBE_BY_BOUND=1, MMVK_BENCH_NO_SEED=1).
         spec.cluster.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
         spec.cluster.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
+        if (variant.per_query) {
+          spec.cluster.batch_by_cluster = false;
+          spec.cluster.span_bound = false;
+          spec.cluster.split_single = false;
+        }
         Result<std::unique_ptr<SearchBackend>> made = registry.make(spec, *f->db);
         if (made) {
           f->backends[variant.label] = std::move(made.value());
@@ -102,7 +111,9 @@ Fixture* fixture(DataSet set) {
   return fixtures.emplace(set, std::move(f)).first->second.get();
 }
 
-void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& which) {
+// `singly`: the batch's queries are searched one at a time (B = 1 calls),
+// so the per-query figures compare with the batched row of the same B.
+void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& which, bool singly) {
   Fixture* f = fixture(set);
   if (!f->db || !f->backends.count(which) || !f->backends.count("fast-brute")) {
     state.SkipWithError("database or backend unavailable (see stderr)");
@@ -122,19 +133,36 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, const std::st
   SearchBackend& backend = *f->backends.at(which);
   std::vector<Match> results(batch);
   backend.reset_stats();
+  const double cpu_start = process_cpu_seconds();
+  const auto wall_start = std::chrono::steady_clock::now();
   for (auto _ : state) {
-    if (Status status = backend.search(query_batch, 1, results); !status) {
+    if (singly) {
+      for (std::size_t q = 0; q < batch; ++q) {
+        const std::size_t dims = f->db->dims();
+        const QueryBatch one{.features = std::span<const float>(queries).subspan(q * dims, dims), .params = {}, .size = 1};
+        if (Status status = backend.search(one, 1, std::span<Match>(results).subspan(q, 1)); !status) {
+          state.SkipWithError(status.message().c_str());
+          return;
+        }
+      }
+    } else if (Status status = backend.search(query_batch, 1, results); !status) {
       state.SkipWithError(status.message().c_str());
       return;
     }
     benchmark::DoNotOptimize(results.data());
   }
+  const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  const double cpu_seconds = process_cpu_seconds() - cpu_start;
   std::size_t hits = 0;
   for (std::size_t q = 0; q < batch; ++q) hits += results[q].frame == truth[q].frame;
   state.counters["queries/s"] = benchmark::Counter(double(batch), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["rows_fraction"] = backend.stats().rows_fraction(f->db->frame_count());
   state.counters["recall@1"] = double(hits) / double(batch);
   state.counters["frames"] = f->db->frame_count();
+  // CPU time of every thread of the process per query: steadier than wall
+  // time on a loaded machine (the pool's threads sleep when idle).
+  state.counters["cpu_us/q"] = cpu_seconds * 1e6 / (double(state.iterations()) * double(batch));
+  state.counters["wall_us/q"] = wall_seconds * 1e6 / (double(state.iterations()) * double(batch));
   if (const auto* clusters = dynamic_cast<const ClusterSearch*>(&backend)) {
     const double queries = double(backend.stats().queries);
     state.counters["clusters"] = clusters->cluster_count();
@@ -149,9 +177,17 @@ const bool registered = [] {
       for (const Variant& variant : variants()) {
         const std::string name = std::string("real/") + std::string(data_set_name(set)) + "/" +
                                  std::string(query_stream_name(stream)) + "/" + variant.label;
-        auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, variant.label);
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, variant.label, false);
         b->ArgName("B")->Arg(1)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
         if (variant.backend == "reference" && set != DataSet::Locomotion) b->Iterations(1);
+        if (variant.label == "clusters" || variant.label == "clusters-per-query") {
+          // B = 1 latency over the same queries as the B = 1024 row.
+          benchmark::RegisterBenchmark((name + "-singly").c_str(), run, set, stream, variant.label, true)
+              ->ArgName("B")
+              ->Arg(1024)
+              ->Unit(benchmark::kMillisecond)
+              ->UseRealTime();
+        }
       }
     }
   }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cstdio>
 #include <cmath>
 #include <random>
 #include <string>
@@ -312,6 +313,118 @@ TEST(ClusterSearch, BadInputIsAnError) {
   auto mismatched = ClusterSearch::create(other, table, pool);
   ASSERT_FALSE(mismatched.ok());
   EXPECT_NE(mismatched.message().find("another database"), std::string::npos) << mismatched.message();
+}
+
+// Issue 10's exact paths against the reference, under every constraint and
+// bias: the grouped batch (sub-batches of 512 queries per thread, so 1100
+// queries on 2 threads cross a sub-batch boundary), the span boxes (few
+// clusters, so clusters hold many 16-tile spans), the query split over the
+// threads (B < threads), and each alone.
+TEST(ClusterSearch, GroupedSpannedAndSplitPathsMatchTheReference) {
+  test::ClusteredDataSpec spec;
+  spec.frames = 6000;
+  const Database db = make_database(spec);
+  ReferenceSearch reference(db);
+  const std::size_t count = 1100;
+  const std::vector<float> features = make_queries(db, count, 21);
+  const std::vector<QueryParams> params = make_params(db, count, 22);
+  const Variant variants[] = {
+      {"all on", {}},
+      {"grouped only", {.span_bound = false, .split_single = false}},
+      {"spans only", {.span_bound = true, .batch_by_cluster = false, .split_single = false}},
+      {"all off", {.span_bound = false, .batch_by_cluster = false, .split_single = false}},
+      {"all on, no seed", {.seed_nearest = false}},
+      {"all on, box + radius", {.radius_bound = true}},
+      {"split", {.split_single = true}},
+  };
+  for (const std::uint32_t clusters : {3u, 40u}) {
+    const ClusterTable table = make_table(db, clusters);
+    for (const unsigned threads : {1u, 2u, 3u}) {
+      ThreadPool pool(threads);
+      for (const std::uint32_t k : {1u, 4u}) {
+        // The whole batch (grouped path), then the first 3 queries one at a
+        // time and 2 at a time (fewer queries than threads: split).
+        std::vector<Match> expected(count * k);
+        ASSERT_TRUE(reference.search({features, params, count}, k, expected).ok());
+        for (const Variant& variant : variants) {
+          const std::string what = std::string(variant.name) + " clusters=" + std::to_string(clusters) +
+                                   " threads=" + std::to_string(threads) + " k=" + std::to_string(k);
+          auto backend = ClusterSearch::create(db, table, pool, variant.options);
+          ASSERT_TRUE(backend.ok()) << backend.message();
+          std::vector<Match> actual(count * k);
+          ASSERT_TRUE((*backend)->search({features, params, count}, k, actual).ok());
+          expect_identical(expected, actual, k, what + " batch");
+          for (std::size_t size : {std::size_t{1}, std::size_t{2}}) {
+            for (std::size_t first = 0; first + size <= 36; first += size) {
+              const QueryBatch part{std::span<const float>(features).subspan(first * db.dims(), size * db.dims()),
+                                    std::span<const QueryParams>(params).subspan(first, size), size};
+              std::vector<Match> one(size * k);
+              ASSERT_TRUE((*backend)->search(part, k, one).ok());
+              expect_identical(std::span<const Match>(expected).subspan(first * k, size * k), one, k,
+                               what + " B=" + std::to_string(size) + " from query " + std::to_string(first));
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+// Every instruction set this CPU runs, forced, in both CPU backends, against
+// the reference; a set the CPU lacks is refused by create().
+TEST(CpuKernels, EveryInstructionSetTheCpuRunsMatchesTheReference) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 25);
+  ThreadPool pool(2);
+  ReferenceSearch reference(db);
+  const std::size_t count = 120;
+  const std::vector<float> features = make_queries(db, count, 31);
+  const std::vector<QueryParams> params = make_params(db, count, 32);
+  const QueryBatch batch{features, params, count};
+  const std::uint32_t k = 3;
+  std::vector<Match> expected(count * k);
+  ASSERT_TRUE(reference.search(batch, k, expected).ok());
+  struct Set {
+    CpuKernels set;
+    const char* name;
+    bool runs;
+  };
+  bool avx2 = false;
+  bool avx512 = false;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  __builtin_cpu_init();
+  avx2 = __builtin_cpu_supports("avx2");
+  avx512 = __builtin_cpu_supports("avx512f");
+#endif
+  const Set sets[] = {{CpuKernels::Generic, "generic", true},
+                      {CpuKernels::Avx2, "avx2", avx2},
+                      {CpuKernels::Avx512, "avx512f", avx512}};
+  for (const Set& set : sets) {
+    auto clusters = ClusterSearch::create(db, table, pool, {.kernels = set.set});
+    auto brute = FastSearch::create(db, pool, {.prune = false, .kernels = set.set});
+    auto box = FastSearch::create(db, pool, {.prune = true, .kernels = set.set});
+    if (!set.runs) {
+      EXPECT_FALSE(clusters.ok()) << set.name;
+      EXPECT_FALSE(brute.ok()) << set.name;
+      std::printf("[ info ] %s: not run by this CPU, refused as expected\n", set.name);
+      continue;
+    }
+    ASSERT_TRUE(clusters.ok()) << clusters.message();
+    ASSERT_TRUE(brute.ok()) << brute.message();
+    ASSERT_TRUE(box.ok()) << box.message();
+    EXPECT_EQ((*clusters)->kernel_name(), set.name);
+    EXPECT_EQ((*brute)->kernel_name(), set.name);
+    for (SearchBackend* backend : {static_cast<SearchBackend*>(clusters->get()), static_cast<SearchBackend*>(brute->get()),
+                                   static_cast<SearchBackend*>(box->get())}) {
+      std::vector<Match> actual(count * k);
+      ASSERT_TRUE(backend->search(batch, k, actual).ok());
+      expect_identical(expected, actual, k, std::string(set.name) + " " + std::string(backend->name()));
+    }
+  }
+  // The widest set is the one picked by default where the CPU has it.
+  auto widest = ClusterSearch::create(db, table, pool);
+  ASSERT_TRUE(widest.ok());
+  EXPECT_EQ((*widest)->kernel_name(), avx512 ? "avx512f" : avx2 ? "avx2" : "generic");
 }
 
 }  // namespace

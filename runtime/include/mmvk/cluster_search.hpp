@@ -62,6 +62,10 @@ struct ClusterSearchOptions {
   // Within a visited cluster, skip 16-row tiles whose own box bound (the
   // same box bound over the tile's members) is above the k-th best.
   bool tile_bound = true;
+  // With tile_bound, in a cluster of more than 16 tiles: first bound each
+  // span of 16 tiles (a third level of boxes) and compute the tile bounds of
+  // the spans whose bound is at most the k-th best only.
+  bool span_bound = true;
   // Exact mode: visit the cluster of the nearest centroid first, then the
   // rest in lower-bound order (the seed tightens the k-th best early).
   bool seed_nearest = true;
@@ -86,6 +90,8 @@ struct ClusterSearchOptions {
   // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
   // AVX-512F (as FastSearchOptions::baseline_kernels; the same kernels).
   bool baseline_kernels = false;
+  // As FastSearchOptions::kernels.
+  CpuKernels kernels = CpuKernels::Widest;
 };
 
 // Work counters beyond SearchStats (benchmarks report them).

@@ -39,6 +39,8 @@ struct FastSearchOptions {
   // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
   // AVX-512F; tests use it to check every kernel against the reference.
   bool baseline_kernels = false;
+  // Which kernels to run (baseline_kernels = true overrides it to Generic).
+  CpuKernels kernels = CpuKernels::Widest;
 };
 
 class FastSearch final : public SearchBackend {

@@ -55,6 +55,12 @@ struct QueryParams {
   }
 };
 
+// The instruction set of the CPU backends' tile kernels (FastSearch,
+// ClusterSearch). Widest: the widest this CPU runs (AVX-512F, AVX2, else the
+// x86-64 baseline SSE2 "generic" ones). Forcing a set the CPU lacks makes
+// the backend's create() an error; tests force each set the CPU has.
+enum class CpuKernels { Widest, Generic, Avx2, Avx512 };
+
 struct Match {
   std::uint32_t frame = kNoFrame;  // kNoFrame: no valid candidate ("none")
   float cost = std::numeric_limits<float>::infinity();

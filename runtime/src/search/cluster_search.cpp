@@ -23,8 +23,10 @@ constexpr std::uint32_t kNoCluster = 0xffffffffu;
 // Exact batched mode: queries whose bounds are held at once per thread (their
 // bounds take kSubBatch x clusters floats), and the rounds that take one
 // candidate cluster per query before the rest are taken at once.
-constexpr std::size_t kSubBatch = 64;
-constexpr std::uint32_t kRankedRounds = 2;
+constexpr std::size_t kSubBatch = 512;
+constexpr std::uint32_t kRankedRounds = 1;
+// Tiles of one cluster handed to the kernel at once.
+constexpr std::uint32_t kTileChunk = 4;
 
 // Ordered by (bound, cluster); in nprobe mode `bound` is the centroid
 // distance and `lower` the lower bound.
@@ -41,8 +43,9 @@ struct Scratch {
   std::vector<ClusterBound> order;
   std::vector<float> bound, distance;            // [clusters, padded to 16]
   std::vector<float> tile_bound;                 // [tiles of the largest cluster, padded to 16]
+  std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
   std::vector<double> radius_sum, radius_total;  // [clusters]
-  std::array<detail::LaneHit, kLanes> hits{};
+  std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
   // Batched exact mode and the split single query.
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
   std::vector<std::uint32_t> seed, cursor, candidate_end;      // [kSubBatch]
@@ -72,6 +75,12 @@ struct ClusterSearch::Layout {
   std::vector<std::uint32_t> tile_box_pack;  // [clusters]
   std::vector<std::uint8_t> tile_rows;       // [tiles]: member rows (the rest is padding)
   std::uint32_t max_cluster_tiles = 0;
+  // The third level, between clusters and tiles: the box of each span of
+  // 16 tiles (one tile-box pack) of a cluster with more than one span,
+  // packed like the tile boxes: span j of cluster c is box span_box_pack[c]
+  // * 16 + j; kNoCluster for a cluster of one span (its cluster box is it).
+  detail::BoxPacks span_boxes;
+  std::vector<std::uint32_t> span_box_pack;  // [clusters]
   detail::BoxPacks cluster_boxes;            // box c: the table's box, min_multiplier and min_bias
   // Box c: [centroid, centroid], multiplier 1, bias 0, so its bound is the
   // channel-weighted squared centroid distance.
@@ -91,7 +100,9 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   l.table = table;
   l.dims = database.dims();
   l.channels = static_cast<std::uint32_t>(database.schema().channels.size());
-  l.kernels = detail::select_kernels(options.baseline_kernels);
+  if (!detail::select_kernels(options.kernels, options.baseline_kernels, l.kernels)) {
+    return make_error("cluster search: this CPU cannot run the requested kernels (ClusterSearchOptions::kernels)");
+  }
   const std::uint32_t k = table.cluster_count;
   l.tile_offsets.assign(k + 1, 0);
   l.tile_box_pack.assign(k, 0);
@@ -127,6 +138,29 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
       l.tile_boxes.set(std::size_t{l.tile_box_pack[c]} * kLanes + (tile - l.tile_offsets[c]), box);
     }
   }
+  l.span_box_pack.assign(k, kNoCluster);
+  std::uint32_t span_packs = 0;
+  for (std::uint32_t c = 0; c < k; ++c) {
+    const std::size_t spans = packs_of(l.tile_offsets[c + 1] - l.tile_offsets[c]);
+    if (spans < 2) continue;
+    l.span_box_pack[c] = span_packs;
+    span_packs += static_cast<std::uint32_t>(packs_of(spans));
+  }
+  l.span_boxes = detail::BoxPacks(span_packs, l.dims);
+  for (std::uint32_t c = 0; c < k; ++c) {
+    if (l.span_box_pack[c] == kNoCluster) continue;
+    const std::size_t first_slot = std::size_t{l.tile_offsets[c]} * kLanes;
+    const std::size_t end_slot = std::size_t{l.tile_offsets[c + 1]} * kLanes;
+    for (std::size_t span = 0; first_slot + span * kLanes * kLanes < end_slot; ++span) {
+      detail::BoxAccumulator box(l.dims);
+      const std::size_t span_end = std::min(end_slot, first_slot + (span + 1) * kLanes * kLanes);
+      for (std::size_t slot = first_slot + span * kLanes * kLanes; slot < span_end; ++slot) {
+        const std::uint32_t f = l.frame[slot];
+        if (f != kNoFrame) box.add_row(database.row(f), database.frame_multiplier()[f], database.frame_bias()[f]);
+      }
+      l.span_boxes.set(std::size_t{l.span_box_pack[c]} * kLanes + span, box);
+    }
+  }
   // Radius-bound margin. For a member row x, the real cost evaluation
   // computes s_ch = fl-sum of fl(fl(x_d - q_d)^2) over n_ch dims: each term
   // is >= its real value times (1-u)^2 (u = 2^-24, round to nearest), and
@@ -159,6 +193,7 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.bound.resize(cluster_packs * kLanes);
     s.distance.resize(cluster_packs * kLanes);
     s.tile_bound.resize(packs_of(l.max_cluster_tiles) * kLanes);
+    s.span_bound.resize(packs_of(packs_of(l.max_cluster_tiles)) * kLanes);
     s.radius_sum.resize(k);
     s.radius_total.resize(k);
     s.batch_bound.resize(kSubBatch * cluster_packs * kLanes);
@@ -251,6 +286,7 @@ struct WalkContext {
   const ClusterSearchOptions& options;
   detail::TileArrays tiles;
   detail::BoxArrays tile_boxes;
+  detail::BoxArrays span_boxes;
 };
 
 float threshold_of(const QueryView& v, const SharedThreshold* shared) {
@@ -267,25 +303,52 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
   ++s.counters.clusters_visited;
   const std::uint32_t first_tile = l.tile_offsets[c];
   const std::uint32_t tiles = l.tile_offsets[c + 1] - first_tile;
-  if (x.options.tile_bound) {
+  if (x.options.tile_bound && (!x.options.span_bound || l.span_box_pack[c] == kNoCluster)) {
     // Members are in frame order, so a tile mostly holds neighbouring
     // frames of a clip and its box is tight.
     l.kernels.box_bounds(x.tile_boxes, l.tile_box_pack[c], packs_of(tiles), v.q, v.w, s.tile_bound.data());
     s.counters.tiles_checked += tiles;
-  }
-  detail::KernelQuery kernel_query{v.q, v.w, 0.0f};
-  for (std::uint32_t i = part; i < tiles; i += parts) {
+  } else if (x.options.tile_bound) {
+    // Spans of 16 tiles first: the tile bounds of a span whose own bound is
+    // above the k-th best are never computed (+inf: skipped below).
+    const std::size_t spans = packs_of(tiles);
+    l.kernels.box_bounds(x.span_boxes, l.span_box_pack[c], packs_of(spans), v.q, v.w, s.span_bound.data());
     const float threshold = threshold_of(v, shared);
-    if (x.options.tile_bound && s.tile_bound[i] > threshold) continue;
-    const std::uint32_t tile = first_tile + i;
-    s.rows += l.tile_rows[tile];
-    kernel_query.threshold = threshold;
-    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, &tile, 1, s.hits.data());
+    for (std::size_t span = 0; span < spans;) {
+      if (s.span_bound[span] > threshold) {
+        std::fill_n(s.tile_bound.data() + span * kLanes, kLanes, std::numeric_limits<float>::infinity());
+        ++span;
+        continue;
+      }
+      std::size_t run_end = span + 1;
+      while (run_end < spans && !(s.span_bound[run_end] > threshold)) ++run_end;
+      l.kernels.box_bounds(x.tile_boxes, l.tile_box_pack[c] + span, run_end - span, v.q, v.w,
+                           s.tile_bound.data() + span * kLanes);
+      s.counters.tiles_checked += (run_end - span) * kLanes;
+      span = run_end;
+    }
+  }
+  // Tiles that pass are evaluated kTileChunk at a time (the kernel overlaps
+  // their sums), against the k-th best from before the chunk.
+  std::array<std::uint32_t, kTileChunk> chunk{};
+  std::uint32_t chunk_size = 0;
+  const auto flush = [&] {
+    const detail::KernelQuery kernel_query{v.q, v.w, threshold_of(v, shared)};
+    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, chunk.data(), chunk_size, s.hits.data());
+    chunk_size = 0;
     for (std::size_t h = 0; h < hits; ++h) {
       detail::offer_tile_row(x.db, *v.params, v.best, Match{l.frame[s.hits[h].slot], s.hits[h].cost});
     }
     if (shared != nullptr && hits != 0) shared->lower_to(v.best.back().cost);
+  };
+  for (std::uint32_t i = part; i < tiles; i += parts) {
+    if (x.options.tile_bound && s.tile_bound[i] > threshold_of(v, shared)) continue;
+    const std::uint32_t tile = first_tile + i;
+    s.rows += l.tile_rows[tile];
+    chunk[chunk_size++] = tile;
+    if (chunk_size == kTileChunk) flush();
   }
+  if (chunk_size != 0) flush();
 }
 
 bool cluster_eligible(const ClusterSearch::Layout& l, const QueryParams& params, std::uint32_t c) {
@@ -542,7 +605,8 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   Layout& l = *layout_;
   const QueryParams default_params;
   const ClusterSearchOptions options = options_;
-  const WalkContext x{*database_, l, options, l.rows.arrays(), l.tile_boxes.arrays(l.rows.channel_end)};
+  const WalkContext x{*database_, l, options, l.rows.arrays(), l.tile_boxes.arrays(l.rows.channel_end),
+                      l.span_boxes.arrays(l.rows.channel_end)};
   for (Scratch& s : l.scratch) {
     s.rows = 0;
     s.counters = {};

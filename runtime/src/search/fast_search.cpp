@@ -20,6 +20,14 @@ constexpr std::uint32_t kGroupRows = kFastTileRows * kFastGroupTiles;
 // and the independent sums hide the add latency).
 constexpr std::uint32_t kBruteQueries = 2;
 
+// The kernels the options ask for (create() has refused a set the CPU
+// lacks; the constructor falls back to the widest).
+detail::Kernels kernels_of(const FastSearchOptions& options) {
+  detail::Kernels kernels{};
+  if (!detail::select_kernels(options.kernels, options.baseline_kernels, kernels)) kernels = detail::select_kernels(false);
+  return kernels;
+}
+
 }  // namespace
 
 struct FastSearch::Workspace {
@@ -36,7 +44,7 @@ FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOpt
     : database_(&database),
       pool_(&pool),
       options_(options),
-      layout_(Layout::build(database, options.baseline_kernels)),
+      layout_(Layout::build(database, kernels_of(options))),
       workspace_(std::make_unique<Workspace>()),
       thread_rows_(pool.thread_count(), 0) {
   workspace_->threads.resize(pool.thread_count());
@@ -45,8 +53,12 @@ FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOpt
 
 Result<std::unique_ptr<FastSearch>> FastSearch::create(const Database& database, ThreadPool& pool,
                                                        FastSearchOptions options) {
-  // Every option value is usable (rows_per_block rounds up to a group), so
-  // there is nothing to refuse yet; the Result keeps one way to make backends.
+  // rows_per_block rounds up to a group; only a kernel set this CPU cannot
+  // run is refused.
+  detail::Kernels kernels{};
+  if (!detail::select_kernels(options.kernels, options.baseline_kernels, kernels)) {
+    return make_error("fast search: this CPU cannot run the requested kernels (FastSearchOptions::kernels)");
+  }
   return std::unique_ptr<FastSearch>(new FastSearch(database, pool, options));
 }
 

@@ -19,10 +19,10 @@ void merge_summary(detail::BlockSummary& into, const detail::BlockSummary& block
 
 }  // namespace
 
-std::unique_ptr<FastSearch::Layout> FastSearch::Layout::build(const Database& db, bool baseline_kernels) {
+std::unique_ptr<FastSearch::Layout> FastSearch::Layout::build(const Database& db, const detail::Kernels& kernels) {
   auto layout = std::make_unique<Layout>();
   Layout& l = *layout;
-  l.kernels = detail::select_kernels(baseline_kernels);
+  l.kernels = kernels;
   l.frames = db.frame_count();
   l.dims = db.dims();
   l.tiles = (l.frames + kLanes - 1) / kLanes;

@@ -42,7 +42,8 @@ struct FastSearch::Layout {
   detail::BoxPacks tile_box_packs;   // one pack per group, one lane per tile of it
   detail::BoxPacks group_box_packs;  // [group_packs], one lane per group
 
-  static std::unique_ptr<Layout> build(const Database& database, bool baseline_kernels);
+  // `kernels`: from detail::select_kernels (create() checks the CPU runs them).
+  static std::unique_ptr<Layout> build(const Database& database, const detail::Kernels& kernels);
 
   detail::TileArrays tile_arrays() const { return rows.arrays(); }
   detail::BoxArrays tile_boxes() const { return tile_box_packs.arrays(rows.channel_end); }

@@ -53,47 +53,57 @@ MMVK_INLINE bool any_lane(const M& m) {
   return any != 0;
 }
 
-template <class V, int Q>
-MMVK_INLINE std::size_t evaluate_tiles_q(const TileArrays& t, const KernelQuery* queries, const std::uint32_t* tile_ids,
-                                         std::size_t count, LaneHit* hits) {
+// Evaluates T tiles at once: with one 16-lane vector per tile (AVX-512)
+// and one query, a single tile is one chain of dependent adds and runs at
+// the add latency; T independent tiles keep the adder busy. Every lane's
+// arithmetic is unchanged.
+template <class V, int Q, int T>
+MMVK_INLINE std::size_t evaluate_tile_group(const TileArrays& t, const KernelQuery* queries, const std::uint32_t* tile,
+                                            LaneHit* hits) {
   using M = typename MaskOf<V>::type;
   constexpr int W = sizeof(V) / sizeof(float);
   constexpr int P = kLanes / W;
   std::size_t hit_count = 0;
   const std::size_t tile_floats = std::size_t{t.dims} * kLanes;
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::uint32_t tile = tile_ids[i];
-    const float* x = t.features + tile * tile_floats;
-    V total[Q][P];
+  const float* x[T];
+  for (int j = 0; j < T; ++j) x[j] = t.features + tile[j] * tile_floats;
+  V total[Q][T][P];
+  for (int q = 0; q < Q; ++q)
+    for (int j = 0; j < T; ++j)
+      for (int p = 0; p < P; ++p) total[q][j][p] = V{} + 0.0f;
+  std::uint32_t d = 0;
+  for (std::uint32_t c = 0; c < t.channels; ++c) {
+    const std::uint32_t end = t.channel_end[c];
+    V sum[Q][T][P];
     for (int q = 0; q < Q; ++q)
-      for (int p = 0; p < P; ++p) total[q][p] = V{} + 0.0f;
-    std::uint32_t d = 0;
-    for (std::uint32_t c = 0; c < t.channels; ++c) {
-      const std::uint32_t end = t.channel_end[c];
-      V sum[Q][P];
-      for (int q = 0; q < Q; ++q)
-        for (int p = 0; p < P; ++p) sum[q][p] = V{} + 0.0f;
-      for (; d < end; ++d) {
-        V row[P];
-        for (int p = 0; p < P; ++p) row[p] = load<V>(x + std::size_t{d} * kLanes + p * W);
-        for (int q = 0; q < Q; ++q) {
-          const float value = queries[q].features[d];
+      for (int j = 0; j < T; ++j)
+        for (int p = 0; p < P; ++p) sum[q][j][p] = V{} + 0.0f;
+    for (; d < end; ++d) {
+      V row[T][P];
+      for (int j = 0; j < T; ++j)
+        for (int p = 0; p < P; ++p) row[j][p] = load<V>(x[j] + std::size_t{d} * kLanes + p * W);
+      for (int q = 0; q < Q; ++q) {
+        const float value = queries[q].features[d];
+        for (int j = 0; j < T; ++j) {
           for (int p = 0; p < P; ++p) {
-            const V diff = row[p] - value;
-            sum[q][p] += diff * diff;
+            const V diff = row[j][p] - value;
+            sum[q][j][p] += diff * diff;
           }
         }
       }
-      for (int q = 0; q < Q; ++q)
-        for (int p = 0; p < P; ++p) total[q][p] += queries[q].weights[c] * sum[q][p];
     }
+    for (int q = 0; q < Q; ++q)
+      for (int j = 0; j < T; ++j)
+        for (int p = 0; p < P; ++p) total[q][j][p] += queries[q].weights[c] * sum[q][j][p];
+  }
+  for (int j = 0; j < T; ++j) {
     for (int p = 0; p < P; ++p) {
-      const std::size_t lane0 = std::size_t{tile} * kLanes + p * W;
+      const std::size_t lane0 = std::size_t{tile[j]} * kLanes + p * W;
       const V multiplier = load<V>(t.multiplier + lane0);
       const V bias = load<V>(t.bias + lane0);
       const M valid = load<M>(t.lane_valid + lane0);
       for (int q = 0; q < Q; ++q) {
-        const V cost = multiplier * total[q][p] + bias;
+        const V cost = multiplier * total[q][j][p] + bias;
         const M pass = (cost <= queries[q].threshold) & valid;
         if (!any_lane(pass)) continue;
         for (int lane = 0; lane < W; ++lane) {
@@ -104,6 +114,21 @@ MMVK_INLINE std::size_t evaluate_tiles_q(const TileArrays& t, const KernelQuery*
       }
     }
   }
+  return hit_count;
+}
+
+template <class V, int Q>
+MMVK_INLINE std::size_t evaluate_tiles_q(const TileArrays& t, const KernelQuery* queries, const std::uint32_t* tile_ids,
+                                         std::size_t count, LaneHit* hits) {
+  // Independent accumulators per pass: about four vectors' worth of sums.
+  constexpr int P = kLanes / (sizeof(V) / sizeof(float));
+  constexpr int T = Q * P >= 4 ? 1 : 4 / (Q * P);
+  std::size_t hit_count = 0;
+  std::size_t i = 0;
+  if constexpr (T > 1) {
+    for (; i + T <= count; i += T) hit_count += evaluate_tile_group<V, Q, T>(t, queries, tile_ids + i, hits + hit_count);
+  }
+  for (; i < count; ++i) hit_count += evaluate_tile_group<V, Q, 1>(t, queries, tile_ids + i, hits + hit_count);
   return hit_count;
 }
 
@@ -118,49 +143,71 @@ MMVK_INLINE std::size_t evaluate_tiles_v(const TileArrays& tiles, const KernelQu
   }
 }
 
+// T packs of 16 boxes at once, from `pack` on (see box_bounds_v).
+template <class V, int T>
+MMVK_INLINE void box_bounds_group(const BoxArrays& b, std::size_t pack, const float* query, const float* weights,
+                                  float* out) {
+  constexpr int W = sizeof(V) / sizeof(float);
+  constexpr int P = kLanes / W;
+  const float* lo = b.lo + pack * b.dims * kLanes;
+  const float* hi = b.hi + pack * b.dims * kLanes;
+  const std::size_t pack_floats = std::size_t{b.dims} * kLanes;
+  V total[T][P];
+  for (int j = 0; j < T; ++j)
+    for (int p = 0; p < P; ++p) total[j][p] = V{} + 0.0f;
+  std::uint32_t d = 0;
+  for (std::uint32_t c = 0; c < b.channels; ++c) {
+    const std::uint32_t end = b.channel_end[c];
+    if (weights[c] == 0.0f) {
+      d = end;
+      continue;
+    }
+    V sum[T][P];
+    for (int j = 0; j < T; ++j)
+      for (int p = 0; p < P; ++p) sum[j][p] = V{} + 0.0f;
+    for (; d < end; ++d) {
+      for (int j = 0; j < T; ++j) {
+        for (int p = 0; p < P; ++p) {
+          // At most one of below and above is > 0 (lo <= hi).
+          const std::size_t at = j * pack_floats + std::size_t{d} * kLanes + p * W;
+          const V below = load<V>(lo + at) - query[d];
+          const V above = query[d] - load<V>(hi + at);
+          V diff = below > above ? below : above;
+          diff = diff > 0.0f ? diff : V{} + 0.0f;
+          sum[j][p] += diff * diff;
+        }
+      }
+    }
+    for (int j = 0; j < T; ++j)
+      for (int p = 0; p < P; ++p) total[j][p] += weights[c] * sum[j][p];
+  }
+  for (int j = 0; j < T; ++j) {
+    for (int p = 0; p < P; ++p) {
+      const std::size_t lane0 = (pack + j) * kLanes + p * W;
+      const V bound = load<V>(b.min_multiplier + lane0) * total[j][p] + load<V>(b.min_bias + lane0);
+      std::memcpy(out + j * kLanes + p * W, &bound, sizeof(bound));
+    }
+  }
+}
+
 // The bound mirrors the cost's operation order with each |x - q| replaced by
 // the distance from q to the box (0 inside it). Rounding is monotonic, so
 // every step stays <= the matching step of any row in the box, and the
 // bound never exceeds a member's computed cost. A channel of weight 0 adds
 // +0 to a member's total, so skipping it changes no bound (and avoids
-// 0 x inf when a far box overflows).
+// 0 x inf when a far box overflows). Consecutive packs are bounded T at a
+// time (independent sums, as in evaluate_tiles_q).
 template <class V>
 MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t first_pack, std::size_t pack_count, const float* query,
                               const float* weights, float* out) {
-  constexpr int W = sizeof(V) / sizeof(float);
-  constexpr int P = kLanes / W;
-  for (std::size_t pack = first_pack; pack < first_pack + pack_count; ++pack, out += kLanes) {
-    const float* lo = b.lo + pack * b.dims * kLanes;
-    const float* hi = b.hi + pack * b.dims * kLanes;
-    V total[P];
-    for (int p = 0; p < P; ++p) total[p] = V{} + 0.0f;
-    std::uint32_t d = 0;
-    for (std::uint32_t c = 0; c < b.channels; ++c) {
-      const std::uint32_t end = b.channel_end[c];
-      if (weights[c] == 0.0f) {
-        d = end;
-        continue;
-      }
-      V sum[P];
-      for (int p = 0; p < P; ++p) sum[p] = V{} + 0.0f;
-      for (; d < end; ++d) {
-        for (int p = 0; p < P; ++p) {
-          // At most one of below and above is > 0 (lo <= hi).
-          const V below = load<V>(lo + std::size_t{d} * kLanes + p * W) - query[d];
-          const V above = query[d] - load<V>(hi + std::size_t{d} * kLanes + p * W);
-          V diff = below > above ? below : above;
-          diff = diff > 0.0f ? diff : V{} + 0.0f;
-          sum[p] += diff * diff;
-        }
-      }
-      for (int p = 0; p < P; ++p) total[p] += weights[c] * sum[p];
-    }
-    for (int p = 0; p < P; ++p) {
-      const V bound = load<V>(b.min_multiplier + pack * kLanes + p * W) * total[p] +
-                      load<V>(b.min_bias + pack * kLanes + p * W);
-      std::memcpy(out + p * W, &bound, sizeof(bound));
-    }
+  constexpr int P = kLanes / (sizeof(V) / sizeof(float));
+  constexpr int T = P >= 4 ? 1 : 4 / P;
+  std::size_t pack = first_pack;
+  const std::size_t end = first_pack + pack_count;
+  if constexpr (T > 1) {
+    for (; pack + T <= end; pack += T, out += T * kLanes) box_bounds_group<V, T>(b, pack, query, weights, out);
   }
+  for (; pack < end; ++pack, out += kLanes) box_bounds_group<V, 1>(b, pack, query, weights, out);
 }
 
 #define MMVK_DEFINE_KERNELS(suffix, V)                                                                         \
@@ -199,6 +246,27 @@ Kernels select_kernels(bool baseline) {
   (void)baseline;
 #endif
   return {evaluate_tiles_generic, box_bounds_generic, "generic"};
+}
+
+bool select_kernels(CpuKernels set, bool baseline, Kernels& out) {
+  if (baseline) set = CpuKernels::Generic;
+  switch (set) {
+    case CpuKernels::Widest: out = select_kernels(false); return true;
+    case CpuKernels::Generic: out = select_kernels(true); return true;
+#if defined(MMVK_HAS_X86_KERNELS)
+    case CpuKernels::Avx2:
+      __builtin_cpu_init();
+      if (!__builtin_cpu_supports("avx2")) return false;
+      out = {evaluate_tiles_avx2, box_bounds_avx2, "avx2"};
+      return true;
+    case CpuKernels::Avx512:
+      __builtin_cpu_init();
+      if (!__builtin_cpu_supports("avx512f")) return false;
+      out = {evaluate_tiles_avx512, box_bounds_avx512, "avx512f"};
+      return true;
+#endif
+    default: return false;
+  }
 }
 
 }  // namespace mmvk::detail

@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "mmvk/search.hpp"
+
 namespace mmvk::detail {
 
 inline constexpr std::uint32_t kLanes = 16;
@@ -72,5 +74,9 @@ struct Kernels {
 // The widest kernels this CPU runs, or the x86-64 baseline ones (tests use
 // them to hold every kernel to the reference).
 Kernels select_kernels(bool baseline);
+
+// The kernels of one instruction set (baseline = true: Generic), or false
+// when this CPU cannot run them.
+bool select_kernels(CpuKernels set, bool baseline, Kernels& out);
 
 }  // namespace mmvk::detail

@@ -94,6 +94,7 @@ Fixture* fixture(DataSet set) {
         // Tuning switches (MMVK_BENCH_PROBE_BY_BOUND=1, MMVK_BENCH_NO_SEED=1).
         spec.cluster.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
         spec.cluster.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
+        if (std::getenv("MMVK_BENCH_SPLIT") != nullptr) spec.cluster.split_single = std::getenv("MMVK_BENCH_SPLIT")[0] == '1';
         if (variant.per_query) {
           spec.cluster.batch_by_cluster = false;
           spec.cluster.span_bound = false;

@@ -85,8 +85,12 @@ struct ClusterSearchOptions {
   bool batch_by_cluster = true;
   // Exact mode, B < threads: each query is split over the pool's threads
   // (tiles of the seed cluster and candidate clusters dealt out in turn,
-  // one shared k-th best for pruning). Off: one thread per query.
-  bool split_single = true;
+  // one shared k-th best for pruning). Off by default: on the shared 2-vCPU
+  // test machine (Bandai volume, 417k frames) a split query took 1.8-2.3x
+  // the CPU time and 2.5-4x the wall time of the query on the calling
+  // thread alone (waking the second thread costs more than it saves; see
+  // bench/RESULTS.md, issue 10). Worth trying where cores are idle.
+  bool split_single = false;
   // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
   // AVX-512F (as FastSearchOptions::baseline_kernels; the same kernels).
   bool baseline_kernels = false;

@@ -17,8 +17,9 @@ static_assert(kFastTileRows == detail::kLanes && kFastGroupTiles == detail::kLan
 
 constexpr std::uint32_t kGroupRows = kFastTileRows * kFastGroupTiles;
 // Queries that share one pass over a tile in brute force (loads are shared,
-// and the independent sums hide the add latency).
-constexpr std::uint32_t kBruteQueries = 2;
+// and the independent sums hide the add latency): at most this many, and
+// Kernels::brute_queries for the chosen set.
+constexpr std::uint32_t kBruteQueries = 4;
 
 // The kernels the options ask for (create() has refused a set the CPU
 // lacks; the constructor falls back to the widest).
@@ -111,7 +112,7 @@ void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::siz
       const std::uint32_t block_end = std::min(end_group, block + block_groups);
       for (std::size_t q = first_query; q < end_query;) {
         std::uint32_t count = 1;
-        while (count * 2 <= kBruteQueries && q + count * 2 <= end_query) count *= 2;
+        while (count * 2 <= l.kernels.brute_queries && q + count * 2 <= end_query) count *= 2;
         std::array<detail::KernelQuery, kBruteQueries> queries{};
         for (std::uint32_t i = 0; i < count; ++i) {
           queries[i].features = query_of(q + i).data();

@@ -238,14 +238,14 @@ MMVK_DEFINE_KERNELS(avx512, V16)
 
 Kernels select_kernels(bool baseline) {
 #if defined(MMVK_HAS_X86_KERNELS)
-  if (baseline) return {evaluate_tiles_generic, box_bounds_generic, "generic"};
+  if (baseline) return {evaluate_tiles_generic, box_bounds_generic, "generic", 2};
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f")) return {evaluate_tiles_avx512, box_bounds_avx512, "avx512f"};
-  if (__builtin_cpu_supports("avx2")) return {evaluate_tiles_avx2, box_bounds_avx2, "avx2"};
+  if (__builtin_cpu_supports("avx512f")) return {evaluate_tiles_avx512, box_bounds_avx512, "avx512f", 4};
+  if (__builtin_cpu_supports("avx2")) return {evaluate_tiles_avx2, box_bounds_avx2, "avx2", 2};
 #else
   (void)baseline;
 #endif
-  return {evaluate_tiles_generic, box_bounds_generic, "generic"};
+  return {evaluate_tiles_generic, box_bounds_generic, "generic", 2};
 }
 
 bool select_kernels(CpuKernels set, bool baseline, Kernels& out) {
@@ -257,12 +257,12 @@ bool select_kernels(CpuKernels set, bool baseline, Kernels& out) {
     case CpuKernels::Avx2:
       __builtin_cpu_init();
       if (!__builtin_cpu_supports("avx2")) return false;
-      out = {evaluate_tiles_avx2, box_bounds_avx2, "avx2"};
+      out = {evaluate_tiles_avx2, box_bounds_avx2, "avx2", 2};
       return true;
     case CpuKernels::Avx512:
       __builtin_cpu_init();
       if (!__builtin_cpu_supports("avx512f")) return false;
-      out = {evaluate_tiles_avx512, box_bounds_avx512, "avx512f"};
+      out = {evaluate_tiles_avx512, box_bounds_avx512, "avx512f", 4};
       return true;
 #endif
     default: return false;

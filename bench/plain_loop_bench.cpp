@@ -147,12 +147,8 @@ const bool registered = [] {
     for (QueryStream stream : {QueryStream::Transition}) {
       const std::string name =
           "real/" + std::string(data_set_name(set)) + "/" + std::string(query_stream_name(stream)) + "/plain-loop";
-      benchmark::RegisterBenchmark(name.c_str(), plain_loop, set, stream)
-          ->ArgName("B")
-          ->Arg(64)
-          ->Arg(1024)
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime();
+      auto* b = benchmark::RegisterBenchmark(name.c_str(), plain_loop, set, stream);
+      b->ArgName("B")->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
     }
   }
   return true;

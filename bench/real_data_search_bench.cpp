@@ -183,11 +183,8 @@ const bool registered = [] {
         if (variant.backend == "reference" && set != DataSet::Locomotion) b->Iterations(1);
         if (variant.label == "clusters" || variant.label == "clusters-per-query") {
           // B = 1 latency over the same queries as the B = 1024 row.
-          benchmark::RegisterBenchmark((name + "-singly").c_str(), run, set, stream, variant.label, true)
-              ->ArgName("B")
-              ->Arg(1024)
-              ->Unit(benchmark::kMillisecond)
-              ->UseRealTime();
+          auto* singly = benchmark::RegisterBenchmark((name + "-singly").c_str(), run, set, stream, variant.label, true);
+          singly->ArgName("B")->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
         }
       }
     }

@@ -86,6 +86,19 @@ std::vector<QueryParams> make_params(const Database& db, std::size_t count, std:
   return params;
 }
 
+// Queries of every kind with every constraint and bias (make_queries and
+// make_params with seeds `seed` and `seed + 1`).
+struct ConstrainedQueries {
+  std::vector<float> features;
+  std::vector<QueryParams> params;
+  std::size_t count;
+  QueryBatch batch() const { return {features, params, count}; }
+};
+
+ConstrainedQueries constrained_queries(const Database& db, std::size_t count, std::uint64_t seed) {
+  return {make_queries(db, count, seed), make_params(db, count, seed + 1), count};
+}
+
 void expect_identical(std::span<const Match> expected, std::span<const Match> actual, std::uint32_t k,
                       const std::string& what) {
   ASSERT_EQ(expected.size(), actual.size());
@@ -122,10 +135,9 @@ TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
   const ClusterTable table = make_table(db, 30);
   ThreadPool pool(2);
   ReferenceSearch reference(db);
-  const std::size_t count = 240;
-  const std::vector<float> features = make_queries(db, count, 11);
-  const std::vector<QueryParams> params = make_params(db, count, 12);
-  const QueryBatch batch{features, params, count};
+  const ConstrainedQueries queries = constrained_queries(db, 240, 11);
+  const std::size_t count = queries.count;
+  const QueryBatch batch = queries.batch();
   for (std::uint32_t k : {1u, 3u, 16u}) {
     std::vector<Match> expected(count * k);
     ASSERT_TRUE(reference.search(batch, k, expected).ok());
@@ -325,9 +337,10 @@ TEST(ClusterSearch, GroupedSpannedAndSplitPathsMatchTheReference) {
   spec.frames = 6000;
   const Database db = make_database(spec);
   ReferenceSearch reference(db);
-  const std::size_t count = 1100;
-  const std::vector<float> features = make_queries(db, count, 21);
-  const std::vector<QueryParams> params = make_params(db, count, 22);
+  const ConstrainedQueries queries = constrained_queries(db, 1100, 21);
+  const std::size_t count = queries.count;
+  const std::vector<float>& features = queries.features;
+  const std::vector<QueryParams>& params = queries.params;
   const Variant variants[] = {
       {"all on", {}},
       {"grouped only", {.span_bound = false, .split_single = false}},
@@ -377,10 +390,9 @@ TEST(CpuKernels, EveryInstructionSetTheCpuRunsMatchesTheReference) {
   const ClusterTable table = make_table(db, 25);
   ThreadPool pool(2);
   ReferenceSearch reference(db);
-  const std::size_t count = 120;
-  const std::vector<float> features = make_queries(db, count, 31);
-  const std::vector<QueryParams> params = make_params(db, count, 32);
-  const QueryBatch batch{features, params, count};
+  const ConstrainedQueries queries = constrained_queries(db, 120, 31);
+  const std::size_t count = queries.count;
+  const QueryBatch batch = queries.batch();
   const std::uint32_t k = 3;
   std::vector<Match> expected(count * k);
   ASSERT_TRUE(reference.search(batch, k, expected).ok());

@@ -383,6 +383,27 @@ TEST(ClusterSearch, GroupedSpannedAndSplitPathsMatchTheReference) {
   }
 }
 
+// nprobe runs the grouped path too: the exact best over the nprobe nearest
+// clusters, so the same lists as the one-query walk, under every constraint.
+TEST(ClusterSearch, GroupedNprobeEqualsTheOneQueryWalk) {
+  const Database db = make_database();
+  const ClusterTable table = make_table(db, 30);
+  ThreadPool pool(2);
+  const ConstrainedQueries queries = constrained_queries(db, 700, 41);
+  for (const std::uint32_t nprobe : {1u, 3u, 7u, 29u}) {
+    for (const std::uint32_t k : {1u, 5u}) {
+      auto grouped = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
+      auto walk = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .batch_by_cluster = false});
+      ASSERT_TRUE(grouped.ok() && walk.ok());
+      std::vector<Match> expected(queries.count * k);
+      std::vector<Match> actual(queries.count * k);
+      ASSERT_TRUE((*walk)->search(queries.batch(), k, expected).ok());
+      ASSERT_TRUE((*grouped)->search(queries.batch(), k, actual).ok());
+      expect_identical(expected, actual, k, "nprobe=" + std::to_string(nprobe) + " k=" + std::to_string(k));
+    }
+  }
+}
+
 // Every instruction set this CPU runs, forced, in both CPU backends, against
 // the reference; a set the CPU lacks is refused by create().
 TEST(CpuKernels, EveryInstructionSetTheCpuRunsMatchesTheReference) {

@@ -37,7 +37,8 @@
 // searched (plus the continuing frame), nearest first, each with the exact
 // mode's cluster and tile bounds against the current k-th best (a probed
 // cluster whose bound is above it is skipped); nprobe >= cluster_count gives
-// the exact results.
+// the exact results. Batches visit the probed clusters grouped by cluster,
+// like exact mode (see batch_by_cluster), with the same results.
 #pragma once
 
 #include <cstdint>

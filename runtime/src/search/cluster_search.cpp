@@ -369,11 +369,12 @@ void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
   }
 }
 
-// Exact mode's lower bounds of every cluster into bound[] (padded to whole
+// Lower bounds of every cluster into bound[] (padded to whole
 // packs): NaN for a cluster the query rules out (never <= any threshold),
 // -inf for a bound that overflowed to NaN (proves nothing: visited first).
 // Returns the eligible cluster with the nearest centroid when seeding
-// (ties: the lower cluster id), else kNoCluster.
+// (ties: the lower cluster id), else kNoCluster. In nprobe mode the clusters
+// beyond the nprobe nearest centroids are ruled out (NaN) as well.
 std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v, float* bound) {
   const ClusterSearch::Layout& l = x.l;
   const ClusterTable& t = l.table;
@@ -395,8 +396,22 @@ std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v,
       if (std::isnan(bound[c])) bound[c] = -std::numeric_limits<float>::infinity();
     }
   }
-  if (!x.options.seed_nearest || eligible < 2) return kNoCluster;
+  const bool probing = x.options.nprobe != 0 && x.options.nprobe < eligible;
+  if (!probing && (!x.options.seed_nearest || eligible < 2)) return kNoCluster;
   l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
+  if (probing) {
+    // nprobe mode: only the nprobe eligible clusters with the nearest
+    // centroids (ties: the lower cluster id) stay eligible; the result is
+    // the exact best over them, as in the one-query walk.
+    s.order.clear();
+    for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
+      if (!std::isnan(bound[c])) s.order.push_back({s.distance[c], c, 0.0f});
+    }
+    std::nth_element(s.order.begin(), s.order.begin() + x.options.nprobe, s.order.end());
+    for (auto it = s.order.begin() + x.options.nprobe; it != s.order.end(); ++it) {
+      bound[it->cluster] = std::numeric_limits<float>::quiet_NaN();
+    }
+  }
   std::uint32_t nearest = kNoCluster;
   for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
     if (std::isnan(bound[c])) continue;
@@ -637,7 +652,7 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   } else {
     pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
       Scratch& s = l.scratch[thread];
-      if (exact && options.batch_by_cluster) {
+      if ((exact || !options.probe_by_bound) && options.batch_by_cluster) {
         walk_batched(x, s, view_of, first, last);
         return;
       }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -272,6 +273,16 @@ int run_query(Args args) {
     Result<PoseQuery> built = build_pose_query(*db, pose_targets, *pose_path);
     if (!built) return fail(built.message());
     pose = std::move(*built);
+  } else {
+    // One search takes at most kMaxBatch queries; a larger file is refused
+    // before it is read (its rows, their copy and the results would each be
+    // allocated at full size).
+    std::error_code size_error;
+    const std::uintmax_t query_bytes = std::filesystem::file_size(*queries_path, size_error);
+    if (!size_error && query_bytes / (std::uintmax_t{4} * db->dims()) > kMaxBatch) {
+      return fail(*queries_path + ": " + std::to_string(query_bytes / (std::uintmax_t{4} * db->dims())) +
+                  " queries, over the limit of " + std::to_string(kMaxBatch) + " per search; split the file");
+    }
   }
   Result<std::vector<float>> features =
       pose ? Result<std::vector<float>>(pose->features) : read_f32_rows(*queries_path, db->dims());

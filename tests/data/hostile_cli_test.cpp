@@ -202,5 +202,24 @@ TEST_F(HostileCli, InspectEscapesControlCharacters) {
   EXPECT_NE(inspected.output.find("red\\x1b[31mclip\\x07"), std::string::npos) << inspected.output;
 }
 
+// Huge inputs (issue 13, allocation failures): refused up front with the
+// limit named, before anything that size is allocated. Sparse files: no disk
+// space is used.
+TEST_F(HostileCli, HugeQueryFilesAreRefusedBeforeReading) {
+  const fs::path queries = dir_ / "huge.f32";
+  std::ofstream(queries, std::ios::binary).put('\0');
+  fs::resize_file(queries, std::uintmax_t{4} * dims_ * ((std::uintmax_t{1} << 20) + 1));  // kMaxBatch + 1 rows
+  const Ran out = run(mmvk_ + " query " + db_ + " --queries " + queries.string() + " --normalized");
+  expect_clean_error(out, {queries.string(), "1048577 queries", "over the limit of 1048576"}, "a huge query file");
+}
+
+TEST_F(HostileCli, HugeDatabaseFilesAreRefusedBeforeReading) {
+  const fs::path db = dir_ / "huge.mmdb";
+  std::ofstream(db, std::ios::binary) << "MMVKDB";
+  fs::resize_file(db, (std::uintmax_t{4} << 30) + 1);
+  const Ran out = run(mmvk_ + " inspect " + db.string());
+  expect_clean_error(out, {db.string(), "4294967297 bytes", "kMaxFileBytes"}, "a 4 GiB + 1 database");
+}
+
 }  // namespace
 }  // namespace mmvk

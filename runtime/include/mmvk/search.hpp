@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -27,6 +28,13 @@ namespace mmvk {
 
 inline constexpr std::uint32_t kNoFrame = 0xFFFFFFFFu;
 inline constexpr std::uint32_t kMaxK = 16;
+// The most queries one search call (and a device backend's max_batch) may
+// hold: 2^20, a million characters searched at once, far above any crowd
+// tick, and small enough that queries x dims (<= 2^27 floats, 512 MiB at
+// 128 dims) and the B x k results (128 MiB at k = 16) stay allocatable and
+// no size product can overflow. A larger batch is an error up front
+// (validate_search), not an allocation failure; split it (docs/search.md).
+inline constexpr std::size_t kMaxBatch = std::size_t{1} << 20;
 
 // Per-query options. The defaults give a plain nearest-neighbour query.
 struct QueryParams {
@@ -96,7 +104,8 @@ class SearchBackend {
   virtual void reset_stats() = 0;
 };
 
-// The checks every backend runs before searching: k in [1, kMaxK], sizes,
+// The checks every backend runs before searching: k in [1, kMaxK], a batch
+// of at most kMaxBatch queries (checked before any size product), sizes,
 // finite query features, params (continuing frame in range, weights finite
 // and >= 0), an empty database, and costs that could overflow float (a
 // finite query so far from every row, or a weight so large, that its cost

@@ -71,7 +71,10 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   if (!std::isfinite(params.continuing_multiplier) || params.continuing_multiplier < 0.0f) {
     return make_error("crowd controller: continuing_multiplier must be finite and >= 0");
   }
-  if (params.max_batch == 0) return make_error("crowd controller: max_batch must be at least 1");
+  if (params.max_batch == 0 || params.max_batch > kMaxBatch) {
+    return make_error("crowd controller: max_batch = " + std::to_string(params.max_batch) + " is out of range [1, " +
+                      std::to_string(kMaxBatch) + "] (kMaxBatch)");
+  }
   Result<QueryAssembler> assembler = QueryAssembler::create(database);
   if (!assembler.ok()) return make_error("crowd controller: " + assembler.message());
 

@@ -3,11 +3,11 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <array>
 #include <bit>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 
 namespace mmvk {
 
@@ -22,12 +22,27 @@ Result<std::string> read_file(const std::filesystem::path& path) {
   // would then report as an empty or truncated file.
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) return make_error(path.string() + ": is a directory, expected a file");
+  // A regular file's size is known up front; anything else (a pipe, a
+  // device such as /dev/zero) is bounded while it is read.
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  const auto too_large = [&](std::uintmax_t bytes, const char* qualifier) {
+    return make_error(path.string() + ": " + qualifier + std::to_string(bytes) + " bytes, over the limit of " +
+                      std::to_string(kMaxFileBytes) + " (kMaxFileBytes) for one mmvk input file");
+  };
+  if (!error && size > kMaxFileBytes) return too_large(size, "");
   std::ifstream in(path, std::ios::binary);
   if (!in) return make_error(path.string() + ": cannot open for reading");
-  std::ostringstream contents;
-  contents << in.rdbuf();
+  std::string contents;
+  if (!error) contents.reserve(static_cast<std::size_t>(size));
+  std::array<char, 1 << 16> chunk;
+  while (in) {
+    in.read(chunk.data(), chunk.size());
+    const std::size_t got = static_cast<std::size_t>(in.gcount());
+    if (contents.size() + got > kMaxFileBytes) return too_large(contents.size() + got, "more than ");
+    contents.append(chunk.data(), got);
+  }
   if (in.bad()) return make_error(path.string() + ": read error");
-  return contents.str();
+  return contents;
 }
 
 Status check_writable(const std::filesystem::path& path) {

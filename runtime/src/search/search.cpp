@@ -37,6 +37,12 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
   if (k < 1 || k > kMaxK) {
     return make_error("search: k = " + std::to_string(k) + " is out of range [1, " + std::to_string(kMaxK) + "]");
   }
+  // Before any product of sizes: a huge batch.size would wrap batch.size *
+  // dims around and let mismatched spans through.
+  if (batch.size > kMaxBatch) {
+    return make_error("search: batch of " + std::to_string(batch.size) + " queries is over the limit of " +
+                      std::to_string(kMaxBatch) + " (kMaxBatch) per call; split it");
+  }
   const std::size_t dims = database.dims();
   if (batch.features.size() != batch.size * dims) {
     return make_error("search: query features have " + std::to_string(batch.features.size()) + " values, expected " +

@@ -49,7 +49,10 @@ float decode_cost(std::uint32_t key) {
 // table is validated here, once, whatever the mode: a table from another
 // database is an error even where it would go unused.
 Status validate_options(const Database& database, const VulkanSearchOptions& options, const ClusterTable* clusters) {
-  if (options.max_batch == 0) return make_error("VulkanSearch: max_batch must be >= 1");
+  if (options.max_batch == 0 || options.max_batch > kMaxBatch) {
+    return make_error("VulkanSearch: max_batch = " + std::to_string(options.max_batch) + " is out of range [1, " +
+                      std::to_string(kMaxBatch) + "] (kMaxBatch)");
+  }
   if (options.max_k < 1 || options.max_k > kMaxK) {
     return make_error("VulkanSearch: max_k = " + std::to_string(options.max_k) + " is out of range [1, " +
                       std::to_string(kMaxK) + "]");

@@ -54,7 +54,7 @@ awk -F, -v limit="$limit_mb" '
   }' "$out/rss.csv" | tee "$out/rss_summary.txt"
 [ "${PIPESTATUS[0]}" -eq 0 ] || exit 1
 
-messages=$(grep -c -i -E "validation (error|warning)|VUID-" "$out/stdout.txt" "$out/stderr.txt" | awk -F: '{ s += $2 } END { print s + 0 }')
+messages=$(cat "$out/stdout.txt" "$out/stderr.txt" | { grep -c -i -E "validation (error|warning)|VUID-" || true; })
 echo "validation messages: $messages" | tee -a "$out/rss_summary.txt"
 [ "$messages" -eq 0 ] || { echo "crowd_soak: FAIL: validation messages in $out/stdout.txt / stderr.txt" >&2; exit 1; }
 grep -o '"ticks": *[0-9]*\|"wall_seconds": *[0-9.e+-]*\|"tick_ms_p50": *[0-9.e+-]*\|"tick_ms_p99": *[0-9.e+-]*\|"queries_per_tick": *[0-9.e+-]*' "$out/summary.json" | tr '\n' ' ' | tee -a "$out/rss_summary.txt"

@@ -34,4 +34,19 @@ Error vk_error(VkResult result, const char* expression, const char* file, int li
                     std::filesystem::path(file).filename().string() + ":" + std::to_string(line));
 }
 
+VkResult injected_or(const Context& context, const char* call, VkResult real) {
+  return context.take_injected_fault(call).value_or(real);
+}
+
+Status watched(const Context& context, VkResult result, const char* call, const char* expression, const char* file,
+               int line) {
+  if (result == VK_SUCCESS) return {};
+  if (result == VK_ERROR_DEVICE_LOST) {
+    context.mark_device_lost(call);
+    return make_error(context.device_lost_error().message + " [" + vk_error(result, expression, file, line).message +
+                      "]");
+  }
+  return vk_error(result, expression, file, line);
+}
+
 }  // namespace mmvk::vulkan::detail

@@ -1,5 +1,7 @@
 #include "commands.hpp"
 
+#include <optional>
+
 #include "check.hpp"
 
 namespace mmvk::vulkan::detail {
@@ -34,8 +36,11 @@ Status submit(const Context& context, VkCommandBuffer commands, VkFence fence) {
   info.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   info.commandBufferCount = 1;
   info.pCommandBuffers = &commands;
-  MMVK_VK_CHECK(vkQueueSubmit(context.queue(), 1, &info, fence));
-  return {};
+  if (context.device_lost()) return context.device_lost_error();
+  // An injected fault stands for a submit that failed: nothing is queued.
+  const std::optional<VkResult> fault = context.take_injected_fault("vkQueueSubmit");
+  const VkResult result = fault ? *fault : vkQueueSubmit(context.queue(), 1, &info, fence);
+  return watched(context, result, "vkQueueSubmit", "vkQueueSubmit(queue, 1, &info, fence)", __FILE__, __LINE__);
 }
 
 }  // namespace mmvk::vulkan::detail

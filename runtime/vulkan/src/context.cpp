@@ -209,7 +209,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
   MMVK_VK_CHECK(vkCreateDevice(context->physical_device_, &device_info, nullptr, &context->device_));
   context->owns_device_ = true;
   vkGetDeviceQueue(context->device_, *family, 0, &context->queue_);
-  MMVK_TRY(context->init_device_info());
+  MMVK_TRY(context->init_device_info(options.limit_caps));
   MMVK_TRY(context->init_pipeline_cache(VK_NULL_HANDLE, options.pipeline_cache_data));
   return context;
 }
@@ -238,13 +238,25 @@ Result<std::unique_ptr<Context>> Context::adopt(const AdoptedDevice& handles, Vk
     return make_error("Vulkan context: adopted queue family " + std::to_string(handles.queue_family) +
                       " does not exist or has no compute support");
   }
-  MMVK_TRY(context->init_device_info());
+  MMVK_TRY(context->init_device_info({}));
   MMVK_TRY(context->init_pipeline_cache(pipeline_cache, {}));
   return context;
 }
 
-Status Context::init_device_info() {
+Status Context::init_device_info(const DeviceLimitCaps& caps) {
   vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+  VkPhysicalDeviceLimits& limits = properties_.limits;
+  if (caps.max_storage_buffer_range != 0) {
+    limits.maxStorageBufferRange = std::min(limits.maxStorageBufferRange, caps.max_storage_buffer_range);
+  }
+  if (caps.max_texel_buffer_elements != 0) {
+    limits.maxTexelBufferElements = std::min(limits.maxTexelBufferElements, caps.max_texel_buffer_elements);
+  }
+  if (caps.heap_bytes != 0) {
+    for (std::uint32_t h = 0; h < memory_properties_.memoryHeapCount; ++h) {
+      memory_properties_.memoryHeaps[h].size = std::min(memory_properties_.memoryHeaps[h].size, caps.heap_bytes);
+    }
+  }
   VkPhysicalDeviceMaintenance3Properties maintenance3{};
   maintenance3.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES;
   VkPhysicalDeviceSubgroupProperties subgroup{};
@@ -354,6 +366,31 @@ Result<std::vector<DeviceInfo>> Context::enumerate_devices() {
   vkDestroyInstance(*instance, nullptr);
   if (!devices) return devices.error();
   return infos;
+}
+
+Error Context::device_lost_error() const {
+  return make_error("Vulkan: the device '" + device_name() + "' was lost (VK_ERROR_DEVICE_LOST from " + lost_call_ +
+                    "; a driver reset, a GPU hang or a removed device): the searches in flight have no results and "
+                    "nothing more can run on this Context; destroy its searches and the Context and create new ones "
+                    "(or use a CPU backend)");
+}
+
+void Context::mark_device_lost(std::string call) const {
+  if (lost_call_.empty()) lost_call_ = std::move(call);
+}
+
+void Context::inject_fault(std::string call, VkResult result, std::uint32_t count) {
+  faults_.push_back({std::move(call), result, count});
+}
+
+std::optional<VkResult> Context::take_injected_fault(std::string_view call) const {
+  for (auto fault = faults_.begin(); fault != faults_.end(); ++fault) {
+    if (fault->call != call || fault->count == 0) continue;
+    const VkResult result = fault->result;
+    if (--fault->count == 0) faults_.erase(fault);
+    return result;
+  }
+  return std::nullopt;
 }
 
 }  // namespace mmvk::vulkan

@@ -15,6 +15,7 @@
 #include "kernel_shape.hpp"
 #include "memory.hpp"
 #include "pipeline.hpp"
+#include "search_fit.hpp"
 #include "search_layout.hpp"
 
 namespace mmvk::vulkan {
@@ -177,10 +178,11 @@ Status VulkanSearch::Impl::create_layouts() {
 
 Status VulkanSearch::Impl::create_slots() {
   const std::uint64_t max_batch = options.max_batch;
-  const std::uint32_t largest_k = k_class(options.max_k);
   const std::uint64_t storage_range = context->properties().limits.maxStorageBufferRange;
   const std::uint64_t per_query_max = scratch_pairs_per_query(options.max_k) * sizeof(std::uint32_t) * 2;
-  std::uint64_t scratch_bytes = std::min(options.scratch_bytes, max_batch * per_query_max);
+  // Larger batches run in chunks, so the scratch never needs more than the
+  // storage range; only one query's scratch beyond it is an error.
+  std::uint64_t scratch_bytes = std::min({options.scratch_bytes, max_batch * per_query_max, storage_range});
   scratch_bytes = std::max(scratch_bytes, per_query_max);  // at least one query per chunk
   if (scratch_bytes > storage_range) {
     return make_error("Vulkan: one query's scratch (" + std::to_string(per_query_max) +
@@ -189,16 +191,17 @@ Status VulkanSearch::Impl::create_slots() {
   }
   scratch_pairs = scratch_bytes / 8;
 
+  const SlotBufferBytes sizes = slot_buffer_bytes(shape, options);
   const struct {
     Buffer Slot::*member;
     std::uint64_t bytes;
     const char* what;
   } buffers[] = {
-      {&Slot::queries, max_batch * shape.dim_vec4s * 16, "the query buffer"},
-      {&Slot::params, max_batch * sizeof(QueryGpu), "the query parameter buffer"},
-      {&Slot::weights, max_batch * std::max(shape.channels, 1u) * sizeof(float), "the weight buffer"},
+      {&Slot::queries, sizes.queries, "the query buffer"},
+      {&Slot::params, sizes.params, "the query parameter buffer"},
+      {&Slot::weights, sizes.weights, "the weight buffer"},
       {&Slot::scratch, scratch_bytes, "the scratch buffer"},
-      {&Slot::results, max_batch * largest_k * 8, "the result buffer"},
+      {&Slot::results, sizes.results, "the result buffer"},
   };
   static_assert(std::size(buffers) == kSearchSet.storage);
   const std::array<VkBufferView, kSearchSet.texel> views = {
@@ -279,6 +282,7 @@ Status VulkanSearch::Impl::warm_up() {
 Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, const Database& database,
                                                            const VulkanSearchOptions& options,
                                                            const ClusterTable* clusters) {
+  if (context.device_lost()) return context.device_lost_error();
   MMVK_TRY(validate_options(database, options, clusters));
   auto impl = std::make_unique<Impl>();
   impl->context = &context;
@@ -286,6 +290,7 @@ Result<std::unique_ptr<VulkanSearch>> VulkanSearch::create(Context& context, con
   impl->options = options;
   impl->channel_of_weight = weighted_channels(database.schema());
   MMVK_ASSIGN_OR_RETURN(impl->shape, make_kernel_shape(context, database, options));
+  MMVK_TRY(check_search_fits(context, impl->shape, options));
   MMVK_TRY(impl->create_layouts());
   MMVK_TRY(impl->upload(options.force_staging_upload));
   if (options.mode == SearchMode::BruteForce) {
@@ -329,6 +334,7 @@ std::vector<std::string_view> VulkanSearch::kernels() const {
 Result<Ticket> VulkanSearch::submit(const QueryBatch& batch, std::uint32_t k) { return impl_->submit(batch, k, 0); }
 
 Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t k, std::uint32_t forced_tile) {
+  if (context->device_lost()) return context->device_lost_error();
   if (batch.size > options.max_batch) {
     return make_error("VulkanSearch: batch of " + std::to_string(batch.size) + " queries is over max_batch = " +
                       std::to_string(options.max_batch));
@@ -435,10 +441,13 @@ Result<bool> VulkanSearch::poll(const Ticket& ticket) const {
   Result<Slot*> slot = impl_->find_ticket(ticket, "poll()");
   if (!slot) return slot.error();
   if ((*slot)->batch == 0) return true;
-  const VkResult status = vkGetFenceStatus(impl_->context->device(), (*slot)->fence.get());
-  if (status == VK_SUCCESS) return true;
+  const Context& context = *impl_->context;
+  if (context.device_lost()) return context.device_lost_error();  // wait() then frees the slot
+  const VkResult status =
+      injected_or(context, "vkGetFenceStatus", vkGetFenceStatus(context.device(), (*slot)->fence.get()));
   if (status == VK_NOT_READY) return false;
-  return vk_error(status, "vkGetFenceStatus(device, slot.fence)", __FILE__, __LINE__);
+  MMVK_TRY(watched(context, status, "vkGetFenceStatus", "vkGetFenceStatus(device, slot.fence)", __FILE__, __LINE__));
+  return true;
 }
 
 Status VulkanSearch::wait(const Ticket& ticket, std::span<Match> out) { return impl_->wait(ticket, out); }
@@ -458,11 +467,14 @@ Status VulkanSearch::Impl::wait(const Ticket& ticket, std::span<Match> out) {
   }
   const VkDevice device = context->device();
   const VkFence fence = slot.fence.get();
-  const VkResult waited = vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX);
+  const VkResult waited =
+      injected_or(*context, "vkWaitForFences", vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX));
   slot.in_flight = false;  // a lost device will not finish it either
-  if (waited != VK_SUCCESS) {
-    return vk_error(waited, "vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX)", __FILE__, __LINE__);
-  }
+  MMVK_TRY(watched(*context, waited, "vkWaitForFences", "vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX)",
+                   __FILE__, __LINE__));
+  // Lost while this ticket ran (reported by another ticket): its results
+  // cannot be trusted either.
+  if (context->device_lost()) return context->device_lost_error();
 
   if (timestamps) {
     std::array<std::uint64_t, 2> ticks{};

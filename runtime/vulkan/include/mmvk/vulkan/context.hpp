@@ -26,6 +26,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -33,6 +34,16 @@
 #include "mmvk/status.hpp"
 
 namespace mmvk::vulkan {
+
+// Lowers device limits as mmvk sees them, never raises them; 0 keeps the
+// device's own. For an application that keeps part of the device for its
+// own buffers, and for testing mmvk's "too large for this device" errors on
+// any device.
+struct DeviceLimitCaps {
+  std::uint32_t max_storage_buffer_range = 0;   // bytes, caps maxStorageBufferRange
+  std::uint32_t max_texel_buffer_elements = 0;  // texels, caps maxTexelBufferElements
+  VkDeviceSize heap_bytes = 0;                  // bytes, caps the size of every memory heap
+};
 
 struct ContextOptions {
   // Index into vkEnumeratePhysicalDevices; nullopt picks the best device:
@@ -47,6 +58,7 @@ struct ContextOptions {
   // A blob for another device or driver version, or a malformed one, is
   // ignored (pipeline_cache_note() says why); never an error.
   std::vector<std::byte> pipeline_cache_data;
+  DeviceLimitCaps limit_caps;
 };
 
 // The application's handles, for Context::adopt. The device must support
@@ -123,9 +135,31 @@ class Context {
   // For the debug messenger callback only.
   void record_validation_message(std::string message);
 
+  // Device loss. Once a submit or a wait reports VK_ERROR_DEVICE_LOST (a
+  // driver reset, a GPU hang, a removed device), the device is gone for
+  // good: every later create(), submit() and wait() of a search on this
+  // Context fails at once with device_lost_error(), and nothing crashes.
+  // Recover by destroying the searches and the Context and creating new
+  // ones (or by falling back to a CPU backend).
+  bool device_lost() const { return !lost_call_.empty(); }
+  // Says the device was lost, in which call, and what to do.
+  Error device_lost_error() const;
+  // For mmvk's checks: records the loss reported by `call`.
+  void mark_device_lost(std::string call) const;
+
+  // Fault injection, for tests of mmvk's error paths and of an
+  // application's own handling of them: the next `count` calls named `call`
+  // that go through mmvk's submit and wait paths ("vkQueueSubmit",
+  // "vkWaitForFences", "vkGetFenceStatus") report `result`. A submit with
+  // an injected fault is not made; a wait reports it after the real wait,
+  // so no work is left running behind the error.
+  void inject_fault(std::string call, VkResult result, std::uint32_t count = 1);
+  // For mmvk's checks: the injected result of `call`, consuming one.
+  std::optional<VkResult> take_injected_fault(std::string_view call) const;
+
  private:
   Context() = default;
-  Status init_device_info();
+  Status init_device_info(const DeviceLimitCaps& caps);
   Status init_pipeline_cache(VkPipelineCache adopted, std::span<const std::byte> initial);
 
   // Declaration order = reverse destruction order; the destructor destroys
@@ -147,6 +181,16 @@ class Context {
   std::uint32_t subgroup_size_ = 1;
   std::uint32_t timestamp_valid_bits_ = 0;
   VkDeviceSize max_allocation_size_ = 0;
+
+  // Mutable: device loss and injected faults are observed by the const
+  // paths that submit and wait (the Context is used from one thread).
+  struct InjectedFault {
+    std::string call;
+    VkResult result = VK_SUCCESS;
+    std::uint32_t count = 0;
+  };
+  mutable std::vector<InjectedFault> faults_;
+  mutable std::string lost_call_;
 
   mutable std::mutex messages_mutex_;
   std::vector<std::string> messages_;

@@ -124,9 +124,19 @@ TEST(VulkanLimits, MaxBatchOverKMaxBatchIsAnError) {
 // ---------------------------------------------------------------------------
 // Device loss (injected: lavapipe has no device to lose)
 
+// A small database, 8 queries and a search on it (k <= 4, 2 slots).
 struct Fixture {
   Database db = synthetic_database({.frames = 600, .clips = 3, .seed = 5});
   std::vector<float> queries = synthetic_queries(db, 8, 9);
+  std::vector<Match> out = std::vector<Match>(8 * 4);
+  std::unique_ptr<VulkanSearch> search;
+
+  explicit Fixture(Context& context) {
+    Result<std::unique_ptr<VulkanSearch>> made = VulkanSearch::create(context, db, small_options());
+    EXPECT_TRUE(made.ok()) << made.message();
+    if (made.ok()) search = std::move(made).value();
+  }
+  QueryBatch batch() const { return QueryBatch{queries, {}, 8}; }
 };
 
 void expect_lost(const std::string& message, const std::string& call) {
@@ -136,54 +146,50 @@ void expect_lost(const std::string& message, const std::string& call) {
 
 TEST(VulkanDeviceLoss, LostAtSubmitIsAnErrorAndTheSearchStaysSafe) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 0));
-  Fixture f;
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, f.db, small_options());
-  ASSERT_TRUE(search.ok()) << search.message();
-  std::vector<Match> out(8 * 4);
-  ASSERT_TRUE((*search)->search(QueryBatch{f.queries, {}, 8}, 4, out).ok());
+  Fixture f(*context);
+  ASSERT_TRUE(f.search);
+  ASSERT_TRUE(f.search->search(f.batch(), 4, f.out).ok());
 
   context->inject_fault("vkQueueSubmit", VK_ERROR_DEVICE_LOST);
-  const Status lost = (*search)->search(QueryBatch{f.queries, {}, 8}, 4, out);
+  const Status lost = f.search->search(f.batch(), 4, f.out);
   ASSERT_FALSE(lost.ok());
   expect_lost(lost.message(), "vkQueueSubmit");
   EXPECT_TRUE(context->device_lost());
   // Every later use fails the same way, at once; nothing crashes.
   for (int i = 0; i < 3; ++i) {
-    const Status again = (*search)->search(QueryBatch{f.queries, {}, 8}, 4, out);
+    const Status again = f.search->search(f.batch(), 4, f.out);
     ASSERT_FALSE(again.ok());
     expect_lost(again.message(), "vkQueueSubmit");
   }
   const Result<std::unique_ptr<VulkanSearch>> another = VulkanSearch::create(*context, f.db, small_options());
   ASSERT_FALSE(another.ok());
   expect_lost(another.message(), "vkQueueSubmit");
-  search->reset();  // destroys cleanly
+  f.search.reset();  // destroys cleanly
   EXPECT_EQ(context->validation_message_count(), 0u);
 }
 
 TEST(VulkanDeviceLoss, LostWhileWaitingFreesTheSlotAndReportsOtherTickets) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 0));
-  Fixture f;
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, f.db, small_options());
-  ASSERT_TRUE(search.ok()) << search.message();
-  VulkanSearch& s = **search;
+  Fixture f(*context);
+  ASSERT_TRUE(f.search);
+  VulkanSearch& s = *f.search;
   // Two tickets in flight; the first wait reports the loss.
-  const Result<vulkan::Ticket> first = s.submit(QueryBatch{f.queries, {}, 8}, 4);
-  const Result<vulkan::Ticket> second = s.submit(QueryBatch{f.queries, {}, 8}, 4);
+  const Result<vulkan::Ticket> first = s.submit(f.batch(), 4);
+  const Result<vulkan::Ticket> second = s.submit(f.batch(), 4);
   ASSERT_TRUE(first.ok() && second.ok());
   context->inject_fault("vkWaitForFences", VK_ERROR_DEVICE_LOST);
-  std::vector<Match> out(8 * 4);
-  const Status waited = s.wait(*first, out);
+  const Status waited = s.wait(*first, f.out);
   ASSERT_FALSE(waited.ok());
   expect_lost(waited.message(), "vkWaitForFences");
   // The other ticket ran on the lost device: an error too, not results.
   const Result<bool> polled = s.poll(*second);
   ASSERT_FALSE(polled.ok());
   expect_lost(polled.message(), "vkWaitForFences");
-  const Status other = s.wait(*second, out);
+  const Status other = s.wait(*second, f.out);
   ASSERT_FALSE(other.ok());
   expect_lost(other.message(), "vkWaitForFences");
   // Both slots are free again (no "all slots in flight"), and say lost.
-  const Result<vulkan::Ticket> next = s.submit(QueryBatch{f.queries, {}, 8}, 4);
+  const Result<vulkan::Ticket> next = s.submit(f.batch(), 4);
   ASSERT_FALSE(next.ok());
   expect_lost(next.message(), "vkWaitForFences");
   EXPECT_EQ(context->validation_message_count(), 0u);
@@ -191,21 +197,19 @@ TEST(VulkanDeviceLoss, LostWhileWaitingFreesTheSlotAndReportsOtherTickets) {
 
 TEST(VulkanDeviceLoss, OtherInjectedFaultsAreErrorsAndTheSearchRecovers) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 0));
-  Fixture f;
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, f.db, small_options());
-  ASSERT_TRUE(search.ok()) << search.message();
+  Fixture f(*context);
+  ASSERT_TRUE(f.search);
   context->inject_fault("vkQueueSubmit", VK_ERROR_OUT_OF_DEVICE_MEMORY);
-  std::vector<Match> out(8 * 4);
-  const Status failed = (*search)->search(QueryBatch{f.queries, {}, 8}, 4, out);
+  const Status failed = f.search->search(f.batch(), 4, f.out);
   ASSERT_FALSE(failed.ok());
   EXPECT_TRUE(contains(failed.message(), "VK_ERROR_OUT_OF_DEVICE_MEMORY")) << failed.message();
   EXPECT_FALSE(context->device_lost());
   // Not a loss: the next search works and matches the reference.
-  ASSERT_TRUE((*search)->search(QueryBatch{f.queries, {}, 8}, 4, out).ok());
+  ASSERT_TRUE(f.search->search(f.batch(), 4, f.out).ok());
   ReferenceSearch reference(f.db);
   std::vector<Match> expected(8 * 4);
-  ASSERT_TRUE(reference.search(QueryBatch{f.queries, {}, 8}, 4, expected).ok());
-  EXPECT_EQ(out, expected);
+  ASSERT_TRUE(reference.search(f.batch(), 4, expected).ok());
+  EXPECT_EQ(f.out, expected);
   EXPECT_EQ(context->validation_message_count(), 0u);
 }
 

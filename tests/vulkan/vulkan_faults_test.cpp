@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mmvk/reference_search.hpp"
+#include "mmvk/vulkan/vulkan_async_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/search_test_data.hpp"
 #include "vulkan_test_env.hpp"
@@ -210,6 +211,33 @@ TEST(VulkanDeviceLoss, OtherInjectedFaultsAreErrorsAndTheSearchRecovers) {
   std::vector<Match> expected(8 * 4);
   ASSERT_TRUE(reference.search(f.batch(), 4, expected).ok());
   EXPECT_EQ(f.out, expected);
+  EXPECT_EQ(context->validation_message_count(), 0u);
+}
+
+// The crowd's asynchronous search: a failed chunk submit in collect() used
+// to leave the chunks already in flight holding their slots, so every
+// later tick failed with "all submission slots are in flight".
+TEST(VulkanDeviceLoss, AsyncSearchFreesItsSlotsAfterAFailedChunk) {
+  MMVK_VULKAN_CONTEXT(context, capped(0, 0, 0));
+  const Database db = synthetic_database({.frames = 600, .clips = 3, .seed = 6});
+  VulkanSearchOptions options = small_options(8);  // 32 queries = 4 chunks on 2 slots
+  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, options);
+  ASSERT_TRUE(search.ok()) << search.message();
+  vulkan::VulkanAsyncSearch async(**search, 32);
+  const std::vector<float> queries = synthetic_queries(db, 32, 4);
+  const QueryBatch batch{queries, {}, 32};
+  std::vector<Match> out(32), expected(32);
+  ASSERT_TRUE(async.submit(batch).ok());
+  context->inject_fault("vkQueueSubmit", VK_ERROR_OUT_OF_HOST_MEMORY);  // the third chunk's
+  const Status failed = async.collect(out);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_TRUE(contains(failed.message(), "VK_ERROR_OUT_OF_HOST_MEMORY")) << failed.message();
+  // The next tick runs as if nothing happened.
+  ASSERT_TRUE(async.submit(batch).ok());
+  const Status collected = async.collect(out);
+  ASSERT_TRUE(collected.ok()) << collected.message();
+  ASSERT_TRUE(ReferenceSearch(db).search(batch, 1, expected).ok());
+  EXPECT_EQ(out, expected);
   EXPECT_EQ(context->validation_message_count(), 0u);
 }
 

@@ -38,7 +38,10 @@ Status VulkanAsyncSearch::submit(const QueryBatch& batch) {
   // As many chunks as there are slots now; the rest go out in collect() as
   // slots free up.
   while (next_chunk_ < batch_.size && tickets_.size() < search_.options().slots) {
-    if (Status status = submit_next_chunk(); !status.ok()) return status;
+    if (Status status = submit_next_chunk(); !status.ok()) {
+      abandon(0);
+      return status;
+    }
   }
   in_flight_ = true;
   return {};
@@ -55,10 +58,26 @@ Status VulkanAsyncSearch::collect(std::span<Match> out) {
   // Oldest chunk first; each finished one frees a slot for the next chunk.
   for (std::size_t i = 0; i < tickets_.size(); ++i) {
     const std::size_t first = chunk_begin_[i];
-    MMVK_TRY(search_.wait(tickets_[i], out.subspan(first, std::min(max_batch, batch_.size - first))));
-    if (next_chunk_ < batch_.size) MMVK_TRY(submit_next_chunk());
+    Status status = search_.wait(tickets_[i], out.subspan(first, std::min(max_batch, batch_.size - first)));
+    if (status.ok() && next_chunk_ < batch_.size) status = submit_next_chunk();
+    if (!status.ok()) {
+      abandon(i + 1);
+      return status;
+    }
   }
   return {};
+}
+
+void VulkanAsyncSearch::abandon(std::size_t first) {
+  const std::size_t max_batch = search_.options().max_batch;
+  std::vector<Match> dropped;
+  for (std::size_t i = first; i < tickets_.size(); ++i) {
+    dropped.resize(std::min(max_batch, batch_.size - chunk_begin_[i]));
+    // Its own error (a lost device) says nothing the caller is not told.
+    static_cast<void>(search_.wait(tickets_[i], dropped));
+  }
+  tickets_.clear();
+  chunk_begin_.clear();
 }
 
 }  // namespace mmvk::vulkan

@@ -27,6 +27,9 @@ class VulkanAsyncSearch final : public AsyncSearch {
  private:
   // Submits the next chunk of batch_ (at most max_batch queries).
   Status submit_next_chunk();
+  // After an error: waits out the tickets from `first` on, dropping their
+  // results, so that no slot stays taken by a batch nobody collects.
+  void abandon(std::size_t first);
 
   VulkanSearch& search_;
   QueryBatch batch_;                      // the batch in flight

@@ -12,7 +12,7 @@
 #include "crowd_recorder.hpp"
 #include "database_sliding.hpp"
 #include "default_data.hpp"
-#include "fnv.hpp"
+#include "mmvk/hash.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/trajectory.hpp"
@@ -176,7 +176,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   std::vector<double> search_ms, tick_ms;
   search_ms.reserve(ticks), tick_ms.reserve(ticks);
-  Fnv1a chosen;
+  Hasher chosen;
   std::uint64_t searches = 0;
   const auto run_start = Clock::now();
   for (std::uint64_t t = 0; t < ticks; ++t) {

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "fnv.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/manifest.hpp"
@@ -28,7 +28,7 @@ bool read_whole_file(const std::filesystem::path& path, std::string& out) {
 // The digest of everything a build reads: the manifest (or folder listing)
 // and the bytes of every clip.
 Result<std::uint64_t> source_digest(const std::filesystem::path& source, const Manifest& manifest) {
-  Fnv1a hash;
+  Hasher hash;
   hash.add_u32(kRecipeVersion);
   hash.add_u32(kDatabaseFormatVersion);
   std::string bytes;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "../../runtime/src/common/hash.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/pose_batch.hpp"
@@ -299,7 +299,7 @@ TEST(DatabaseFile, FormatOneStillLoadsWithoutAnimation) {
   };
   put(8, 1, 4);
   put(16, bytes.size() - 8 - kDatabaseHeaderBytes, 8);
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(bytes.data(), bytes.size() - 8);
   put(bytes.size() - 8, hasher.digest(), 8);
   Result<Database> loaded = deserialize_database(bytes, "v1.mmdb");

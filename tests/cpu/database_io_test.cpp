@@ -9,7 +9,7 @@
 
 #include <unistd.h>
 
-#include "../../runtime/src/common/hash.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/database_io.hpp"
 #include "support/test_data.hpp"
 
@@ -88,7 +88,7 @@ void put_u32(std::string& bytes, std::size_t at, std::uint32_t v) {
 
 // Recomputes the trailing checksum after a deliberate edit.
 void reseal(std::string& bytes) {
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(bytes.data(), bytes.size() - 8);
   const std::uint64_t sum = hasher.digest();
   for (int i = 0; i < 8; ++i) bytes[bytes.size() - 8 + i] = static_cast<char>((sum >> (8 * i)) & 0xFF);

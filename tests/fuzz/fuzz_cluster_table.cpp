@@ -6,7 +6,7 @@
 #include <cstring>
 #include <string>
 
-#include "common/hash.hpp"
+#include "mmvk/hash.hpp"
 #include "fixed_database.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "temp_file.hpp"
@@ -14,7 +14,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string bytes(reinterpret_cast<const char*>(data), size);
   if (bytes.size() >= 16) {
-    mmvk::detail::Hasher hasher;
+    mmvk::Hasher hasher;
     hasher.add_bytes(bytes.data(), bytes.size() - 8);
     const std::uint64_t digest = hasher.digest();
     std::memcpy(bytes.data() + bytes.size() - 8, &digest, 8);

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string>
 
-#include "common/hash.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/database_io.hpp"
 
 namespace mmvk::fuzz {
@@ -25,7 +25,7 @@ inline void repair_mmdb(std::string& bytes) {
   std::memcpy(bytes.data() + 8, &version, 4);
   const std::uint64_t payload = bytes.size() - kDatabaseHeaderBytes - kChecksumBytes;
   std::memcpy(bytes.data() + 16, &payload, 8);
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(bytes.data(), bytes.size() - kChecksumBytes);
   const std::uint64_t digest = hasher.digest();
   std::memcpy(bytes.data() + bytes.size() - kChecksumBytes, &digest, 8);

@@ -21,7 +21,7 @@
 #include <string>
 
 #include "mmvk/file_io.hpp"
-#include "common/hash.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/cluster_table.hpp"
 
 namespace mmvk {
@@ -101,7 +101,7 @@ Status save_cluster_table(const ClusterTable& t, const std::filesystem::path& pa
   put_array(out, t.tag_intersection);
   put_array(out, t.flags_intersection);
   put_array(out, t.channel_radius);
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(out.data(), out.size());
   put(out, hasher.digest());
   return write_file_atomically(path, out);
@@ -142,7 +142,7 @@ Result<ClusterTable> load_cluster_table(const std::filesystem::path& path) {
     return make_error(where + "file has " + std::to_string(bytes.size()) + " bytes, its header implies " +
                       std::to_string(expected) + " (truncated or corrupted)");
   }
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(bytes.data(), bytes.size() - 8);
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);

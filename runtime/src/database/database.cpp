@@ -4,7 +4,7 @@
 #include <cmath>
 #include <set>
 
-#include "common/hash.hpp"
+#include "mmvk/hash.hpp"
 
 namespace mmvk {
 
@@ -149,7 +149,7 @@ Database::Database(DatabaseParts parts) : parts_(std::move(parts)) {
     float& bound = max_abs_features_[i % dims_];
     bound = std::max(bound, std::fabs(parts_.features[i]));
   }
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add(parts_.fps);
   hasher.add(dims_);
   hasher.add(frame_count_);

@@ -7,7 +7,7 @@
 #include <span>
 
 #include "mmvk/file_io.hpp"
-#include "common/hash.hpp"
+#include "mmvk/hash.hpp"
 
 namespace mmvk {
 
@@ -291,7 +291,7 @@ std::string serialize_database(const Database& database) {
   std::string& bytes = file.bytes();
   const std::uint64_t payload_size = bytes.size() - kDatabaseHeaderBytes;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<char>((payload_size >> (8 * i)) & 0xFF);
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(bytes.data(), bytes.size());
   file.u64(hasher.digest());
   return std::move(bytes);
@@ -326,7 +326,7 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
     return make_error(source + ": corrupt mmvk database (" + std::to_string(available - payload_size) +
                       " unexpected bytes after the payload)");
   }
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(bytes.data(), kDatabaseHeaderBytes + payload_size);
   if (hasher.digest() != read_u64_at(bytes, kDatabaseHeaderBytes + payload_size)) {
     return make_error(source + ": checksum mismatch: the mmvk database is corrupt");

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <system_error>
 
-#include "../../src/common/hash.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/file_io.hpp"
 
 namespace mmvk::vulkan {
@@ -28,7 +28,7 @@ std::uint64_t read_le(std::string_view in, std::size_t at, std::size_t bytes) {
 }
 
 std::uint64_t checksum(const void* data, std::size_t size) {
-  detail::Hasher hasher;
+  Hasher hasher;
   hasher.add_bytes(data, size);
   return hasher.digest();
 }

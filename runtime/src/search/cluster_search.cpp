@@ -44,12 +44,14 @@ struct Scratch {
   std::vector<float> bound, distance;            // [clusters, padded to 16]
   std::vector<float> tile_bound;                 // [tiles of the largest cluster, padded to 16]
   std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
+  std::vector<std::uint32_t> passing;            // [tiles of the largest cluster]
   std::vector<double> radius_sum, radius_total;  // [clusters]
   std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
   // Batched exact mode and the split single query.
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
   std::vector<std::uint32_t> seed, cursor, candidate_end;      // [kSubBatch]
   std::vector<ClusterBound> candidates;                        // each query's, sorted, one after another
+  std::vector<ClusterBound> staging;                           // [clusters]: collect_candidates'
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (cluster, query) to visit
   std::vector<std::uint32_t> bucket_start, bucket_fill, bucket_query;
   std::uint64_t rows = 0;
@@ -86,7 +88,10 @@ struct ClusterSearch::Layout {
   // channel-weighted squared centroid distance.
   detail::BoxPacks centroids;
   std::vector<float> radius_t;               // [channels x clusters]
-  std::vector<bool> never_candidate;         // [clusters]: empty or all members excluded by flags
+  // [clusters]: 1 when empty or all members excluded by flags (bytes, not
+  // vector<bool>, so the per-query eligibility loop vectorizes).
+  std::vector<std::uint8_t> never_candidate;
+  std::uint32_t candidate_clusters = 0;      // clusters with never_candidate 0
   double radius_margin = 0.0;
   std::vector<Scratch> scratch;              // [pool threads]
   std::vector<Match> partial;                // [threads x k]: a split query's lists
@@ -112,6 +117,7 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     const std::uint32_t size = table.offsets[c + 1] - table.offsets[c];
     const std::uint32_t tiles_c = (size + kLanes - 1) / kLanes;
     l.never_candidate[c] = size == 0 || (table.flags_intersection[c] & detail::kNeverCandidate) != 0;
+    l.candidate_clusters += l.never_candidate[c] == 0 ? 1u : 0u;
     l.tile_offsets[c + 1] = l.tile_offsets[c] + tiles_c;
     l.tile_box_pack[c] = tile_packs;
     tile_packs += static_cast<std::uint32_t>(packs_of(tiles_c));
@@ -194,6 +200,8 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.distance.resize(cluster_packs * kLanes);
     s.tile_bound.resize(packs_of(l.max_cluster_tiles) * kLanes);
     s.span_bound.resize(packs_of(packs_of(l.max_cluster_tiles)) * kLanes);
+    s.passing.resize(l.max_cluster_tiles);
+    s.staging.resize(k);
     s.radius_sum.resize(k);
     s.radius_total.resize(k);
     s.batch_bound.resize(kSubBatch * cluster_packs * kLanes);
@@ -341,7 +349,18 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
     }
     if (shared != nullptr && hits != 0) shared->lower_to(v.best.back().cost);
   };
+  // The tiles whose bound passes the k-th best from before the walk,
+  // compacted without a branch (most tiles fail, in no pattern a predictor
+  // learns); each is checked again below as the k-th best tightens.
+  std::uint32_t* passing = s.passing.data();
+  std::uint32_t passing_count = 0;
+  const float threshold_before = threshold_of(v, shared);
   for (std::uint32_t i = part; i < tiles; i += parts) {
+    passing[passing_count] = i;
+    passing_count += !x.options.tile_bound || !(s.tile_bound[i] > threshold_before) ? 1u : 0u;
+  }
+  for (std::uint32_t j = 0; j < passing_count; ++j) {
+    const std::uint32_t i = passing[j];
     if (x.options.tile_bound && s.tile_bound[i] > threshold_of(v, shared)) continue;
     const std::uint32_t tile = first_tile + i;
     s.rows += l.tile_rows[tile];
@@ -369,6 +388,62 @@ void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
   }
 }
 
+// Rules out (NaN: never <= any threshold) each cluster of bound[] that
+// query `params` cannot take a frame from, and turns a bound that overflowed
+// to NaN into -inf (it proves nothing: visited first). Returns the number
+// of eligible clusters. The loops are branch-free so that they vectorize:
+// they run for every query over every cluster.
+std::uint32_t mark_ineligible(const ClusterSearch::Layout& l, const QueryParams& params, float* bound) {
+  const ClusterTable& t = l.table;
+  const std::uint32_t n = t.cluster_count;
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  constexpr float kMinusInfinity = -std::numeric_limits<float>::infinity();
+  // A tag both required and excluded rules out every frame.
+  if ((params.require_all & params.exclude_any) != 0) {
+    std::fill_n(bound, n, kNaN);
+    return 0;
+  }
+  const std::uint8_t* never = l.never_candidate.data();
+  if (params.require_all == 0 && params.exclude_any == 0) {
+    // No tag rules (most queries): the table's own eligibility.
+    for (std::uint32_t c = 0; c < n; ++c) {
+      const float b = std::isnan(bound[c]) ? kMinusInfinity : bound[c];
+      bound[c] = never[c] != 0 ? kNaN : b;
+    }
+    return l.candidate_clusters;
+  }
+  std::uint32_t eligible = 0;
+  for (std::uint32_t c = 0; c < n; ++c) {
+    const bool ok = never[c] == 0 && (t.tag_union[c] & params.require_all) == params.require_all &&
+                    (t.tag_intersection[c] & params.exclude_any) == 0;
+    const float b = std::isnan(bound[c]) ? kMinusInfinity : bound[c];
+    bound[c] = ok ? b : kNaN;
+    eligible += ok ? 1u : 0u;
+  }
+  return eligible;
+}
+
+// The eligible cluster (bound not NaN) with the smallest centroid distance,
+// ties to the lower cluster id; kNoCluster when none is eligible. Two
+// branch-free passes (the minimum, then its first cluster) rather than one
+// branchy one: they run for every query over every cluster. Distances are
+// finite or +inf (queries are validated finite); an eligible cluster with a
+// NaN distance is taken only when no eligible one has a number.
+std::uint32_t nearest_centroid(const float* distance, const float* bound, std::uint32_t clusters) {
+  float nearest = std::numeric_limits<float>::infinity();
+  for (std::uint32_t c = 0; c < clusters; ++c) {
+    const float d = std::isnan(bound[c]) ? std::numeric_limits<float>::infinity() : distance[c];
+    nearest = d < nearest ? d : nearest;
+  }
+  std::uint32_t first_eligible = kNoCluster;
+  for (std::uint32_t c = 0; c < clusters; ++c) {
+    if (std::isnan(bound[c])) continue;
+    if (first_eligible == kNoCluster) first_eligible = c;
+    if (distance[c] == nearest) return c;
+  }
+  return first_eligible;
+}
+
 // Lower bounds of every cluster into bound[] (padded to whole
 // packs): NaN for a cluster the query rules out (never <= any threshold),
 // -inf for a bound that overflowed to NaN (proves nothing: visited first).
@@ -385,17 +460,7 @@ std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v,
     std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
   }
   if (x.options.radius_bound) radius_bounds(l, v.q, v.w, s, bound);
-  // A tag both required and excluded rules out every frame.
-  const bool contradictory = (v.params->require_all & v.params->exclude_any) != 0;
-  std::uint32_t eligible = 0;
-  for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
-    if (contradictory || !cluster_eligible(l, *v.params, c)) {
-      bound[c] = std::numeric_limits<float>::quiet_NaN();
-    } else {
-      ++eligible;
-      if (std::isnan(bound[c])) bound[c] = -std::numeric_limits<float>::infinity();
-    }
-  }
+  const std::uint32_t eligible = mark_ineligible(l, *v.params, bound);
   const bool probing = x.options.nprobe != 0 && x.options.nprobe < eligible;
   if (!probing && (!x.options.seed_nearest || eligible < 2)) return kNoCluster;
   l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
@@ -412,23 +477,23 @@ std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v,
       bound[it->cluster] = std::numeric_limits<float>::quiet_NaN();
     }
   }
-  std::uint32_t nearest = kNoCluster;
-  for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
-    if (std::isnan(bound[c])) continue;
-    if (nearest == kNoCluster || s.distance[c] < s.distance[nearest]) nearest = c;
-  }
-  return nearest;
+  return nearest_centroid(s.distance.data(), bound, t.cluster_count);
 }
 
 // Appends the clusters other than `skip` whose bound is at most `threshold`,
-// sorted by (bound, cluster).
+// sorted by (bound, cluster). They are compacted into `staging` (one slot
+// per cluster) without a branch first: this runs for every query over every
+// cluster, and which clusters pass follows no pattern a predictor learns.
 void collect_candidates(const float* bound, std::uint32_t clusters, std::uint32_t skip, float threshold,
-                        std::vector<ClusterBound>& out) {
-  const std::size_t begin = out.size();
+                        std::vector<ClusterBound>& staging, std::vector<ClusterBound>& out) {
+  ClusterBound* passing = staging.data();
+  std::size_t count = 0;
   for (std::uint32_t c = 0; c < clusters; ++c) {
-    if (c != skip && bound[c] <= threshold) out.push_back({bound[c], c, 0.0f});
+    passing[count] = {bound[c], c, 0.0f};
+    count += c != skip && bound[c] <= threshold ? 1u : 0u;
   }
-  std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.end());
+  std::sort(passing, passing + count);
+  out.insert(out.end(), passing, passing + count);
 }
 
 // The per-query walk (nprobe mode, and exact mode's fallback).
@@ -563,7 +628,7 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
     for (std::uint32_t i = 0; i < n; ++i) {
       s.candidate_end[i] = static_cast<std::uint32_t>(s.candidates.size());  // this query's begin, for now
       collect_candidates(s.batch_bound.data() + i * stride, clusters, s.seed[i], local(i).best.back().cost,
-                         s.candidates);
+                         s.staging, s.candidates);
     }
     for (std::uint32_t i = 0; i < n; ++i) {
       s.cursor[i] = s.candidate_end[i];
@@ -605,7 +670,7 @@ void walk_split(const WalkContext& x, Scratch& s, const QueryView& v, std::uint3
   const std::uint32_t seed = exact_bounds(x, s, v, bound);
   if (seed != kNoCluster && bound[seed] <= threshold_of(v, &shared)) visit_cluster(x, s, v, seed, part, parts, &shared);
   s.candidates.clear();
-  collect_candidates(bound, clusters, seed, threshold_of(v, &shared), s.candidates);
+  collect_candidates(bound, clusters, seed, threshold_of(v, &shared), s.staging, s.candidates);
   for (std::size_t j = part; j < s.candidates.size(); j += parts) {
     const ClusterBound& b = s.candidates[j];
     if (b.bound > threshold_of(v, &shared)) break;

@@ -39,6 +39,15 @@ struct ClusterBound {
   }
 };
 
+// A cluster that query `query` of a sub-batch is to visit, with the
+// cluster's lower bound for that query (carried, so that the grouped walk
+// does not look it up in a sub-batch's bounds, a cache miss per pair).
+struct VisitPair {
+  std::uint32_t cluster;
+  std::uint32_t query;
+  float bound;
+};
+
 struct Scratch {
   std::vector<ClusterBound> order;
   std::vector<float> bound, distance;            // [clusters, padded to 16]
@@ -52,8 +61,8 @@ struct Scratch {
   std::vector<std::uint32_t> seed, cursor, candidate_end;      // [kSubBatch]
   std::vector<ClusterBound> candidates;                        // each query's, sorted, one after another
   std::vector<ClusterBound> staging;                           // [clusters]: collect_candidates'
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (cluster, query) to visit
-  std::vector<std::uint32_t> bucket_start, bucket_fill, bucket_query;
+  std::vector<VisitPair> pairs, bucketed;                      // to visit; the same grouped by cluster
+  std::vector<std::uint32_t> bucket_start, bucket_fill;
   std::uint64_t rows = 0;
   ClusterSearchCounters counters;
 };
@@ -584,20 +593,17 @@ void walk_one(const WalkContext& x, Scratch& s, const QueryView& v) {
 // visits it, and stay in cache between those queries. A pair is skipped when
 // the cluster's bound has risen above the query's k-th best meanwhile.
 template <class ViewOf>
-void visit_grouped(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::size_t stride) {
+void visit_grouped(const WalkContext& x, Scratch& s, const ViewOf& view_of) {
   const std::uint32_t clusters = x.l.table.cluster_count;
   s.bucket_start.assign(clusters + 1, 0);
-  for (const auto& [c, i] : s.pairs) ++s.bucket_start[c + 1];
+  for (const VisitPair& p : s.pairs) ++s.bucket_start[p.cluster + 1];
   for (std::uint32_t c = 0; c < clusters; ++c) s.bucket_start[c + 1] += s.bucket_start[c];
-  s.bucket_query.resize(s.pairs.size());
+  s.bucketed.resize(s.pairs.size());
   s.bucket_fill.assign(s.bucket_start.begin(), s.bucket_start.end() - 1);
-  for (const auto& [c, i] : s.pairs) s.bucket_query[s.bucket_fill[c]++] = i;
-  for (std::uint32_t c = 0; c < clusters; ++c) {
-    for (std::uint32_t at = s.bucket_start[c]; at < s.bucket_start[c + 1]; ++at) {
-      const std::uint32_t i = s.bucket_query[at];
-      const QueryView v = view_of(i);
-      if (s.batch_bound[i * stride + c] <= v.best.back().cost) visit_cluster(x, s, v, c);
-    }
+  for (const VisitPair& p : s.pairs) s.bucketed[s.bucket_fill[p.cluster]++] = p;
+  for (const VisitPair& p : s.bucketed) {
+    const QueryView v = view_of(p.query);
+    if (p.bound <= v.best.back().cost) visit_cluster(x, s, v, p.cluster);
   }
 }
 
@@ -620,9 +626,11 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
       start_query(x, s, v);
       float* bound = s.batch_bound.data() + i * stride;
       s.seed[i] = exact_bounds(x, s, v, bound);
-      if (s.seed[i] != kNoCluster && bound[s.seed[i]] <= v.best.back().cost) s.pairs.emplace_back(s.seed[i], i);
+      if (s.seed[i] != kNoCluster && bound[s.seed[i]] <= v.best.back().cost) {
+        s.pairs.push_back({s.seed[i], i, bound[s.seed[i]]});
+      }
     }
-    visit_grouped(x, s, local, stride);
+    visit_grouped(x, s, local);
 
     s.candidates.clear();
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -645,11 +653,11 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
             s.cursor[i] = s.candidate_end[i];  // sorted: the rest are above it too
             break;
           }
-          s.pairs.emplace_back(b.cluster, i);
+          s.pairs.push_back({b.cluster, i, b.bound});
         }
       }
       if (s.pairs.empty()) break;
-      visit_grouped(x, s, local, stride);
+      visit_grouped(x, s, local);
     }
   }
 }

@@ -39,8 +39,14 @@ struct Variant {
   const char* label;
   const char* backend;
   std::uint32_t nprobe = 4;
+  // The CPU backends' instruction set: fast-brute-avx2 runs the 256-bit
+  // kernels, the vector width lavapipe's lanes have (shared/LAVAPIPE.md),
+  // to tell the width's share of the Vulkan/CPU gap from the kernel's.
+  CpuKernels kernels = CpuKernels::Widest;
 };
-constexpr Variant kVariants[] = {{"fast-brute", "fast-brute"},           {"clusters", "clusters"},
+constexpr Variant kVariants[] = {{"fast-brute", "fast-brute"},
+                                 {"fast-brute-avx2", "fast-brute", 4, CpuKernels::Avx2},
+                                 {"clusters", "clusters"},
                                  {"vulkan-brute", "vulkan-brute"},       {"vulkan-clusters", "vulkan-clusters"},
                                  {"vulkan-nprobe4", "vulkan-nprobe", 4}, {"vulkan-nprobe16", "vulkan-nprobe", 16}};
 
@@ -106,6 +112,7 @@ Result<std::unique_ptr<SearchBackend>> make_variant(Setup& s, const Variant& var
   if (context != nullptr) MMVK_TRY(vulkan::add_backends(registry, *context));
   BackendSpec spec{.name = variant.backend, .pool = &s.pool, .clusters = &s.table};
   spec.nprobe = variant.nprobe;
+  spec.fast.kernels = variant.kernels;
   spec.max_batch = kQueries;
   spec.max_k = 1;
   return registry.make(spec, *s.db);

@@ -16,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -52,10 +53,17 @@ const std::vector<Variant>& variants() {
   return all;
 }
 
+// The pool's spin before its threads sleep: MMVK_BENCH_SPIN_US (tuning; 0
+// measures the pool as it was before it spun), else the library default.
+unsigned pool_spin_us() {
+  const char* spin = std::getenv("MMVK_BENCH_SPIN_US");
+  return spin == nullptr ? ThreadPool::kDefaultSpinMicroseconds : static_cast<unsigned>(std::strtoul(spin, nullptr, 10));
+}
+
 // Everything built for one database, once per process.
 struct Fixture {
   const Database* db = nullptr;
-  ThreadPool pool;  // all cores
+  ThreadPool pool{0, pool_spin_us()};  // all cores
   ClusterTable table;
   std::map<std::string, std::unique_ptr<SearchBackend>> backends;  // by Variant::label
   // Exact top-1 per (stream, batch), for recall.
@@ -112,9 +120,14 @@ Fixture* fixture(DataSet set) {
   return fixtures.emplace(set, std::move(f)).first->second.get();
 }
 
-// `singly`: the batch's queries are searched one at a time (B = 1 calls),
-// so the per-query figures compare with the batched row of the same B.
-void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& which, bool singly) {
+// How the batch's queries are searched: at once; one at a time (B = 1
+// calls back to back), so the per-query figures compare with the batched
+// row of the same B; or one at a time 1 ms apart, as a game issuing one
+// query per tick would (wall_us/q then times the calls only; the pool's
+// threads have gone to sleep between them).
+enum class Calls { Batch, Singly, Paced };
+
+void run(benchmark::State& state, DataSet set, QueryStream stream, const std::string& which, Calls calls) {
   Fixture* f = fixture(set);
   if (!f->db || !f->backends.count(which) || !f->backends.count("fast-brute")) {
     state.SkipWithError("database or backend unavailable (see stderr)");
@@ -136,15 +149,19 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, const std::st
   backend.reset_stats();
   const double cpu_start = process_cpu_seconds();
   const auto wall_start = std::chrono::steady_clock::now();
+  double paced_seconds = 0.0;  // Calls::Paced: inside the calls
   for (auto _ : state) {
-    if (singly) {
+    if (calls != Calls::Batch) {
       for (std::size_t q = 0; q < batch; ++q) {
         const std::size_t dims = f->db->dims();
         const QueryBatch one{.features = std::span<const float>(queries).subspan(q * dims, dims), .params = {}, .size = 1};
+        if (calls == Calls::Paced) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        const auto call_start = std::chrono::steady_clock::now();
         if (Status status = backend.search(one, 1, std::span<Match>(results).subspan(q, 1)); !status) {
           state.SkipWithError(status.message().c_str());
           return;
         }
+        paced_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - call_start).count();
       }
     } else if (Status status = backend.search(query_batch, 1, results); !status) {
       state.SkipWithError(status.message().c_str());
@@ -152,7 +169,9 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, const std::st
     }
     benchmark::DoNotOptimize(results.data());
   }
-  const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  const double wall_seconds = calls == Calls::Paced
+                                  ? paced_seconds
+                                  : std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const double cpu_seconds = process_cpu_seconds() - cpu_start;
   std::size_t hits = 0;
   for (std::size_t q = 0; q < batch; ++q) hits += results[q].frame == truth[q].frame;
@@ -178,13 +197,18 @@ const bool registered = [] {
       for (const Variant& variant : variants()) {
         const std::string name = std::string("real/") + std::string(data_set_name(set)) + "/" +
                                  std::string(query_stream_name(stream)) + "/" + variant.label;
-        auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, variant.label, false);
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), run, set, stream, variant.label, Calls::Batch);
         b->ArgName("B")->Arg(1)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
         if (variant.backend == "reference" && set != DataSet::Locomotion) b->Iterations(1);
         if (variant.label == "clusters" || variant.label == "clusters-per-query") {
           // B = 1 latency over the same queries as the B = 1024 row.
-          auto* singly = benchmark::RegisterBenchmark((name + "-singly").c_str(), run, set, stream, variant.label, true);
+          auto* singly =
+              benchmark::RegisterBenchmark((name + "-singly").c_str(), run, set, stream, variant.label, Calls::Singly);
           singly->ArgName("B")->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
+          // The same 1 ms apart: one pass takes over a second, so once.
+          auto* paced =
+              benchmark::RegisterBenchmark((name + "-paced").c_str(), run, set, stream, variant.label, Calls::Paced);
+          paced->ArgName("B")->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
         }
       }
     }

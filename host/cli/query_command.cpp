@@ -262,6 +262,16 @@ int run_query(Args args) {
   if (const auto out = parsed->value("--out")) {
     if (Status writable = check_writable(*out); !writable) return fail(writable.message());
   }
+  // A mistyped backend is reported before the database loads (seconds for
+  // a large one), in the words the registry would use.
+  const std::string backend_name = parsed->value("--backend").value_or(BackendSpec{}.name);
+  {
+    ContextHolder unused;
+    const BackendRegistry registry = query_backends(unused);
+    if (registry.find(backend_name) == nullptr) {
+      return fail("unknown backend '" + backend_name + "' (known: " + registry.names() + ")");
+    }
+  }
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db) return fail(db.message());
   std::vector<PoseTarget> pose_targets;
@@ -322,7 +332,6 @@ int run_query(Args args) {
   Result<std::unique_ptr<ThreadPool>> pool = ThreadPool::create(threads);
   if (!pool) return fail(pool.message());
   holder.pool = std::move(pool.value());
-  const std::string backend_name = parsed->value("--backend").value_or(BackendSpec{}.name);
   const Status made = make_backend(holder, *db, backend_name, *parsed, count, k);
   if (!made) return fail(made.message());
   std::vector<Match> results(count * k);

@@ -112,6 +112,13 @@ TEST_F(QueryCli, BadQueryFilesAreNamed) {
                                         " --backend nonsense");
   EXPECT_NE(bad_backend.exit_code, 0);
   EXPECT_NE(bad_backend.output.find("unknown backend 'nonsense'"), std::string::npos) << bad_backend.output;
+
+  // Named before the database is read: with a missing database as well, the
+  // backend is what the user hears about (no wait for a large load first).
+  const CommandResult before_load = run(mmvk_ + " query " + (dir_ / "missing.mmdb").string() + " --queries " +
+                                        write_queries(1, 27).string() + " --backend nonsense");
+  EXPECT_NE(before_load.exit_code, 0);
+  EXPECT_NE(before_load.output.find("unknown backend 'nonsense'"), std::string::npos) << before_load.output;
 }
 
 // --help lists the backend registry itself: every name a --backend accepts.

@@ -86,11 +86,12 @@ struct ClusterSearchOptions {
   bool batch_by_cluster = true;
   // Exact mode, B < threads: each query is split over the pool's threads
   // (tiles of the seed cluster and candidate clusters dealt out in turn,
-  // one shared k-th best for pruning). Off by default: on the shared 2-vCPU
-  // test machine (Bandai volume, 417k frames) a split query took 1.8-2.3x
-  // the CPU time and 2.5-4x the wall time of the query on the calling
-  // thread alone (waking the second thread costs more than it saves; see
-  // bench/RESULTS.md, issue 10). Worth trying where cores are idle.
+  // one shared k-th best for pruning). Off by default: on the 2-vCPU test
+  // machine (Bandai volume, 417k frames) B = 1 calls back to back ran 1.7x
+  // faster split, with the pool's workers still spinning, but calls 1 ms
+  // apart (a game's one query per tick) 1.2x slower, each paying for
+  // waking a sleeping worker (bench/RESULTS.md, issue 10). Worth it for
+  // bursts of single queries on otherwise idle cores.
   bool split_single = false;
   // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
   // AVX-512F (as FastSearchOptions::baseline_kernels; the same kernels).

@@ -5,11 +5,12 @@
 //
 // Hand-over: a worker that finished a chunk, and a caller waiting for the
 // workers, spin for a short while (spin_us) before they sleep on a condition
-// variable. Waking a sleeping thread took 34-50 µs per parallel_for on the
-// 2-vCPU test machine, as long as a whole query of the cluster search; a
-// spinning one picks the next call up in about a microsecond (see
-// bench/RESULTS.md, issue 10). The cost is at most spin_us of one core per
-// call when no call follows.
+// variable. Waking a sleeping thread took 46-52 µs per parallel_for on the
+// 2-vCPU test machine, longer than a whole query of the cluster search; a
+// spinning one picks the next call up in 0.4 µs, 3-4 µs with more threads
+// than cores (bench BM_ThreadPoolHandOver, bench/RESULTS.md, issue 10). The
+// cost is at most spin_us of each thread's core per call when no call
+// follows.
 #pragma once
 
 #include <algorithm>

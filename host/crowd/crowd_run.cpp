@@ -169,6 +169,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   std::vector<float> foot_xz(4 * std::size_t(agents));
   std::vector<std::uint8_t> contact(2 * std::size_t(agents));
   std::vector<std::uint32_t> searched_before, searched_now, frames_before(agents);
+  std::vector<std::uint8_t> kinds_before(agents, 0);  // controller.searched() of the tick before
   searched_before.reserve(agents), searched_now.reserve(agents);
   glm::vec3 horizon_pos[1];
   float horizon_yaw[1];
@@ -224,13 +225,14 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
     meter.add_transitions(controller.last_tick().jumps);
     meter.end_tick();
 
-    if (recorder) recorder->record_tick(t, matches, searched_before, frames_before);
+    if (recorder) recorder->record_tick(t, matches, searched_before, kinds_before, frames_before);
     searched_now.clear();
-    const auto flags = controller.searched();
+    const auto kinds = controller.searched();
     for (std::uint32_t b = 0; b < agents; ++b) {
-      if (flags[b]) searched_now.push_back(b);
+      if (kinds[b] != 0) searched_now.push_back(b);
     }
     searched_before.swap(searched_now);
+    std::copy(kinds.begin(), kinds.end(), kinds_before.begin());
     const auto frames = controller.frames();
     std::copy(frames.begin(), frames.end(), frames_before.begin());
     progress.tick(double(t + 1) * dt, controller.last_tick().searches, search_ms.back());

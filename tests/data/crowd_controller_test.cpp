@@ -70,6 +70,24 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   EXPECT_EQ(totals.applied, totals.searches);
   EXPECT_GT(totals.jumps, 50u);
   EXPECT_EQ(run->ticks[0].searches, test::kCrowdCharacters);  // placement forces a first search
+  // searched() tells the kinds apart: every first search is forced (2), and
+  // per tick its 1s and 2s add up to the tick's regular and forced counts.
+  const std::uint32_t n = test::kCrowdCharacters;
+  for (std::uint32_t b = 0; b < n; ++b) EXPECT_EQ(run->searched[b], 2) << "character " << b;
+  std::uint32_t regular_seen = 0;
+  for (std::size_t t = 0; t < run->ticks.size(); ++t) {
+    std::uint32_t regular = 0, forced = 0;
+    for (std::uint32_t b = 0; b < n; ++b) {
+      const std::uint8_t kind = run->searched[t * n + b];
+      ASSERT_LE(kind, 2) << "tick " << t << ", character " << b;
+      regular += kind == 1 ? 1u : 0u;
+      forced += kind == 2 ? 1u : 0u;
+    }
+    EXPECT_EQ(forced, run->ticks[t].forced) << "tick " << t;
+    EXPECT_EQ(regular + forced, run->ticks[t].searches) << "tick " << t;
+    regular_seen += regular;
+  }
+  EXPECT_GT(regular_seen, 0u);
   // Regular searches are spread: 50 characters, 0.1 s interval at 30 Hz is
   // 16.7 per tick.
   for (std::size_t t = 4; t < run->ticks.size(); ++t) {

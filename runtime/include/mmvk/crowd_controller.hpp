@@ -166,7 +166,10 @@ class CrowdController {
   std::span<const glm::vec3> root_positions() const { return root_pos_; }   // animated root, world, y = 0
   std::span<const float> root_yaws() const { return root_yaw_; }
   std::span<const SimulationState> simulation() const { return sim_; }      // simulated root
-  std::span<const std::uint8_t> searched() const { return searched_; }      // 1: searched this tick
+  // This tick's search of each character: 0 none, 1 a regular one (its
+  // timer ran out), 2 a forced one (placement, a clip's end, a sharp change
+  // of the desired velocity or yaw; ControllerParams' force_search_*).
+  std::span<const std::uint8_t> searched() const { return searched_; }
   std::span<const std::uint8_t> jumped() const { return jumped_; }          // 1: jumped this tick
   std::span<const float> match_costs() const { return match_cost_; }        // last applied match (inf: none)
   std::span<const std::uint8_t> contacts() const { return contacts_; }      // FootContact bits of the frame

@@ -378,7 +378,7 @@ void CrowdController::assemble(ThreadPool& pool) {
       predict_trajectory(sim_[b], desired_velocity_[b], desired_yaw_[b], params_.spring, offsets, positions, yaws);
       searched_velocity_[b] = desired_velocity_[b];
       searched_yaw_[b] = desired_yaw_[b];
-      searched_[b] = 1;
+      searched_[b] = due_flag_[b];  // 1 regular, 2 forced
       due_refs_[i] = QueryFrame{root_pos_[b], root_yaw_[b]};
       assembler_.assemble(frames_[b], due_refs_[i], positions, yaws,
                           std::span(queries_).subspan(i * dims, dims));

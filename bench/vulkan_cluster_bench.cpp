@@ -4,7 +4,8 @@
 // train_cluster_table(db, KMeansParams{}) (round(sqrt(N)) clusters).
 //
 // Counters: queries/s (kIsRate, end to end: submit to results in host
-// memory), kernel_ms (GPU time of the last batch from timestamps), rows
+// memory), kernel_ms (GPU time of the last batch from timestamps),
+// device_MiB (VulkanSearch::device_bytes(): all it allocated), rows
 // (fraction of the frames evaluated per query), recall@1 (the frame found
 // equals FastSearch brute force's exact frame; 1 for exact backends).
 //
@@ -156,6 +157,7 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, const Variant
   state.counters["recall@1"] = total == 0 ? 0.0 : double(hits) / double(total);
   if (auto* gpu = dynamic_cast<vulkan::VulkanSearch*>(backend.get()); gpu != nullptr) {
     state.counters["kernel_ms"] = gpu->last_kernel_seconds().value_or(0.0) * 1e3;
+    state.counters["device_MiB"] = double(gpu->device_bytes()) / double(1 << 20);
   }
 }
 

@@ -68,12 +68,6 @@ double tiled_copy_bytes(const Database& db) {
   return (tiles * kFastTileRows + 2.0 * tiles + 2.0 * groups) * db.dims() * sizeof(float);
 }
 
-// The Vulkan backend's database buffers (device_database.cpp): features
-// padded to vec4, 16 bytes of metadata and 8 of cost terms per frame.
-double vulkan_database_bytes(const Database& db) {
-  return double(db.frame_count()) * (double((db.dims() + 3) / 4) * 16.0 + 16.0 + 8.0);
-}
-
 }  // namespace
 
 const std::vector<std::string>& suite_method_names() {
@@ -157,9 +151,12 @@ struct SuiteMethodFactory::Shared {
     method.build_s += seconds_since(start);
     const bool device = backend.rfind("vulkan-", 0) == 0;
     if (device) {
-      method.device_bytes = vulkan_database_bytes(db) + method.index_bytes;
-      method.index_bytes = 0.0;  // the table was uploaded, the host keeps none
       method.vulkan = as_vulkan_search(*method.backend);
+      // What the backend allocated (VulkanSearch::device_bytes): the
+      // database, a cluster mode's table and rows in cluster order, and
+      // the slots' scratch, which the cluster modes size for the worst case.
+      if (method.vulkan != nullptr) method.device_bytes = double(method.vulkan->device_bytes());
+      method.index_bytes = 0.0;  // the table was uploaded, the host keeps none
     } else if (backend != "reference") {
       method.index_bytes += tiled_copy_bytes(db);
     }

@@ -39,7 +39,7 @@ struct SuiteMethod {
   bool exact = false;
   double build_s = 0.0;       // index build (training, copies, upload), seconds
   double index_bytes = 0.0;   // host bytes beyond the database's feature matrix
-  double device_bytes = 0.0;  // device buffers (database, cluster arrays)
+  double device_bytes = 0.0;  // VulkanSearch::device_bytes(): database, tables, slots' scratch
   vulkan::VulkanSearch* vulkan = nullptr;  // for kernel timestamps
 };
 

@@ -238,6 +238,43 @@ TEST(VulkanClusterSearch, BuildsOnlyItsModesKernels) {
   }
 }
 
+// device_bytes() counts what a search allocated: at least the database's
+// features (dims padded to 4 floats), the cluster modes their second,
+// cluster-ordered copy of the rows on top, and each slot the same amount
+// (slots 1, 2 and 3 step by a constant that grows with the cluster
+// scratch budget).
+TEST(VulkanClusterSearch, DeviceBytesCountTheDatabaseTablesAndSlots) {
+  MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
+  const Database db = synthetic_database({.frames = 3000, .seed = 71});
+  ClusterTableCache tables;
+  Result<const ClusterTable*> table = tables.table_for(db);
+  ASSERT_TRUE(table.ok()) << table.message();
+  const std::uint64_t feature_bytes = std::uint64_t{db.frame_count()} * ((db.dims() + 3) / 4) * 16;
+  const auto bytes_of = [&](vulkan::SearchMode mode, std::uint32_t slots, std::uint64_t cluster_scratch) {
+    vulkan::VulkanSearchOptions options;
+    options.warm_up = false;
+    options.mode = mode;
+    options.slots = slots;
+    options.max_batch = 64;
+    options.cluster_scratch_bytes = cluster_scratch;
+    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
+    EXPECT_TRUE(gpu.ok()) << gpu.message();
+    return gpu.ok() ? (*gpu)->device_bytes() : 0;
+  };
+  const std::uint64_t brute = bytes_of(vulkan::SearchMode::BruteForce, 1, 1u << 20);
+  const std::uint64_t clusters[] = {bytes_of(vulkan::SearchMode::ClustersExact, 1, 1u << 20),
+                                    bytes_of(vulkan::SearchMode::ClustersExact, 2, 1u << 20),
+                                    bytes_of(vulkan::SearchMode::ClustersExact, 3, 1u << 20)};
+  EXPECT_GE(brute, feature_bytes + std::uint64_t{db.frame_count()} * (16 + 8));
+  EXPECT_GE(clusters[0], 2 * feature_bytes);
+  const std::uint64_t per_slot = clusters[1] - clusters[0];
+  EXPECT_GT(per_slot, 0u);
+  EXPECT_EQ(clusters[2] - clusters[1], per_slot);
+  // A larger scratch budget holds more queries per chunk: more per slot.
+  const std::uint64_t roomy = bytes_of(vulkan::SearchMode::ClustersExact, 1, 64u << 20);
+  EXPECT_GT(roomy, clusters[0]);
+}
+
 TEST(VulkanClusterSearch, CreationErrors) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 1000, .seed = 59});

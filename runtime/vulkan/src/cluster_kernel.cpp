@@ -341,6 +341,21 @@ std::vector<std::uint32_t> ClusterKernel::k_classes() const {
   return classes;
 }
 
+std::uint64_t ClusterKernel::device_bytes() const {
+  std::uint64_t bytes = 0;
+  for (const TexelBuffer* table : {&member_meta_, &member_rows_, &member_cost_, &block_info_, &cluster_info_,
+                                   &cluster_vectors_, &block_vectors_}) {
+    bytes += table->buffer.size;
+  }
+  for (const SlotScratch& slot : slots_) {
+    for (const Buffer* buffer : {&slot.bound_keys, &slot.states, &slot.block_pairs, &slot.scan_dispatch,
+                                 &slot.work_items, &slot.listed, &slot.block_sort}) {
+      bytes += buffer->size;
+    }
+  }
+  return bytes;
+}
+
 std::vector<std::string_view> ClusterKernel::kernel_names() const {
   std::vector<std::string_view> names = {"cluster_bounds", "cluster_select", "cluster_sort", "cluster_sort",
                                          "cluster_sort"};

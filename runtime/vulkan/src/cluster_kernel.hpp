@@ -67,6 +67,10 @@ class ClusterKernel {
   Status record(const Context& context, VkCommandBuffer commands, std::uint32_t slot, VkDescriptorSet search_set,
                 std::uint32_t batch, std::uint32_t k) const;
 
+  // Bytes of the buffers it allocated: the uploaded table (member rows in
+  // cluster order, blocks, boxes) and every slot's scratch.
+  std::uint64_t device_bytes() const;
+
   // Rows evaluated by the last search recorded into `slot` (read after its
   // fence signalled).
   std::uint64_t rows_evaluated(std::uint32_t slot, std::uint32_t batch) const;

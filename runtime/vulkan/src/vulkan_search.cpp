@@ -324,6 +324,16 @@ std::uint32_t VulkanSearch::workgroup_size() const { return impl_->shape.workgro
 
 Status VulkanSearch::warm_up() { return impl_->warm_up(); }
 
+std::uint64_t VulkanSearch::device_bytes() const {
+  const DeviceDatabase& db = impl_->device_database;
+  std::uint64_t bytes = db.features.buffer.size + db.frame_meta.buffer.size + db.frame_cost.buffer.size;
+  for (const Slot& slot : impl_->slots) {
+    bytes += slot.queries.size + slot.params.size + slot.weights.size + slot.scratch.size + slot.results.size;
+  }
+  if (impl_->clusters) bytes += impl_->clusters->device_bytes();
+  return bytes;
+}
+
 std::vector<std::string_view> VulkanSearch::kernels() const {
   std::vector<std::string_view> names;
   if (impl_->brute) names = impl_->brute->kernel_names();

@@ -126,6 +126,14 @@ class VulkanSearch final : public SearchBackend {
   // builds no brute-force kernel), all of which warm_up() dispatches.
   std::vector<std::string_view> kernels() const;
 
+  // Bytes of the buffers this search allocated through Vulkan: the database
+  // (features, metadata, cost terms), a cluster mode's table (its rows again,
+  // in cluster order, with blocks and boxes) and, per slot, the query,
+  // scratch and result buffers (the cluster modes' scratch is sized by
+  // cluster_scratch_bytes for the worst case). The driver's own memory
+  // (pipelines, descriptor pools, command buffers) is not counted.
+  std::uint64_t device_bytes() const;
+
   // GPU time of the last waited-for submit from timestamp queries, seconds;
   // nullopt when the queue has no timestamps.
   std::optional<double> last_kernel_seconds() const;

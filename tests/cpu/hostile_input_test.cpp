@@ -6,13 +6,17 @@
 #include <sys/resource.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
 #include "mmvk/bvh.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/motion.hpp"
 #include "mmvk/reference_search.hpp"
@@ -91,6 +95,29 @@ TEST(HostileClusterTable, ZeroClustersIsAnError) {
   Result<ClusterTable> loaded = load_cluster_table(path);
   ASSERT_FALSE(loaded.ok());
   EXPECT_TRUE(contains(loaded.message(), "cluster_count is 0")) << loaded.message();
+  EXPECT_TRUE(contains(loaded.message(), path.string())) << loaded.message();
+}
+
+// Fuzz finding (fuzz_cluster_table): a header of 0xFFFFFFFF clusters, dims
+// and channels made the loader's file-size formula wrap around 2^64 to the
+// file's own 160 bytes, and the arrays were then allocated at those counts
+// (std::length_error, an abort). The input is the finding, with its
+// checksum repaired as the fuzz target does.
+TEST(HostileClusterTable, HeaderCountsBeyondTheFileAreAnError) {
+  const std::filesystem::path finding =
+      test::test_source_dir() / "corpus" / "fuzz_cluster_table" / "size_formula_overflow.mmkc";
+  std::ifstream in(finding, std::ios::binary);
+  std::string bytes(std::istreambuf_iterator<char>(in), {});
+  ASSERT_EQ(bytes.size(), 160u) << finding;
+  Hasher hasher;
+  hasher.add_bytes(bytes.data(), bytes.size() - 8);
+  const std::uint64_t digest = hasher.digest();
+  std::memcpy(bytes.data() + bytes.size() - 8, &digest, 8);
+  const std::filesystem::path path = test::make_temp_dir() / "overflow.mmkc";
+  std::ofstream(path, std::ios::binary) << bytes;
+  Result<ClusterTable> loaded = load_cluster_table(path);
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_TRUE(contains(loaded.message(), "header counts")) << loaded.message();
   EXPECT_TRUE(contains(loaded.message(), path.string())) << loaded.message();
 }
 

@@ -133,7 +133,21 @@ Result<ClusterTable> load_cluster_table(const std::filesystem::path& path) {
   t.channel_count = reader.get<std::uint32_t>();
   const auto frames = reader.get<std::uint32_t>();
   if (t.cluster_count == 0) return make_error(where + "cluster_count is 0 (a table needs at least one cluster)");
-  // 64-bit arithmetic on 32-bit counts cannot overflow.
+  // Every array element takes at least 4 bytes, so no count, nor the
+  // products clusters x dims and clusters x channels, can exceed a quarter
+  // of the file. Checked first, by division: the size formula below
+  // multiplies counts, and a header of large counts once wrapped it around
+  // to the file's own size (a fuzz finding, tests/corpus/fuzz_cluster_table).
+  const std::uint64_t quarter = bytes.size() / 4;
+  if (t.cluster_count > quarter || frames > quarter || t.dims > quarter || t.channel_count > quarter ||
+      (t.dims != 0 && t.cluster_count > quarter / t.dims) ||
+      (t.channel_count != 0 && t.cluster_count > quarter / t.channel_count)) {
+    return make_error(where + "header counts (" + std::to_string(t.cluster_count) + " clusters, " +
+                      std::to_string(t.dims) + " dims, " + std::to_string(t.channel_count) + " channels, " +
+                      std::to_string(frames) + " frames) need more than the file's " +
+                      std::to_string(bytes.size()) + " bytes (truncated or corrupted)");
+  }
+  // With the counts so bounded the sum below stays far below 2^64.
   const std::uint64_t k = t.cluster_count;
   const std::uint64_t kd = k * t.dims;
   const std::uint64_t expected = kHeaderSize + kd * 4 + (k + 1) * 4 + std::uint64_t{frames} * 4 + kd * 8 + k * 8 +

@@ -208,10 +208,13 @@ std::string read_animation(Reader& in, AnimationData& a) {
   a.encoding = static_cast<RotationEncoding>(encoding);
   const std::uint64_t frames = a.frame_count;
   const std::uint64_t rotation_bytes = a.encoding == RotationEncoding::Float32 ? 16 : 8;
-  const std::uint64_t need = frames * (joints * rotation_bytes + translated * 12 + 8 + 4 + 1);
-  if (need != in.left()) {
-    return "animation of " + std::to_string(frames) + " frames needs " + std::to_string(need) + " bytes, " +
-           std::to_string(in.left()) + " are left";
+  // joints and translated are bounded by the bytes left, so per_frame fits;
+  // frames is compared by division first, so frames * per_frame cannot wrap
+  // around 2^64 to the bytes left (as a cluster table header once did).
+  const std::uint64_t per_frame = joints * rotation_bytes + translated * 12 + 8 + 4 + 1;
+  if (frames > in.left() / per_frame || frames * per_frame != in.left()) {
+    return "animation of " + std::to_string(frames) + " frames of " + std::to_string(per_frame) +
+           " bytes each does not fill the " + std::to_string(in.left()) + " bytes left";
   }
   a.local_rotations.resize(frames * joints);
   for (glm::quat& q : a.local_rotations) {
@@ -388,7 +391,8 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
   // Version 1 ends with the features; version 2 adds a presence byte and
   // the optional animation section.
   const std::uint64_t after = version == 1 ? 0 : 1;
-  if (values * 4 + after > in.left() || (version == 1 && values * 4 != in.left())) {
+  // values > left / 4 first: values * 4 alone could wrap for a multi-GiB file.
+  if (values > in.left() / 4 || values * 4 + after > in.left() || (version == 1 && values * 4 != in.left())) {
     return corrupt("feature matrix of " + std::to_string(frames) + " x " + std::to_string(dims) + " floats needs " +
                    std::to_string(values * 4) + " bytes, " + std::to_string(in.left()) + " are left");
   }

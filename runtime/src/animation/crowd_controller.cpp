@@ -11,8 +11,6 @@ namespace mmvk {
 
 namespace {
 
-const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
-
 // Rotates a character-space vector by yaw into the world (R_y(yaw) * v).
 glm::vec3 yaw_rotate(const glm::vec3& v, float yaw) {
   const float c = std::cos(yaw);

@@ -32,8 +32,9 @@ template <> struct MaskOf<V16> { using type = std::int32_t __attribute__((vector
 #define MMVK_INLINE inline __attribute__((always_inline))
 
 // The helpers below take and return vectors but are always inlined into
-// this file's entry points, so the ABI note GCC gives for them is moot.
-#if defined(__GNUC__) && !defined(__clang__)
+// this file's entry points, so the ABI note GCC and Clang give for them is
+// moot.
+#if defined(__GNUC__) || defined(__clang__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
@@ -222,7 +223,19 @@ MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t first_pack, std::s
   }
 
 MMVK_DEFINE_KERNELS(generic, V4)
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#if defined(__x86_64__) && defined(__clang__)
+// Clang ignores GCC's target pragmas (the kernels would be built for SSE2
+// and only named avx2 / avx512f); its own pragma sets the target of every
+// function defined in the region, and the always-inline helpers take it
+// on when inlined there.
+#define MMVK_HAS_X86_KERNELS 1
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+MMVK_DEFINE_KERNELS(avx2, V8)
+#pragma clang attribute pop
+#pragma clang attribute push(__attribute__((target("avx512f"))), apply_to = function)
+MMVK_DEFINE_KERNELS(avx512, V16)
+#pragma clang attribute pop
+#elif defined(__x86_64__) && defined(__GNUC__)
 #define MMVK_HAS_X86_KERNELS 1
 #pragma GCC push_options
 #pragma GCC target("avx2")

@@ -400,8 +400,9 @@ void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
 // Rules out (NaN: never <= any threshold) each cluster of bound[] that
 // query `params` cannot take a frame from, and turns a bound that overflowed
 // to NaN into -inf (it proves nothing: visited first). Returns the number
-// of eligible clusters. The loops are branch-free so that they vectorize:
-// they run for every query over every cluster.
+// of eligible clusters. It runs for every query over every cluster, so the
+// common case (no tag rules) is a branch-free loop that vectorizes; queries
+// with tag rules take cluster_eligible() per cluster.
 std::uint32_t mark_ineligible(const ClusterSearch::Layout& l, const QueryParams& params, float* bound) {
   const ClusterTable& t = l.table;
   const std::uint32_t n = t.cluster_count;
@@ -423,8 +424,7 @@ std::uint32_t mark_ineligible(const ClusterSearch::Layout& l, const QueryParams&
   }
   std::uint32_t eligible = 0;
   for (std::uint32_t c = 0; c < n; ++c) {
-    const bool ok = never[c] == 0 && (t.tag_union[c] & params.require_all) == params.require_all &&
-                    (t.tag_intersection[c] & params.exclude_any) == 0;
+    const bool ok = cluster_eligible(l, params, c);
     const float b = std::isnan(bound[c]) ? kMinusInfinity : bound[c];
     bound[c] = ok ? b : kNaN;
     eligible += ok ? 1u : 0u;

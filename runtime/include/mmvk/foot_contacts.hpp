@@ -9,10 +9,17 @@
 
 namespace mmvk {
 
-// Contact bits of AnimationData::contacts.
+// Contact bits of AnimationData::contacts. kContactLeft / kContactRight say
+// the foot is planted (what the foot_contact channel and foot locking read);
+// the heel and toe bits say which of its points touch the ground, where the
+// skeleton has both (the heel is the ankle joint, the toe the ball of the foot).
 enum FootContact : std::uint8_t {
   kContactLeft = 1u << 0,
   kContactRight = 1u << 1,
+  kContactLeftHeel = 1u << 2,
+  kContactLeftToe = 1u << 3,
+  kContactRightHeel = 1u << 4,
+  kContactRightToe = 1u << 5,
 };
 
 // How foot contacts are detected at build time. A foot is in contact on a

@@ -20,6 +20,9 @@ constexpr const char* kCrowdUsage =
     "usage: mmvk crowd [--data DIR|manifest.json|db.mmdb] [--agents N] [--seconds S] [--rate HZ]\n"
     "                  [--search-interval S] [--backend NAME] [--device N] [--seed N]\n"
     "                  [--scenario file.json] [--summary out.json] [--html out.html]\n"
+    "                  [--foot-ik on|off] [--continuing-bias B] [--continuing-multiplier M]\n"
+    "                  [--exclusion-window N] [--weights CHANNEL=W,...]\n"
+    "                  [--trace FILE] [--trace-agents M]\n"
     "\n"
     "Simulates a crowd on a ground plane: each character walks to its goals, steered\n"
     "(seek + separation on a uniform grid) at speeds measured in the database, and is\n"
@@ -31,21 +34,37 @@ constexpr const char* kCrowdUsage =
     "                        (or ~/.cache/mmvk)\n"
     "  --agents N            characters (default 1000; with --scenario, its count)\n"
     "  --seconds S           simulated time (default 10)\n"
-    "  --rate HZ             simulation ticks per second (default 30)\n"
+    "  --rate HZ             simulation ticks per second (default 30; any rate: poses are\n"
+    "                        interpolated between database frames)\n"
     "  --search-interval S   seconds between a character's regular searches (default 0.1)\n"
     "  --backend NAME        the search backend (default vulkan-brute, on the best device)\n"
     "  --device N            the Vulkan device index (default: the best one)\n"
     "  --seed N              the random scenario's seed (default 1)\n"
     "  --scenario FILE       starts, goals, speeds and tags from JSON (see host/crowd/scenario.hpp)\n"
     "  --summary FILE        write the run's figures as JSON\n"
-    "  --html FILE           write the viewer: one self-contained page\n";
+    "  --html FILE           write the viewer: one self-contained page\n"
+    "  --foot-ik on|off      lock planted feet where they touched down, legs solved by\n"
+    "                        two-bone IK (default on)\n"
+    "  --continuing-bias B   added to the cost of the frame a character would play anyway\n"
+    "                        (default -1: a jump must win by 1)\n"
+    "  --continuing-multiplier M  multiplies that frame's cost first (finite, >= 0; default 1)\n"
+    "  --exclusion-window N  frames within N of that frame in its clip are no candidates\n"
+    "                        (default 0)\n"
+    "  --weights CHANNEL=W,...  reweigh schema channels for every search (W >= 0)\n"
+    "  --trace FILE          write the displayed world joint positions of the first\n"
+    "                        --trace-agents characters every tick: float32 x, y, z per\n"
+    "                        joint, [ticks x agents x joints], and FILE.json beside it\n"
+    "                        (joint names, parents, tick rate, contacts, foot locks)\n"
+    "  --trace-agents M      characters in the trace (default 1)\n";
 
 }  // namespace
 
 int run_crowd(Args args, const char* argv0) {
   const auto parsed = parse_args("crowd", args,
                                  {"--data", "--agents", "--seconds", "--rate", "--search-interval", "--backend",
-                                  "--device", "--seed", "--scenario", "--summary", "--html"},
+                                  "--device", "--seed", "--scenario", "--summary", "--html", "--foot-ik",
+                                  "--continuing-bias", "--continuing-multiplier", "--exclusion-window", "--weights",
+                                  "--trace", "--trace-agents"},
                                  {"--help", "-h"});
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
@@ -88,6 +107,38 @@ int run_crowd(Args args, const char* argv0) {
   if (const auto v = parsed->value("--scenario")) options.scenario = *v;
   if (const auto v = parsed->value("--summary")) options.summary = *v;
   if (const auto v = parsed->value("--html")) options.html = *v;
+  if (const auto v = parsed->value("--foot-ik")) {
+    if (*v != "on" && *v != "off") return fail("--foot-ik expects on or off, got '" + *v + "'");
+    options.foot_ik = *v == "on";
+  }
+  if (const auto v = parsed->value("--continuing-bias")) {
+    Result<float> bias = parse_float("--continuing-bias", *v);
+    if (!bias) return fail(bias.message());
+    options.continuing_bias = *bias;
+  }
+  if (const auto v = parsed->value("--continuing-multiplier")) {
+    Result<float> multiplier = parse_float("--continuing-multiplier", *v);
+    if (!multiplier) return fail(multiplier.message());
+    if (*multiplier < 0.0f) return fail("--continuing-multiplier must be >= 0, got '" + *v + "'");
+    options.continuing_multiplier = *multiplier;
+  }
+  if (const auto v = parsed->value("--exclusion-window")) {
+    Result<std::uint32_t> window = parse_u32("--exclusion-window", *v);
+    if (!window) return fail(window.message());
+    options.exclusion_window = *window;
+  }
+  if (const auto v = parsed->value("--weights")) {
+    Result<std::vector<std::pair<std::string, float>>> weights = parse_weight_list("--weights", *v);
+    if (!weights) return fail(weights.message());
+    options.weights = std::move(*weights);
+  }
+  if (const auto v = parsed->value("--trace")) options.trace = *v;
+  if (const auto v = parsed->value("--trace-agents")) {
+    if (!options.trace) return fail("--trace-agents needs --trace FILE");
+    Result<std::uint32_t> traced = parse_u32("--trace-agents", *v, 1);
+    if (!traced) return fail(traced.message());
+    options.trace_agents = *traced;
+  }
   std::error_code ec;
   if (argv0) options.executable = std::filesystem::canonical("/proc/self/exe", ec);
   if (ec || options.executable.empty()) options.executable = argv0 ? argv0 : "";
@@ -111,6 +162,7 @@ int run_crowd(Args args, const char* argv0) {
     if (Status written = crowd::write_summary(s, *options.summary); !written) return fail(written.message());
     std::fprintf(stderr, "mmvk crowd: summary written to %s\n", options.summary->string().c_str());
   }
+  if (options.trace) std::fprintf(stderr, "mmvk crowd: trace written to %s\n", options.trace->string().c_str());
   if (options.html) {
     const auto absolute = std::filesystem::absolute(*options.html, ec);
     std::fprintf(stderr, "mmvk crowd: the viewer is at %s (%.1f MB): open it in a browser\n",

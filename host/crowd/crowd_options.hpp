@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mmvk::crowd {
 
@@ -20,6 +22,16 @@ struct CrowdOptions {
   std::optional<std::filesystem::path> scenario;
   std::optional<std::filesystem::path> summary;
   std::optional<std::filesystem::path> html;
+  // Motion matching controls: none keeps the crowd's defaults (crowd_run.cpp).
+  std::optional<float> continuing_bias;
+  std::optional<float> continuing_multiplier;
+  std::optional<std::uint32_t> exclusion_window;
+  std::vector<std::pair<std::string, float>> weights;  // schema channel name -> weight
+  bool foot_ik = true;                                  // lock planted feet with two-bone IK
+  // The displayed joint positions of the first trace_agents characters,
+  // every tick (trace.hpp).
+  std::optional<std::filesystem::path> trace;
+  std::uint32_t trace_agents = 1;
   // Set by the command line, not by flags.
   std::filesystem::path executable;           // for the shipped data beside an installed binary
   std::filesystem::path cache_dir;            // empty: never cache

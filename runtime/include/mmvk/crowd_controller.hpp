@@ -30,7 +30,9 @@
 //      same_location_window of its time in the same clip; a jump plays on
 //      from the matched frame and starts an inertialization (pose_batch.hpp);
 //   7. correct: the animated root is pulled toward the simulated root with a
-//      bounded correction (ControllerParams).
+//      bounded correction (ControllerParams); then foot locking holds planted
+//      feet on the ground through two-bone IK (foot_locker.hpp): the
+//      displayed pose.
 // Deferred form tick(dt, input, async, pool): steps 5-6 split: the batch is
 // submitted in step 5 and its results are applied at the start of the next
 // tick (one tick of latency), so a GPU search overlaps the caller's work.
@@ -40,6 +42,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -48,6 +51,7 @@
 
 #include "mmvk/animation_data.hpp"
 #include "mmvk/database.hpp"
+#include "mmvk/foot_locker.hpp"
 #include "mmvk/pose_batch.hpp"
 #include "mmvk/query_assembly.hpp"
 #include "mmvk/root_history.hpp"
@@ -88,6 +92,11 @@ struct ControllerParams {
   // the same motion without a blend (Motion Symphony's "same location"
   // rule). >= 0; 0 suppresses only the continuing frame.
   float same_location_window = 0.2f;
+  // Foot locking: planted feet held where they touched down, legs solved by
+  // two-bone IK on the displayed pose (foot_locker.hpp). Its bones are the
+  // roles @hips, @left_/@right_upper_leg, _lower_leg, _foot and _toe;
+  // enabled = false lets a skeleton without them through.
+  FootIkParams foot_ik;
 };
 
 // Per-tick input, [B] each.
@@ -201,10 +210,13 @@ class CrowdController {
   // Foot locking (ControllerParams::foot_ik), per character and foot
   // (left, right), [B x 2]: 1 while the foot is held where it was planted;
   // the world position it is held at (metres); 1 when the leg could not
-  // reach its target this tick and was soft-clamped.
-  std::span<const std::uint8_t> foot_locked() const { return foot_locked_; }
-  std::span<const glm::vec3> foot_anchors() const { return foot_anchors_; }
-  std::span<const std::uint8_t> ik_reach_clamped() const { return ik_clamped_; }
+  // reach its target this tick and was soft-clamped. All 0 with foot IK off.
+  std::span<const std::uint8_t> foot_locked() const;
+  std::span<const glm::vec3> foot_anchors() const;
+  std::span<const std::uint8_t> ik_reach_clamped() const;
+  // The locker itself (hip drops, corrections), or null with foot IK off
+  // on a skeleton without legs.
+  const FootLocker* foot_locker() const { return locker_ ? &*locker_ : nullptr; }
 
  private:
   CrowdController() = default;
@@ -222,6 +234,9 @@ class CrowdController {
   // The measurements of b's animated pose that queries read: its joint
   // positions, joint velocities and yaw rate; `fresh`: no previous tick.
   void measure_shown(std::uint32_t b, float dt, bool fresh);
+  // b's displayed pose: the animated one with its feet locked (foot IK),
+  // and its world joint positions.
+  void display(std::uint32_t b, float dt);
   // Pulls b's animated root toward its simulated root (step 7).
   void correct_root(std::uint32_t b, float dt, float correction);
   // b's match `to` is close enough to its time to play on instead.
@@ -268,8 +283,10 @@ class CrowdController {
   std::vector<glm::vec3> velocity_world_;     // [B x V] world positions of the assembler's velocity joints
   std::vector<glm::vec3> joint_velocities_;   // [B x V] their velocities, character space
   std::vector<std::uint8_t> fresh_;           // [B] placed since the last tick: no velocities yet
-  std::vector<std::uint8_t> foot_locked_, ik_clamped_;  // [B x 2]
-  std::vector<glm::vec3> foot_anchors_;                 // [B x 2]
+  std::optional<FootLocker> locker_;
+  std::vector<glm::vec3> world_;              // [B x joints] displayed world joint positions
+  std::vector<std::uint8_t> no_feet_flags_;   // [B x 2] zeros, without a locker
+  std::vector<glm::vec3> no_feet_anchors_;    // [B x 2]
 
   // The batch, [B] capacity.
   std::vector<std::uint32_t> due_;       // characters in the batch, ascending

@@ -79,6 +79,10 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   }
   Result<QueryAssembler> assembler = QueryAssembler::create(database);
   if (!assembler.ok()) return make_error("crowd controller: " + assembler.message());
+  Result<FootLocker> locker = FootLocker::create(*animation, characters, params.foot_ik);
+  if (!locker.ok() && params.foot_ik.enabled) {
+    return make_error("crowd controller: " + locker.message() + " (foot_ik.enabled = false runs without foot locking)");
+  }
 
   CrowdController c;
   c.database_ = &database;
@@ -128,9 +132,10 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.velocity_world_.assign(n * velocity_joints, glm::vec3(0.0f));
   c.joint_velocities_.assign(n * velocity_joints, glm::vec3(0.0f));
   c.fresh_.assign(n, 1);
-  c.foot_locked_.assign(2 * n, 0);
-  c.ik_clamped_.assign(2 * n, 0);
-  c.foot_anchors_.assign(2 * n, glm::vec3(0.0f));
+  if (locker.ok()) c.locker_ = std::move(*locker);
+  c.world_.resize(n * c.joints_);
+  c.no_feet_flags_.assign(2 * n, 0);
+  c.no_feet_anchors_.assign(2 * n, glm::vec3(0.0f));
   c.past_pos_.resize(n * past.size());
   c.past_yaw_.resize(n * past.size());
   for (std::uint32_t b = 0; b < characters; ++b) MMVK_TRY(c.place(b, glm::vec3(0.0f), 0.0f, 0));
@@ -172,9 +177,9 @@ Status CrowdController::place(std::uint32_t b, const glm::vec3& position, float 
   const std::size_t base = std::size_t{b} * joints_;
   sample_pose(*animation_, frame, std::span(anim_rotations_).subspan(base, joints_),
               std::span(anim_translations_).subspan(base, joints_));
-  std::copy_n(anim_rotations_.begin() + std::ptrdiff_t(base), joints_, rotations_.begin() + std::ptrdiff_t(base));
-  std::copy_n(anim_translations_.begin() + std::ptrdiff_t(base), joints_, translations_.begin() + std::ptrdiff_t(base));
   measure_shown(b, 0.0f, true);
+  if (locker_) locker_->reset(b);
+  display(b, 0.0f);
   return {};
 }
 
@@ -298,8 +303,7 @@ void CrowdController::play(std::uint32_t b, float dt, const CrowdInput& input, f
   const std::uint32_t nearest = nearest_frame(database, step.time);
   contacts_[b] = animation.contacts[nearest];
   measure_shown(b, dt, fresh_[b] != 0);
-  std::copy(rotations.begin(), rotations.end(), rotations_.begin() + std::ptrdiff_t(base));
-  std::copy(translations.begin(), translations.end(), translations_.begin() + std::ptrdiff_t(base));
+  display(b, dt);
 
   // 3. decide.
   search_timer_[b] -= dt;
@@ -366,6 +370,34 @@ void CrowdController::measure_shown(std::uint32_t b, float dt, bool fresh) {
     last = world;
   }
   fresh_[b] = fresh && !(dt > 0.0f) ? 1 : 0;
+}
+
+void CrowdController::display(std::uint32_t b, float dt) {
+  const std::size_t base = std::size_t{b} * joints_;
+  const auto at = [base](auto& v) { return v.begin() + std::ptrdiff_t(base); };
+  std::copy_n(at(anim_rotations_), joints_, at(rotations_));
+  std::copy_n(at(anim_translations_), joints_, at(translations_));
+  const std::span<glm::quat> rotations(rotations_.data() + base, joints_);
+  const std::span<glm::vec3> translations(translations_.data() + base, joints_);
+  const std::span<glm::vec3> world(world_.data() + base, joints_);
+  if (locker_) {
+    locker_->update(b, dt, contacts_[b], root_pos_[b], root_yaw_[b], rotations, translations, world);
+  } else {
+    forward_kinematics_batch(animation_->skeleton, rotations, translations, {&root_pos_[b], 1}, {&root_yaw_[b], 1},
+                             world);
+  }
+}
+
+std::span<const std::uint8_t> CrowdController::foot_locked() const {
+  return locker_ ? locker_->locked() : std::span<const std::uint8_t>(no_feet_flags_);
+}
+
+std::span<const glm::vec3> CrowdController::foot_anchors() const {
+  return locker_ ? locker_->anchors() : std::span<const glm::vec3>(no_feet_anchors_);
+}
+
+std::span<const std::uint8_t> CrowdController::ik_reach_clamped() const {
+  return locker_ ? locker_->reach_clamped() : std::span<const std::uint8_t>(no_feet_flags_);
 }
 
 void CrowdController::begin(float dt, const CrowdInput& input, ThreadPool& pool) {
@@ -583,8 +615,9 @@ Status CrowdController::tick(float dt, const CrowdInput& input, AsyncSearch& sea
   return {};
 }
 
-void CrowdController::world_positions(std::span<glm::vec3> out, ThreadPool& pool) const {
-  forward_kinematics_batch(animation_->skeleton, rotations_, translations_, root_pos_, root_yaw_, out, &pool);
+void CrowdController::world_positions(std::span<glm::vec3> out, ThreadPool&) const {
+  // Written by display() each tick (the locker computes them anyway).
+  std::copy(world_.begin(), world_.end(), out.begin());
 }
 
 void CrowdController::animated_world_positions(std::span<glm::vec3> out, ThreadPool& pool) const {

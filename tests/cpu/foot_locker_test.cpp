@@ -142,6 +142,15 @@ Pose walk_pose(const AnimationData& a, float t) {
   return pose;
 }
 
+// Both feet flat on the ground, as a fifth into the walk's stance.
+Pose standing_pose(const AnimationData& a) {
+  Pose pose = rest_pose(a, kHipsHeight);
+  for (int side = 0; side < 2; ++side) {
+    pose_leg(a, side, stance_foot(side == 0 ? 0.1f : -0.1f, 0.2f).ankle, 0.0f, pose);
+  }
+  return pose;
+}
+
 // The root at time t: 1 m/s along its facing, turning at `turn` rad/s.
 void walk_root(float t, float turn, glm::vec3& position, float& yaw) {
   yaw = turn * t;
@@ -349,6 +358,37 @@ TEST(FootLocker, FootKeepsItsAnimatedOrientationTurnedByTheYawCorrection) {
   EXPECT_GT(largest_yaw, 0.1f);  // the turning root made the lock turn the feet
 }
 
+TEST(FootLocker, YawCorrectionStopsAtItsLimitAndTheFootPivotsInPlace) {
+  // The root turns 1.2 rad in place over a still pose with the left toe
+  // planted: the foot's heading is held for max_yaw_correction, then the foot
+  // turns with the body about its toe, which never leaves its anchor.
+  const AnimationData a = make_skeleton();
+  FootIkParams params;
+  params.max_yaw_correction = 0.4f;
+  Result<FootLocker> locker = FootLocker::create(a, 1, params);
+  ASSERT_TRUE(locker.ok()) << locker.message();
+  const Pose still = standing_pose(a);
+  const float dt = 1.0f / 60.0f;
+  std::vector<glm::vec3> world(a.joint_count());
+  glm::vec3 anchor(0.0f);
+  float previous_psi = 0.0f;
+  for (int i = 0; i <= 60; ++i) {
+    Pose pose = still;
+    const float yaw = 1.2f * float(i) / 60.0f;
+    locker->update(0, i == 0 ? 0.0f : dt, kContactLeft | kContactLeftToe, glm::vec3(0.0f), yaw, pose.rotations,
+                   pose.translations, world);
+    const glm::vec3 toe = world[static_cast<std::size_t>(locker->legs()[0].toe)];
+    if (i == 0) anchor = toe;
+    EXPECT_EQ(locker->locked()[0], 1) << i;
+    EXPECT_LT(glm::length(toe - anchor), 1e-3f) << i;
+    const float psi = locker->yaw_corrections()[0];
+    EXPECT_LE(std::abs(psi), 0.4f + 1e-6f) << i;
+    EXPECT_LE(std::abs(psi - previous_psi), 1.2f / 60.0f + 1e-5f) << i;  // no faster than the body turns
+    previous_psi = psi;
+  }
+  EXPECT_NEAR(previous_psi, -0.4f, 1e-5f);  // held against the turn, at its limit
+}
+
 TEST(FootLocker, ReleaseDecaysTheCorrectionWithoutAJump) {
   // Planted (toe) for 0.5 s while the root slides 0.15 m under a still pose,
   // then lifted: the correction decays to nothing, in small steps.
@@ -357,11 +397,7 @@ TEST(FootLocker, ReleaseDecaysTheCorrectionWithoutAJump) {
   params.release_half_life = 0.1f;
   Result<FootLocker> locker = FootLocker::create(a, 1, params);
   ASSERT_TRUE(locker.ok()) << locker.message();
-  Pose still = rest_pose(a, kHipsHeight);
-  for (int side = 0; side < 2; ++side) {
-    const FootState foot = stance_foot(side == 0 ? 0.1f : -0.1f, 0.2f);
-    pose_leg(a, side, foot.ankle, 0.0f, still);
-  }
+  const Pose still = standing_pose(a);
   const float dt = 1.0f / 60.0f;
   std::vector<glm::vec3> world(a.joint_count()), previous;
   float largest_step = 0.0f;
@@ -547,7 +583,7 @@ TEST(FootLocker, ErrorsNameTheRoleOrField) {
       {"soft_reach_start", [](FootIkParams& p) { p.soft_reach_start = 0.0f; }},
       {"soft_reach_start", [](FootIkParams& p) { p.soft_reach_start = 1.5f; }},
       {"unlock_distance", [](FootIkParams& p) { p.unlock_distance = -1.0f; }},
-      {"unlock_yaw", [](FootIkParams& p) { p.unlock_yaw = NAN; }},
+      {"max_yaw_correction", [](FootIkParams& p) { p.max_yaw_correction = NAN; }},
       {"release_half_life", [](FootIkParams& p) { p.release_half_life = 0.0f; }},
       {"hip_half_life", [](FootIkParams& p) { p.hip_half_life = INFINITY; }},
       {"max_hip_drop", [](FootIkParams& p) { p.max_hip_drop = -0.1f; }},

@@ -38,7 +38,7 @@ struct TwoBoneIkSolution {
   glm::quat lower{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 knee{0.0f};   // knee' (the solved knee position)
   glm::vec3 ankle{0.0f};  // ankle' (where the ankle ends up)
-  // The ankle was not put on the target (more than 0.1 mm away): the target
+  // The ankle was not put on the target (more than 1 mm away): the target
   // was in the soft zone or beyond the leg's length, or nearer the hip than
   // |upper length - lower length|.
   bool clamped = false;

@@ -17,15 +17,16 @@
 //   - lock: while the foot is planted (kContactLeft / kContactRight) and not
 //     locked, it locks at its displayed contact point (P + c) and displayed
 //     heading; while locked, c = anchor - P and psi = anchor yaw - animated
-//     yaw, so the displayed contact point stays on the anchor. A switch of
-//     contact point (heel to toe) re-anchors at the new point's displayed
-//     position, so c stays continuous;
-//   - release: when the contact ends, or c grows beyond unlock_distance (or
-//     |psi| beyond unlock_yaw). Then c and psi decay to zero with a
-//     critically damped spring (release_half_life), starting from their
-//     last rate of change, so the displayed foot is continuous in position
-//     and velocity. A foot released by drift does not lock again until its
-//     contact has ended;
+//     yaw, so the displayed contact point stays on the anchor. |psi| is held
+//     to max_yaw_correction: an animated foot that turns further pivots
+//     about its contact point with the animation. A switch of contact point
+//     (heel to toe) re-anchors at the new point's displayed position, so c
+//     stays continuous;
+//   - release: when the contact ends, or c grows beyond unlock_distance.
+//     Then c and psi decay to zero with a critically damped spring
+//     (release_half_life), starting from their last rate of change, so the
+//     displayed foot is continuous in position and velocity. A foot released
+//     by drift does not lock again until its contact has ended;
 //   - hips: when a target is beyond a leg's comfortable reach (the soft
 //     start, or the animated extension where that is longer), the hips are
 //     lowered by the least drop that brings it within reach, for the worse
@@ -63,9 +64,11 @@ struct FootIkParams {
   // Horizontal correction (metres, > 0) beyond which a lock is released.
   float unlock_distance = 0.2f;
   // Hold the foot's heading while locked (the foot turns about its contact
-  // point by psi); |psi| beyond unlock_yaw (radians, > 0) releases the lock.
+  // point by psi), by at most max_yaw_correction (radians, > 0): an animated
+  // foot that turns further (a pivot in a turn) turns on about its contact
+  // point, its position still held.
   bool lock_yaw = true;
-  float unlock_yaw = 0.8f;
+  float max_yaw_correction = 0.4f;
   // Half-life (seconds, > 0) of the correction's decay after a release.
   float release_half_life = 0.1f;
   // Largest lowering of the hips (metres, >= 0; 0 disables it) and the

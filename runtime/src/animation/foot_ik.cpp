@@ -20,8 +20,9 @@ namespace {
 constexpr float kTiny = 1e-7f;
 // The pole is blended with the hint below this fraction of the leg's length.
 constexpr float kStraightPole = 0.01f;
-// The ankle counts as on its target within this distance (metres).
-constexpr float kReached = 1e-4f;
+// The ankle counts as on its target within this distance (metres): the
+// tolerance of a held foot.
+constexpr float kReached = 1e-3f;
 
 const glm::vec3 kDown(0.0f, -1.0f, 0.0f);
 
@@ -44,16 +45,18 @@ glm::quat rotation_between(const glm::vec3& from, const glm::vec3& to) {
   const float from2 = glm::dot(from, from);
   const float to2 = glm::dot(to, to);
   if (!(from2 > kTiny * kTiny) || !(to2 > kTiny * kTiny)) return glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-  const glm::vec3 a = from / std::sqrt(from2);
-  const glm::vec3 b = to / std::sqrt(to2);
-  const float c = glm::dot(a, b);
-  if (c < -1.0f + 1e-6f) {
-    const glm::vec3 axis = perpendicular(a);
+  // The half-way quaternion (|a||b| + a.b, a x b), normalized: exact for
+  // small angles, where an angle-axis construction divides by the sine, and
+  // two square roots in all (the solver's hottest call).
+  const float lengths = std::sqrt(from2 * to2);
+  const float w = lengths + glm::dot(from, to);
+  if (w < 1e-6f * lengths) {  // opposite: a half turn about any perpendicular axis
+    const glm::vec3 axis = perpendicular(from / std::sqrt(from2));
     return glm::quat(0.0f, axis.x, axis.y, axis.z);
   }
-  // The half-way quaternion (1 + cos, sin * axis), normalized: exact for
-  // small angles, where an angle-axis construction divides by the sine.
-  return glm::normalize(glm::quat(1.0f + c, glm::cross(a, b)));
+  const glm::vec3 v = glm::cross(from, to);
+  const float scale = 1.0f / std::sqrt(w * w + glm::dot(v, v));
+  return glm::quat(w * scale, v.x * scale, v.y * scale, v.z * scale);
 }
 
 TwoBoneIkSolution solve_two_bone_ik(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle,

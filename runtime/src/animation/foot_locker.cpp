@@ -94,7 +94,7 @@ Status FootIkParams::validate() const {
     const char* name;
     float value;
   } positive[] = {{"unlock_distance", unlock_distance},
-                  {"unlock_yaw", unlock_yaw},
+                  {"max_yaw_correction", max_yaw_correction},
                   {"release_half_life", release_half_life},
                   {"hip_half_life", hip_half_life}};
   for (const auto& check : positive) {
@@ -242,8 +242,10 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
     const bool heel_touches = (contacts & kHeelBit[side]) != 0;
     // Data without point bits (older files) counts as planted on the toe.
     const std::uint8_t point = leg.toe >= 0 && (toe_touches || !heel_touches) ? kToe : kHeel;
+    // The foot's heading, only where a lock reads it.
     float yaw = 0.0f;
-    const bool has_yaw = params_.lock_yaw && heading_yaw(global[leg.foot] * heading_[side], yaw);
+    const bool has_yaw = params_.lock_yaw && (planted || locked_[f] != 0) &&
+                         heading_yaw(global[leg.foot] * heading_[side], yaw);
 
     glm::vec3& offset = offset_[f];
     glm::vec3& offset_rate = offset_rate_[f];
@@ -269,8 +271,14 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
         if (move_point(point)) anchor_[f] = at(point_[f]) + offset;
         if (has_yaw && std::isnan(anchor_yaw_[f])) anchor_yaw_[f] = yaw + yaw_offset;
         const glm::vec3 next = horizontal(anchor_[f] - at(point_[f]));
-        const float next_yaw = has_yaw ? wrap_angle(anchor_yaw_[f] - yaw) : yaw_offset;
-        if (glm::length(next) > params_.unlock_distance || std::abs(next_yaw) > params_.unlock_yaw) {
+        float next_yaw = has_yaw ? wrap_angle(anchor_yaw_[f] - yaw) : yaw_offset;
+        if (std::abs(next_yaw) > params_.max_yaw_correction) {
+          // The animated foot turned further than the lock holds: it pivots
+          // about its contact point from here, the position still held.
+          next_yaw = std::clamp(next_yaw, -params_.max_yaw_correction, params_.max_yaw_correction);
+          anchor_yaw_[f] = yaw + next_yaw;
+        }
+        if (glm::length(next) > params_.unlock_distance) {
           locked_[f] = 0;
           drifted_[f] = 1;
         } else {
@@ -327,7 +335,9 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
     // The least drop of the hips that brings the target within the leg's
     // comfortable reach (the solver's soft start): |target - (hip - drop * up)|
     // = reach, the smaller root; the drop to the target's height when the
-    // target is horizontally further than the reach.
+    // target is horizontally further than the reach. An animated target
+    // needs none: the animated extension is within reach by definition.
+    if (!target.solve) continue;
     const glm::vec3 hip = world[leg.upper];
     const float length = glm::length(world[leg.lower] - hip) + glm::length(ankle - world[leg.lower]);
     const float reach = std::min(length, std::max(params_.soft_reach_start * length, glm::length(ankle - hip)));

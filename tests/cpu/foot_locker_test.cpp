@@ -389,6 +389,37 @@ TEST(FootLocker, YawCorrectionStopsAtItsLimitAndTheFootPivotsInPlace) {
   EXPECT_NEAR(previous_psi, -0.4f, 1e-5f);  // held against the turn, at its limit
 }
 
+TEST(FootLocker, AFootPitchedThroughVerticalKeepsItsYawCorrection) {
+  // The planted left foot pitches about its toe until it points past
+  // straight down and back, while the root turns: the heading's yaw is
+  // undefined near vertical (and flips by half a turn past it), but the yaw
+  // correction is held meanwhile and carries on, and the toe stays put.
+  const AnimationData a = make_skeleton();
+  Result<FootLocker> locker = FootLocker::create(a, 1);
+  ASSERT_TRUE(locker.ok()) << locker.message();
+  const FootState flat = stance_foot(0.1f, 0.2f);
+  const glm::vec3 toe_at = flat.ankle + kToeOffset;
+  const float dt = 1.0f / 60.0f;
+  std::vector<glm::vec3> world(a.joint_count());
+  glm::vec3 anchor(0.0f);
+  float previous_psi = 0.0f;
+  for (int i = 0; i <= 120; ++i) {
+    Pose pose = standing_pose(a);
+    const float pitch = 1.45f * std::sin(3.14159265f * float(i) / 120.0f);
+    pose_leg(a, 0, toe_at - glm::angleAxis(pitch, kX) * kToeOffset, pitch, pose);
+    const float yaw = 0.2f * float(i) / 60.0f;
+    locker->update(0, i == 0 ? 0.0f : dt, kContactLeft | kContactLeftToe, glm::vec3(0.0f), yaw, pose.rotations,
+                   pose.translations, world);
+    const glm::vec3 toe = world[static_cast<std::size_t>(locker->legs()[0].toe)];
+    if (i == 0) anchor = toe;
+    ASSERT_TRUE(finite(toe)) << i;
+    EXPECT_LT(glm::length(toe - anchor), 1e-3f) << i;
+    const float psi = locker->yaw_corrections()[0];
+    EXPECT_LE(std::abs(psi - previous_psi), 0.2f / 60.0f + 1e-5f) << i;
+    previous_psi = psi;
+  }
+}
+
 TEST(FootLocker, ReleaseDecaysTheCorrectionWithoutAJump) {
   // Planted (toe) for 0.5 s while the root slides 0.15 m under a still pose,
   // then lifted: the correction decays to nothing, in small steps.

@@ -27,12 +27,13 @@ const glm::quat kIdentity(1.0f, 0.0f, 0.0f, 0.0f);
 // is not solved at all.
 constexpr float kSettled = 1e-5f;
 constexpr float kSettledRate = 1e-4f;
-// A foot heading shorter than this (horizontally) points straight up or
-// down: its yaw is undefined and the yaw correction is held.
-constexpr float kVerticalHeading = 1e-3f;
+// A unit foot heading shorter than this horizontally (within 14 degrees of
+// vertical) has no reliable yaw: the yaw correction is held meanwhile, and
+// the lock's heading taken afresh when the foot levels again.
+constexpr float kVerticalHeading = 0.25f;
 
-// Marks a lock taken while the foot's heading was vertical: its anchor yaw is
-// set on the first tick with a heading.
+// Marks a lock whose foot heading is (or was last) vertical: its anchor yaw
+// is set on the next tick with a heading, so the yaw correction carries on.
 constexpr float kNoYaw = std::numeric_limits<float>::quiet_NaN();
 
 constexpr std::uint8_t kPlantedBit[2] = {kContactLeft, kContactRight};
@@ -269,7 +270,11 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
       } else {
         // Heel to toe (or back): the anchor moves to the new point as shown.
         if (move_point(point)) anchor_[f] = at(point_[f]) + offset;
-        if (has_yaw && std::isnan(anchor_yaw_[f])) anchor_yaw_[f] = yaw + yaw_offset;
+        if (!has_yaw) {
+          anchor_yaw_[f] = kNoYaw;
+        } else if (std::isnan(anchor_yaw_[f])) {
+          anchor_yaw_[f] = yaw + yaw_offset;
+        }
         const glm::vec3 next = horizontal(anchor_[f] - at(point_[f]));
         float next_yaw = has_yaw ? wrap_angle(anchor_yaw_[f] - yaw) : yaw_offset;
         if (std::abs(next_yaw) > params_.max_yaw_correction) {

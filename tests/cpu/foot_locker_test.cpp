@@ -638,6 +638,19 @@ TEST(FootLocker, ErrorsNameTheRoleOrField) {
   Result<FootLocker> chain = FootLocker::create(crossed, 1);
   ASSERT_FALSE(chain.ok());
   EXPECT_NE(chain.message().find("@left_foot"), std::string::npos) << chain.message();
+  // set_params validates too, and keeps the old parameters on an error.
+  Result<FootLocker> locker = FootLocker::create(a, 1);
+  ASSERT_TRUE(locker.ok());
+  FootIkParams off;
+  off.enabled = false;
+  EXPECT_TRUE(locker->set_params(off).ok());
+  EXPECT_FALSE(locker->params().enabled);
+  FootIkParams bad_params;
+  bad_params.hip_half_life = -1.0f;
+  const Status status = locker->set_params(bad_params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("hip_half_life"), std::string::npos) << status.message();
+  EXPECT_FALSE(locker->params().enabled);
 }
 
 }  // namespace

@@ -80,7 +80,8 @@ struct FootIkParams {
   bool clamp_to_floor = true;
   float floor_height = 0.0f;
 
-  // Errors name the field ("foot IK: unlock_distance must be > 0, got 0").
+  // Errors name the field ("foot IK: unlock_distance must be finite and > 0,
+  // got 0.000000").
   Status validate() const;
 };
 
@@ -118,6 +119,10 @@ class FootLocker {
 
   std::uint32_t size() const { return characters_; }
   const FootIkParams& params() const { return params_; }
+  // New parameters between ticks (not during updates), e.g. IK switched on
+  // or off: the locks carry on (switched off, each character's state is
+  // cleared at its next update). Errors: params.validate(); nothing changes.
+  Status set_params(const FootIkParams& params);
 
   // Per foot, [B x 2] at b * 2 + side (0 left, 1 right), as of the last update:
   std::span<const std::uint8_t> locked() const { return locked_; }         // 1: held on its anchor

@@ -179,6 +179,12 @@ Result<FootLocker> FootLocker::create(const AnimationData& animation, std::uint3
   return locker;
 }
 
+Status FootLocker::set_params(const FootIkParams& params) {
+  MMVK_TRY(params.validate());
+  params_ = params;
+  return {};
+}
+
 void FootLocker::clear(std::uint32_t b) {
   for (std::size_t f = std::size_t{b} * 2; f < std::size_t{b} * 2 + 2; ++f) {
     locked_[f] = clamped_[f] = drifted_[f] = 0;

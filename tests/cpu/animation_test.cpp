@@ -296,6 +296,51 @@ TEST(CrowdController, DeferredAppliesResultsOneTickLater) {
   EXPECT_FALSE(deferred.submit(QueryBatch{}).ok() && deferred.submit(QueryBatch{}).ok());
 }
 
+// Answers every query with its continuing frame (or frame 0 without one),
+// recording the continuing frames it was asked with.
+class ContinuingSearch final : public SearchBackend {
+ public:
+  explicit ContinuingSearch(const Database& database) : database_(database) {}
+  std::string_view name() const override { return "continuing"; }
+  const Database& database() const override { return database_; }
+  Status search(const QueryBatch& batch, std::uint32_t, std::span<Match> out) override {
+    for (std::size_t i = 0; i < batch.size; ++i) {
+      const std::uint32_t continuing = batch.params[i].continuing_frame;
+      asked.push_back(continuing);
+      out[i] = Match{continuing == kNoFrame ? 0u : continuing, 0.0f};
+    }
+    return {};
+  }
+  SearchStats stats() const override { return {}; }
+  void reset_stats() override {}
+  std::vector<std::uint32_t> asked;
+
+ private:
+  const Database& database_;
+};
+
+TEST(CrowdController, HeldOnAClipsLastFrameGetsNoContinuingBonus) {
+  DatabaseParts parts = make_parts(true);
+  parts.clips[0].loop = false;
+  Result<Database> db = Database::create(std::move(parts));
+  ASSERT_TRUE(db.ok()) << db.message();
+  ContinuingSearch search(*db);
+  ThreadPool pool(1);
+  Result<CrowdController> controller = CrowdController::create(*db, 1);
+  ASSERT_TRUE(controller.ok()) << controller.message();
+  ASSERT_TRUE(controller->place(0, glm::vec3(0.0f), 0.0f, 57).ok());
+  std::vector<glm::vec3> velocity(1, glm::vec3(0.0f, 0.0f, 1.0f));
+  // Frame 57 plays on to 58, then 59, the last, where it is held: that
+  // search has no continuing frame, and its answer (frame 0) is jumped to.
+  for (int tick = 0; tick < 4 && controller->frames()[0] != 0; ++tick) {
+    ASSERT_TRUE(controller->tick(1.0f / 30.0f, CrowdInput{velocity, {}}, search, pool).ok());
+  }
+  ASSERT_FALSE(search.asked.empty());
+  EXPECT_EQ(search.asked.front(), 58u);  // placed: a forced search after one frame, continuing
+  EXPECT_EQ(search.asked.back(), kNoFrame);
+  EXPECT_EQ(controller->frames()[0], 0u);
+}
+
 TEST(DatabaseFile, FormatOneStillLoadsWithoutAnimation) {
   const Database db = make_database(true);
   std::string bytes = serialize_database(make_database(false));

@@ -283,6 +283,7 @@ class CrowdController {
   std::vector<glm::vec3> velocity_world_;     // [B x V] world positions of the assembler's velocity joints
   std::vector<glm::vec3> joint_velocities_;   // [B x V] their velocities, character space
   std::vector<std::uint8_t> fresh_;           // [B] placed since the last tick: no velocities yet
+  std::vector<std::uint8_t> held_;            // [B] on a non-looping clip's last frame
   std::optional<FootLocker> locker_;
   std::vector<glm::vec3> world_;              // [B x joints] displayed world joint positions
   std::vector<std::uint8_t> no_feet_flags_;   // [B x 2] zeros, without a locker

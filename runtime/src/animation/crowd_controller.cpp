@@ -132,6 +132,7 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.velocity_world_.assign(n * velocity_joints, glm::vec3(0.0f));
   c.joint_velocities_.assign(n * velocity_joints, glm::vec3(0.0f));
   c.fresh_.assign(n, 1);
+  c.held_.assign(n, 0);
   if (locker.ok()) c.locker_ = std::move(*locker);
   c.world_.resize(n * c.joints_);
   c.no_feet_flags_.assign(2 * n, 0);
@@ -167,6 +168,7 @@ Status CrowdController::place(std::uint32_t b, const glm::vec3& position, float 
   desired_yaw_[b] = searched_yaw_[b] = root_yaw_[b];
   frames_[b] = frame;
   fractions_[b] = 0.0f;
+  held_[b] = 0;
   force_[b] = 1;
   played_velocity_[b] = glm::vec3(0.0f);
   played_yaw_rate_[b] = 0.0f;
@@ -280,6 +282,7 @@ void CrowdController::play(std::uint32_t b, float dt, const CrowdInput& input, f
   const PlaybackStep step = advance_playback(database, {frames_[b], fractions_[b]}, dt * database.fps());
   frames_[b] = step.time.frame;
   fractions_[b] = step.time.fraction;
+  held_[b] = step.reached_end ? 1 : 0;
   // The root motion of the frame interval now played (the source velocity
   // of a jump).
   const RootDelta velocity = root_velocity_at(database, frames_[b]);
@@ -449,7 +452,10 @@ void CrowdController::assemble(ThreadPool& pool) {
       assembler_.assemble_shown(pose, due_refs_[i], positions, yaws, query);
       QueryParams& p = batch_params_[i];
       p = query_params_[b];
-      p.continuing_frame = nearest;
+      // A character held on a non-looping clip's last frame has nothing to
+      // play on: that frame gets no continuing bonus, else it wins the
+      // forced search it triggers and the character searches every tick.
+      p.continuing_frame = held_[b] != 0 ? kNoFrame : nearest;
       p.continuing_bias = params_.continuing_bias;
       p.continuing_multiplier = params_.continuing_multiplier;
       p.exclusion_window = params_.exclusion_window;
@@ -505,6 +511,7 @@ void CrowdController::jump(std::uint32_t b, std::uint32_t to, unsigned thread) {
   played_yaw_rate_[b] = to_root.yaw;
   frames_[b] = to;
   fractions_[b] = 0.0f;
+  held_[b] = 0;
   jumped_[b] = 1;
 }
 

@@ -139,6 +139,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   options.source = source;
   options.custom = custom;
   options.contacts = settings.animation.contacts;  // foot_contact channels agree with the animation's contacts
+  if (settings.edge_rule == EdgeRule::Extrapolate) options.extrapolate_seconds = kExtrapolateSeconds;
   Result<RawFeatures> raw = extract_features(motion, *root, settings.schema, options);
   if (!raw.ok()) return raw.error();
   MMVK_TRY(check_plausible(*raw, settings.schema, motion.fps, source + ": clip '" + meta.name + "'"));
@@ -154,7 +155,8 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   out.tags = meta.tags;
   out.fps = motion.fps;
   out.flags.assign(motion.frame_count, 0);
-  if (settings.edge_rule == EdgeRule::Exclude) {
+  // Under Extrapolate, past_end marks only the phase windows that still clamp.
+  if (settings.edge_rule != EdgeRule::Clamp) {
     for (std::uint32_t f = 0; f < motion.frame_count; ++f) {
       if (raw->past_end[f]) out.flags[f] |= kFrameEdgeExcluded;
     }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/json_parse.hpp"
+#include "common/name_table.hpp"
 #include "mmvk/file_io.hpp"
 
 namespace mmvk {
@@ -264,7 +265,29 @@ bool is_bvh(const std::filesystem::path& path) {
   return ext == ".bvh";
 }
 
+struct EdgeRuleEntry {
+  EdgeRule rule;
+  std::string_view name;
+};
+constexpr EdgeRuleEntry kEdgeRules[] = {
+    {EdgeRule::Exclude, "exclude"},
+    {EdgeRule::Clamp, "clamp"},
+    {EdgeRule::Extrapolate, "extrapolate"},
+};
+static_assert(detail::indexed_by(std::span<const EdgeRuleEntry>(kEdgeRules), &EdgeRuleEntry::rule));
+
 }  // namespace
+
+std::string_view edge_rule_name(EdgeRule rule) {
+  return detail::name_for(std::span<const EdgeRuleEntry>(kEdgeRules), &EdgeRuleEntry::name, rule);
+}
+
+Result<EdgeRule> parse_edge_rule(std::string_view name) {
+  const std::span<const EdgeRuleEntry> table(kEdgeRules);
+  if (const EdgeRuleEntry* entry = detail::find_named(table, &EdgeRuleEntry::name, name)) return entry->rule;
+  return make_error("expected " + detail::name_list(table, &EdgeRuleEntry::name, '"', true) + ", got \"" +
+                    std::string(name) + "\"");
+}
 
 Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_view source,
                                      const std::filesystem::path& base_dir) {
@@ -344,13 +367,9 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   if (root.contains("edge_rule")) {
     std::string rule;
     MMVK_READ(rule, read_string(root["edge_rule"], at + "edge_rule"));
-    if (rule == "exclude") {
-      manifest.edge_rule = EdgeRule::Exclude;
-    } else if (rule == "clamp") {
-      manifest.edge_rule = EdgeRule::Clamp;
-    } else {
-      return make_error(at + "edge_rule: expected \"exclude\" or \"clamp\", got \"" + rule + "\"");
-    }
+    Result<EdgeRule> parsed = parse_edge_rule(rule);
+    if (!parsed.ok()) return make_error(at + "edge_rule: " + parsed.message());
+    manifest.edge_rule = *parsed;
   }
   bool mirror_all = false;
   if (root.contains("mirror")) MMVK_READ(mirror_all, read_bool(root["mirror"], at + "mirror"));

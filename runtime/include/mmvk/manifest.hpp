@@ -52,7 +52,8 @@ namespace mmvk {
 // as candidates with the clamped features; Extrapolate keeps them as
 // candidates with the trajectory continued at the constant speed and turning
 // rate of the clip's last kExtrapolateSeconds (before the first frame: of
-// its first), and excludes only frames whose phase window crosses an edge.
+// its first), and excludes only the clip's last kExtrapolateEndSeconds and
+// frames whose phase window crosses an edge.
 // Looping clips always wrap. Extrapolate suits short takes of steady
 // locomotion, whose last second Exclude would drop: a take that ends in
 // mid-stride did not stop there.
@@ -66,6 +67,13 @@ enum class EdgeRule : std::uint8_t { Exclude, Clamp, Extrapolate };
 // rather than one frame, so that a 120 fps clip does not extrapolate one
 // noisy 8 ms step.
 inline constexpr float kExtrapolateSeconds = 0.1f;
+
+// Extrapolate still excludes a clip's last this many seconds (at least one
+// frame): a frame there would play into the clip's end within a few ticks,
+// and the end can only be left by another jump. On the CMU subject 16 set
+// (1,000 characters, 20 s) 0.1 s forced 21,414 searches, 0.2 s 4,762,
+// 0.33 s 4,755; 0.5 s left too few frames of the 1.1 s run to count as one.
+inline constexpr float kExtrapolateEndSeconds = 0.2f;
 
 // "exclude", "clamp", "extrapolate".
 std::string_view edge_rule_name(EdgeRule rule);

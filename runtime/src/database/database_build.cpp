@@ -161,6 +161,12 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
       if (raw->past_end[f]) out.flags[f] |= kFrameEdgeExcluded;
     }
   }
+  // Extrapolate keeps the end's frames, but not the last few: a character
+  // sent there would reach the end (and search again) at once.
+  if (settings.edge_rule == EdgeRule::Extrapolate && !meta.loop) {
+    const std::uint32_t keep_out = std::min(offset_frames(kExtrapolateEndSeconds, motion.fps), motion.frame_count);
+    for (std::uint32_t f = motion.frame_count - keep_out; f < motion.frame_count; ++f) out.flags[f] |= kFrameEdgeExcluded;
+  }
   flag_ranges(meta.do_not_use, motion.fps, kFrameDoNotUse, out.flags);
   flag_ranges(meta.block_transition, motion.fps, kFrameBlockTransition, out.flags);
   MMVK_TRY(apply_time_ranges(meta, motion.frame_count, motion.fps, out));

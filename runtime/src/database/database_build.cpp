@@ -331,6 +331,10 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
   const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation};
   Result<ProcessedClip> processed = process_motion(meta, *motion, custom, false, settings);
   if (!processed.ok()) return fail(processed.message());
+  // The units the import used, recorded so that `mmvk inspect` can show them.
+  const float units = manifest.import.metres_per_unit > 0.0f ? manifest.import.metres_per_unit
+                                                             : guess_metres_per_unit(*bvh);
+  processed->clip.metres_per_unit = units;
   out.clips.push_back(std::move(*processed));
   if (meta.mirror) {
     Result<Motion> mirrored = mirror(*motion, manifest.mirror_bones);
@@ -341,6 +345,7 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
     mirror_sidecars(manifest, custom);
     Result<ProcessedClip> processed_mirror = process_motion(meta, *mirrored, custom, true, settings);
     if (!processed_mirror.ok()) return fail(processed_mirror.message());
+    processed_mirror->clip.metres_per_unit = units;
     out.clips.push_back(std::move(*processed_mirror));
   }
   return out;

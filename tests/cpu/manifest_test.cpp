@@ -58,6 +58,19 @@ TEST(Manifest, ParsesEveryField) {
   EXPECT_EQ(manifest->clips[2].file, std::filesystem::path("/abs/turn.bvh"));
 }
 
+TEST(Manifest, ClipRange) {
+  Result<Manifest> manifest =
+      parse_manifest_json(R"({"clips": [{"file": "a.bvh", "range": [0.5, 1.4], "loop": true}, "b.bvh"]})", "m.json", "/base");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  ASSERT_TRUE(manifest->clips[0].range.has_value());
+  EXPECT_EQ(manifest->clips[0].range->begin_seconds, 0.5f);
+  EXPECT_EQ(manifest->clips[0].range->end_seconds, 1.4f);
+  EXPECT_FALSE(manifest->clips[1].range.has_value());
+  Result<Manifest> bad = parse_manifest_json(R"({"clips": [{"file": "a.bvh", "range": [2, 1]}]})", "m.json", "/base");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("m.json: clips[0].range: expected 0 <= begin < end"), std::string::npos) << bad.message();
+}
+
 TEST(Manifest, EdgeRulesByName) {
   for (const EdgeRule rule : {EdgeRule::Exclude, EdgeRule::Clamp, EdgeRule::Extrapolate}) {
     const std::string json =

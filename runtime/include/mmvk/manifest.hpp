@@ -15,6 +15,7 @@
 //                              // how a custom (sidecar) channel's dims mirror
 //   "clips": [
 //     { "file": "walk.bvh",    // relative paths are relative to the manifest's folder
+//       "range": [0.5, 1.4],   // only this part of the file, seconds (default: all of it)
 //       "name": "walk",        // default: the file name without extension
 //       "tags": ["walk"], "loop": false, "mirror": false,
 //       "cost_multiplier": 1.0, "cost_bias": 0.0,
@@ -35,6 +36,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -102,6 +104,10 @@ struct CostRange {
 
 struct ManifestClip {
   std::filesystem::path file;      // the BVH file (resolved: absolute or relative to the working directory)
+  // The part of the file the clip takes: frames f (at the build's rate) with
+  // begin <= f / fps < end; none = the whole file. With `loop`, a cycle cut
+  // out of a longer take; the clip's other time ranges count from its begin.
+  std::optional<TimeRange> range;
   std::string name;                // unique per database is not required
   std::vector<std::string> tags;
   bool loop = false;

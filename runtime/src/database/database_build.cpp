@@ -183,6 +183,19 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
 
 bool same_rate(float a, float b) { return std::abs(a - b) <= 1e-3f * std::max(a, b); }
 
+// Frames [first, first + count) of a motion and of its sidecar arrays.
+void keep_frames(Motion& motion, std::vector<std::vector<float>>& custom, std::uint32_t first, std::uint32_t count) {
+  const std::size_t joints = motion.joint_count();
+  auto keep = [&](auto& values, std::size_t per_frame) {
+    values.erase(values.begin() + std::ptrdiff_t((first + count) * per_frame), values.end());
+    values.erase(values.begin(), values.begin() + std::ptrdiff_t(first * per_frame));
+  };
+  keep(motion.local_positions, joints);
+  keep(motion.local_rotations, joints);
+  for (std::vector<float>& values : custom) keep(values, values.size() / motion.frame_count);
+  motion.frame_count = count;
+}
+
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
                           const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
@@ -327,6 +340,18 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
       ++i;
     }
     motion = std::move(resampled);
+  }
+  if (meta.range) {
+    // The part of the file the clip takes, at the build's rate.
+    const std::string field = (meta.field.empty() ? meta.file.string() + ": clip '" + meta.name + "'" : meta.field) +
+                              ".range";
+    Status inside = check_inside(*meta.range, motion->frame_count, motion->fps, field);
+    if (!inside.ok()) return fail(inside.message());
+    std::uint32_t first = motion->frame_count, end = 0;
+    for (std::uint32_t f = 0; f < motion->frame_count; ++f) {
+      if (in_range(f, motion->fps, *meta.range)) first = std::min(first, f), end = f + 1;
+    }
+    keep_frames(*motion, custom, first, end - first);
   }
   const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation};
   Result<ProcessedClip> processed = process_motion(meta, *motion, custom, false, settings);

@@ -129,8 +129,8 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   }
   if (!object.is_object()) return make_error(where + ": expected an object (or a file name)");
   MMVK_TRY(check_fields(object, where,
-                        {"file", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias", "do_not_use",
-                         "block_transition", "tag_ranges", "cost_ranges"}));
+                        {"file", "range", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias",
+                         "do_not_use", "block_transition", "tag_ranges", "cost_ranges"}));
   ManifestClip clip;
   clip.field = where;
   if (!object.contains("file")) return make_error(where + ".file: missing");
@@ -139,6 +139,7 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (file.empty()) return make_error(where + ".file: empty");
   clip.file = base_dir / file;
   clip.name = clip.file.stem().string();
+  if (object.contains("range")) MMVK_READ(clip.range, read_range(object["range"], where + ".range"));
   if (object.contains("name")) MMVK_READ(clip.name, read_string(object["name"], where + ".name"));
   if (object.contains("tags")) {
     const Json& tags = object["tags"];

@@ -2,6 +2,7 @@
 // one batched search per tick; prints what it used, writes a summary and the
 // viewer page. The work is in host/crowd (run_crowd); this file parses the
 // command line and reads the environment (the cache folder, the terminal).
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -10,6 +11,7 @@
 #include "commands.hpp"
 #include "crowd_backend.hpp"
 #include "crowd_run.hpp"
+#include "default_data.hpp"
 #include "user_cache_dir.hpp"
 
 namespace mmvk::cli {
@@ -17,7 +19,7 @@ namespace mmvk::cli {
 namespace {
 
 constexpr const char* kCrowdUsage =
-    "usage: mmvk crowd [--data DIR|manifest.json|db.mmdb] [--agents N] [--seconds S] [--rate HZ]\n"
+    "usage: mmvk crowd [--data NAME|DIR|manifest.json|db.mmdb] [--agents N] [--seconds S] [--rate HZ]\n"
     "                  [--search-interval S] [--backend NAME] [--device N] [--seed N]\n"
     "                  [--scenario file.json] [--summary out.json] [--html out.html]\n"
     "                  [--foot-ik on|off] [--continuing-bias B] [--continuing-multiplier M]\n"
@@ -28,10 +30,9 @@ constexpr const char* kCrowdUsage =
     "(seek + separation on a uniform grid) at speeds measured in the database, and is\n"
     "animated by motion matching, all characters' searches batched into one per tick.\n"
     "\n"
-    "  --data PATH           the motion: an .mmdb (built with animation), a manifest or a\n"
-    "                        folder of BVH (built once and cached). Default: the CMU subject\n"
-    "                        131 walks shipped with mmvk, cached in $XDG_CACHE_HOME/mmvk\n"
-    "                        (or ~/.cache/mmvk)\n"
+    "  --data NAME|PATH      the motion: a shipped set by name (below), an .mmdb (built with\n"
+    "                        animation), a manifest or a folder of BVH (built once and cached\n"
+    "                        in $XDG_CACHE_HOME/mmvk or ~/.cache/mmvk). Default: cmu-walks\n"
     "  --agents N            characters (default 1000; with --scenario, its count)\n"
     "  --seconds S           simulated time (default 10)\n"
     "  --rate HZ             simulation ticks per second (default 30; any rate: poses are\n"
@@ -57,6 +58,38 @@ constexpr const char* kCrowdUsage =
     "                        (joint names, parents, tick rate, contacts, foot locks)\n"
     "  --trace-agents M      characters in the trace (default 1)\n";
 
+// One entry per shipped set, its description wrapped under the usage's
+// option descriptions (column 22, at most 88 wide).
+std::string shipped_data_help() {
+  constexpr std::size_t kIndent = 22;
+  constexpr std::size_t kWidth = 88;
+  std::string out;
+  for (const crowd::ShippedData& data : crowd::shipped_data()) {
+    // Appending, not "  " + std::string(...): GCC 12 at -O3 warns (-Wrestrict,
+    // a known false positive) on the latter.
+    std::string line("  ");
+    line.append(data.name);
+    line.resize(std::max(kIndent, line.size() + 1), ' ');
+    bool fresh = true;  // no word on this line yet
+    std::string_view rest = data.description;
+    while (!rest.empty()) {
+      const std::size_t space = rest.find(' ');
+      const std::string_view word = rest.substr(0, space);
+      rest = space == std::string_view::npos ? std::string_view() : rest.substr(space + 1);
+      if (!fresh && line.size() + 1 + word.size() > kWidth) {
+        out += line + "\n";
+        line.assign(kIndent, ' ');
+        fresh = true;
+      }
+      if (!fresh) line += ' ';
+      line.append(word);
+      fresh = false;
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 int run_crowd(Args args, const char* argv0) {
@@ -69,6 +102,7 @@ int run_crowd(Args args, const char* argv0) {
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
     std::fputs(kCrowdUsage, stdout);
+    std::printf("\nshipped motion sets (--data NAME; the first is the default):\n%s", shipped_data_help().c_str());
     std::printf("\nbackends:\n%s", crowd::crowd_backend_help().c_str());
     return 0;
   }

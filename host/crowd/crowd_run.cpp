@@ -13,6 +13,7 @@
 #include "database_sliding.hpp"
 #include "default_data.hpp"
 #include "mmvk/hash.hpp"
+#include "gait_plan.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/trajectory.hpp"
@@ -47,24 +48,19 @@ Status check_options(const CrowdOptions& o) {
   return {};
 }
 
-Result<OpenedDatabase> open_crowd_database(const CrowdOptions& options, std::FILE* log) {
+Result<OpenedDatabase> open_crowd_database(const DataChoice& data, const CrowdOptions& options, std::FILE* log) {
   auto say = [log](const std::string& line) {
     if (log) std::fprintf(log, "mmvk crowd: %s\n", line.c_str());
   };
-  if (options.data) return open_database(*options.data, options.cache_dir, say);
-  for (const auto& candidate : default_manifest_candidates(options.executable)) {
-    std::error_code ec;
-    if (std::filesystem::exists(candidate, ec)) return open_database(candidate, options.cache_dir, say);
-  }
-  return make_error("the default motion data (host/crowd/data/cmu131) was not found beside the program or in "
-                    "its source tree; pass --data DIR|manifest.json|db.mmdb");
+  return open_database(data.source, options.cache_dir, say);
 }
 
-Result<Scenario> make_scenario(const CrowdOptions& options) {
+Result<Scenario> make_scenario(const CrowdOptions& options, bool can_run) {
   if (!options.scenario) {
     RandomScenarioOptions random;
     random.agents = options.agents.value_or(1000);
     random.seed = options.seed;
+    if (!can_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     return make_random_scenario(random);
   }
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, load_scenario(*options.scenario));
@@ -111,15 +107,17 @@ constexpr float kErrorHorizon[1] = {1.0f};
 
 Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_TRY(check_options(options));
-  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(options, log));
+  MMVK_ASSIGN_OR_RETURN(const DataChoice data, choose_data(options.data, options.executable));
+  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
   const Database& db = opened.database;
-  const std::string db_name = (options.data ? options.data->string() : std::string("the CMU 131 walks (default)"));
+  const std::string& db_name = data.label;
   if (!db.animation()) {
     return make_error(db_name + ": " + missing_animation_error("mmvk crowd").message);
   }
   Result<GaitSpeeds> speeds = measure_gait_speeds(db);
   if (!speeds) return make_error(db_name + ": " + speeds.message());
-  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options));
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options, speeds->has_run));
+  MMVK_TRY(resolve_gaits(scenario, *speeds));
   const auto agents = std::uint32_t(scenario.agents.size());
 
   ControllerParams params;
@@ -139,9 +137,11 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_ASSIGN_OR_RETURN(CrowdSearch search,
                         make_crowd_search(options.backend, options.device, db, agents, pool, options.cache_dir));
   if (log) {
-    std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, run %.2f m/s)\n",
-                 agents, options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps,
-                 speeds->run_mps);
+    char run[48] = "no run: every character walks";
+    if (speeds->has_run) std::snprintf(run, sizeof(run), "run %.2f m/s", double(speeds->run_mps));
+    std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, %s)\n", agents,
+                 options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps, run);
+    if (!speeds->has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds->no_run_reason.c_str());
     std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
                  search.device.c_str());
     if (!search.pipeline_cache_note.empty()) {
@@ -159,10 +159,9 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
     const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
     // Short enough for the page's header: "1000 agents · locomotion-normal · vulkan-brute-force on llvmpipe".
     const std::string device = search.device.substr(0, search.device.find(" ("));
-    const std::string data = options.data ? options.data->filename().string() : std::string("CMU 131 walks");
     recorder = std::make_unique<CrowdRecorder>(
         controller, scenario,
-        std::to_string(agents) + " agents \u00b7 " + data + " \u00b7 " + std::string(search.backend->name()) + " on " + device,
+        std::to_string(agents) + " agents \u00b7 " + data.short_label + " \u00b7 " + std::string(search.backend->name()) + " on " + device,
         dt, per_sample);
   }
   ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,
@@ -256,7 +255,9 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.database = opened.path.empty() ? db_name : opened.path.string();
   s.database_frames = db.frame_count();
   s.walk_mps = speeds->walk_mps;
-  s.run_mps = speeds->run_mps;
+  s.run_mps = speeds->has_run ? speeds->run_mps : std::nan("");  // null in the JSON
+  s.runners = count_runners(scenario);
+  if (!speeds->has_run) s.notes.push_back("run_mps is null: the data has no run (" + speeds->no_run_reason + ")");
   s.backend = std::string(search.backend->name());
   s.device = search.device;
   s.searches = searches;

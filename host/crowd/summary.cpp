@@ -34,6 +34,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["database_frames"] = s.database_frames;
   j["walk_mps"] = number(s.walk_mps);
   j["run_mps"] = number(s.run_mps);
+  j["runners"] = s.runners;
   j["backend"] = s.backend;
   j["device"] = s.device;
   j["searches"] = s.searches;
@@ -53,6 +54,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["goals_reached"] = s.goals_reached;
   // A string: a 64-bit value is not exact in every JSON reader's doubles.
   j["chosen_frames_hash"] = hex(s.chosen_frames_hash);
+  j["notes"] = s.notes;
   if (!s.html.empty()) {
     j["html"] = s.html;
     j["html_bytes"] = s.html_bytes;

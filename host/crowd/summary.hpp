@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "mmvk/status.hpp"
 
@@ -21,7 +22,8 @@ struct CrowdSummary {
   std::string database;            // the .mmdb or source folder
   std::uint64_t database_frames = 0;
   double walk_mps = 0.0;           // measured in the database
-  double run_mps = 0.0;
+  double run_mps = 0.0;            // NaN (null in the JSON) when the data has no run
+  std::uint64_t runners = 0;       // characters that prefer to run
   std::string backend;
   std::string device;              // "cpu" for CPU backends
   // How fast.
@@ -40,6 +42,7 @@ struct CrowdSummary {
   double transitions_per_agent_s = 0.0;
   std::uint64_t goals_reached = 0;
   std::uint64_t chosen_frames_hash = 0;
+  std::vector<std::string> notes;  // what the data cannot do (no run, ...)
   // The viewer, when written.
   std::string html;
   std::uint64_t html_bytes = 0;

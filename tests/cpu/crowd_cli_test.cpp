@@ -62,7 +62,7 @@ TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
   std::ifstream in(summary);
   const auto json = nlohmann::json::parse(in, nullptr, false);
   ASSERT_FALSE(json.is_discarded());
-  for (const char* key : {"agents", "ticks", "seconds", "backend", "device", "searches", "no_candidate",
+  for (const char* key : {"agents", "ticks", "seconds", "walk_mps", "run_mps", "runners", "notes", "backend", "device", "searches", "no_candidate",
                           "search_ms_p50", "search_ms_p99", "tick_ms_p50", "tick_ms_p99", "trajectory_error_m_1s",
                           "foot_sliding_cm_s", "transitions_per_agent_s", "chosen_frames_hash"}) {
     EXPECT_TRUE(json.contains(key)) << key;
@@ -94,6 +94,46 @@ TEST_F(CrowdCli, ScenarioErrorsNameTheFileAndTheField) {
   std::ofstream(tags) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "require_tags": ["moonwalk"]}]})";
   expect_failure("--backend fast-box --scenario " + tags.string(), tags.string() + ": agents[0].require_tags");
   expect_failure("--backend fast-box --agents 3 --scenario " + tags.string(), "defines 1 agents, but --agents asks for 3");
+}
+
+// Reads a --summary file (an empty object when it cannot be parsed).
+nlohmann::json read_summary(const fs::path& path) {
+  std::ifstream in(path);
+  nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+  EXPECT_FALSE(json.is_discarded()) << path;
+  return json.is_discarded() ? nlohmann::json::object() : json;
+}
+
+TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
+  // The CMU 131 walks (cmu-walks) never reach 2 m/s and tag no run.
+  const fs::path summary = dir_ / "walks.json";
+  const auto walks = run_command(mmvk_ + " crowd --data cmu-walks --agents 50 --seconds 1 --backend fast-box "
+                                 "--summary " + summary.string());
+  ASSERT_EQ(walks.exit_code, 0) << walks.output;
+  EXPECT_NE(walks.output.find("no run: every character walks"), std::string::npos) << walks.output;
+  nlohmann::json json = read_summary(summary);
+  EXPECT_TRUE(json["run_mps"].is_null()) << json.dump();
+  EXPECT_EQ(json["runners"], 0);
+  ASSERT_EQ(json["notes"].size(), 1u) << json.dump();
+  EXPECT_NE(json["notes"][0].get<std::string>().find("run_mps is null: the data has no run (no frame is tagged 'run'"),
+            std::string::npos)
+      << json.dump();
+  // A scenario that asks for a run there is an error naming the gait.
+  const fs::path runner = dir_ / "runner.json";
+  std::ofstream(runner) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "speed": "run"}]})";
+  expect_failure("--data cmu-walks --backend fast-box --scenario " + runner.string(),
+                 runner.string() + ": agents[0].speed: asks for the 'run' gait, but the motion data has no run");
+
+  // The CMU 16 walks and runs do run: a pedestrian walk, a run over 2.5 m/s
+  // and a fifth of the crowd running.
+  const auto both = run_command(mmvk_ + " crowd --data cmu-walk-run --agents 50 --seconds 1 --backend fast-box "
+                                "--summary " + summary.string());
+  ASSERT_EQ(both.exit_code, 0) << both.output;
+  json = read_summary(summary);
+  EXPECT_GE(json["walk_mps"].get<double>(), 1.1) << json.dump();
+  EXPECT_GE(json["run_mps"].get<double>(), 2.5) << json.dump();
+  EXPECT_GT(json["runners"].get<int>(), 0) << json.dump();
+  EXPECT_TRUE(json["notes"].empty()) << json.dump();
 }
 
 TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {

@@ -168,7 +168,7 @@
             const v = [0, 0, 0];
             for (let k = 0; k < 3; k++) {
               const frameMm = slot >= 0 ? Math.round(d.poses[(slot * J + legJoints[l]) * 3 + k] * 1000) : 0;
-              v[k] = (frameMm + r.z()) / 1000;
+              v[k] = (frameMm + 2 * r.z()) / 1000;  // corrections in 2 mm steps
             }
             const base = (i * L + l) * 3;
             d.legs[base] = d.rootX[i] + c * v[0] + sn * v[2];
@@ -504,7 +504,7 @@
         if (!(feet.state & (4 << foot))) continue;
         const dx = feet.anchor[3 * foot] - p.x, dz = feet.anchor[3 * foot + 2] - p.z;
         const m = project(c * dx - sn * dz, 0, sn * dx + c * dz);
-        footMark(ctx, m[0], m[1], Math.max(4, scale * 0.04), foot, colors.locked, null);
+        footMark(ctx, m[0], m[1], Math.max(5, scale * 0.05), foot, colors.locked, null);
       }
       label.textContent += ' \u00b7 ' + feetText(feet.state);
     }
@@ -595,7 +595,7 @@
     // Bands from the top: the played frame, the feet (when recorded: a row
     // per foot, dim where planted, bright where locked), the searches' axis,
     // the match costs.
-    const top = 24, feetH = D.feet ? 14 : 0, frameH = (h - top - 22 - feetH) * 0.55;
+    const top = 24, feetH = D.feet ? 16 : 0, frameH = (h - top - 22 - feetH) * 0.55;
     const feetTop = top + frameH + 4, axisY = top + frameH + feetH + 8, costTop = axisY + 6, costH = h - 18 - costTop;
     const tickStep = D.duration > 30 ? 10 : D.duration > 8 ? 2 : 1;
     for (let t = 0; t <= D.duration + 1e-6; t += tickStep) {
@@ -665,17 +665,19 @@
 
   function drawFeetRows(ctx, w, a, y) {
     const f = D.feet[a], end = D.duration;
+    ctx.font = '8px system-ui, sans-serif';
     for (let foot = 0; foot < 2; foot++) {
-      const rowY = y + foot * 6;
-      ctx.fillStyle = colors.dim; ctx.fillText(foot === 0 ? 'L' : 'R', 28, rowY + 5);
+      const rowY = y + foot * 7;
+      ctx.fillStyle = colors.dim; ctx.fillText(foot === 0 ? 'L' : 'R', 30, rowY + 6);
       for (let i = 0; i < f.t.length; i++) {
         const bits = f.state[i], until = i + 1 < f.t.length ? f.t[i + 1] : end;
         if (!(bits & ((1 | 4) << foot))) continue;
         ctx.fillStyle = bits & (4 << foot) ? colors.locked : 'rgba(125,255,138,0.3)';
         const x0 = timeToX(f.t[i], w), x1 = timeToX(Math.min(until, end), w);
-        ctx.fillRect(x0, rowY, Math.max(1, x1 - x0), 4);
+        ctx.fillRect(x0, rowY, Math.max(1, x1 - x0), 5);
       }
     }
+    ctx.font = '11px system-ui, sans-serif';
   }
 
   // ---- the loop and the controls ----------------------------------------

@@ -70,8 +70,8 @@ MotionMeter::MotionMeter(std::size_t streams, std::size_t joints, const MotionMe
       jump_ticks_(std::max<std::uint64_t>(ring_ - 1, std::uint64_t(std::ceil(params.jump_window_s / params.dt - 1e-9)))),
       seen_(streams, 0),
       since_jump_(streams, std::numeric_limits<std::uint64_t>::max()),
-      last_feet_(2 * streams),
-      last_feet_animated_(2 * streams),
+      last_points_(4 * streams),
+      last_points_animated_(4 * streams),
       last_contacts_(streams, 0),
       last_knee_(2 * streams, 0.0f),
       poses_(ring_ * streams * joints),
@@ -99,29 +99,40 @@ void MotionMeter::record(const Tick& tick) {
 }
 
 void MotionMeter::record_feet(std::size_t s, const Tick& tick) {
+  const LegJoints& legs = params_.legs;
   const std::uint8_t contacts = tick.contacts[s];
   for (int f = 0; f < 2; ++f) {
-    const std::size_t joint = s * joints_ + std::size_t(params_.legs.contact[f]);
-    const glm::vec3 shown = tick.shown[joint];
-    const glm::vec3 animated = tick.animated.empty() ? shown : tick.animated[joint];
-    const std::uint8_t bit = f == 0 ? kContactLeft : kContactRight;
     const std::size_t foot = 2 * s + std::size_t(f);
+    // The foot's two points: its contact joint (the toe) and its ankle.
+    const int joints[2] = {legs.contact[f], legs.ankle[f] >= 0 ? legs.ankle[f] : legs.contact[f]};
+    glm::vec3 shown[2], animated[2];
+    for (int k = 0; k < 2; ++k) {
+      shown[k] = tick.shown[s * joints_ + std::size_t(joints[k])];
+      animated[k] = tick.animated.empty() ? shown[k] : tick.animated[s * joints_ + std::size_t(joints[k])];
+    }
+    const std::uint8_t planted = f == 0 ? kContactLeft : kContactRight;
+    const std::uint8_t heel = f == 0 ? kContactLeftHeel : kContactRightHeel;
+    const std::uint8_t toe = f == 0 ? kContactLeftToe : kContactRightToe;
     ++foot_ticks_;
     if (!tick.clamped.empty() && tick.clamped[foot]) ++clamped_ticks_;
-    if (contacts & bit) {
+    if (contacts & planted) {
       ++contact_ticks_;
       if (!tick.locked.empty() && tick.locked[foot]) ++locked_ticks_;
-      const double height_cm = 100.0 * (double(shown.y) - params_.planted_height[std::size_t(f)]);
+      const double height_cm = 100.0 * (double(shown[0].y) - params_.planted_height[std::size_t(f)]);
       height_sum_cm_ += height_cm;
       height_.add(std::abs(height_cm));
-      if (seen_[s] > 0 && (last_contacts_[s] & bit)) {
-        sliding_sum_ += horizontal(shown, last_feet_[foot]) / params_.dt;
-        sliding_animated_sum_ += horizontal(animated, last_feet_animated_[foot]) / params_.dt;
+      if (seen_[s] > 0 && (last_contacts_[s] & planted)) {
+        // The point on the ground: the heel while only the heel touches.
+        const int k = (contacts & heel) && !(contacts & toe) ? 1 : 0;
+        sliding_sum_ += horizontal(shown[k], last_points_[2 * foot + std::size_t(k)]) / params_.dt;
+        sliding_animated_sum_ += horizontal(animated[k], last_points_animated_[2 * foot + std::size_t(k)]) / params_.dt;
         ++sliding_samples_;
       }
     }
-    last_feet_[foot] = shown;
-    last_feet_animated_[foot] = animated;
+    for (int k = 0; k < 2; ++k) {
+      last_points_[2 * foot + std::size_t(k)] = shown[k];
+      last_points_animated_[2 * foot + std::size_t(k)] = animated[k];
+    }
   }
   last_contacts_[s] = contacts;
 }

@@ -5,10 +5,13 @@
 // of figures are the same measurement.
 //
 // Per stream (a character, or a clip) and tick of dt seconds:
-//   - foot sliding: the horizontal speed of a foot's contact joint between
-//     two ticks where the foot is flagged in contact (FootContact planted
-//     bits) at both, mean in cm/s; the same on the pose before foot IK when
-//     it is given.
+//   - foot sliding: the horizontal speed of a foot's point on the ground
+//     between two ticks where the foot is flagged in contact (FootContact
+//     planted bits) at both, mean in cm/s; the same on the pose before foot
+//     IK when it is given. The point is the contact joint (the toe), or the
+//     ankle while the frame says only the heel touches (heel bit without the
+//     toe bit): a foot rolling onto its toe after a heel strike moves its
+//     toe down and forward without sliding, and foot IK holds the heel then.
 //   - foot locks: of the foot-ticks flagged in contact, the fraction locked;
 //     of all foot-ticks, the fraction whose leg was soft-clamped by the IK.
 //   - knee angular speed: the knee's flexion angle is the angle between the
@@ -116,7 +119,7 @@ class MotionMeter {
   std::uint64_t ticks_ = 0;
   std::vector<std::uint64_t> seen_;        // [streams] ticks since the stream (re)started
   std::vector<std::uint64_t> since_jump_;  // [streams] ticks since its last jump's first pose
-  std::vector<glm::vec3> last_feet_, last_feet_animated_;  // [streams x 2]
+  std::vector<glm::vec3> last_points_, last_points_animated_;  // [streams x 2 feet x (toe, ankle)]
   std::vector<std::uint8_t> last_contacts_;                // [streams]
   std::vector<float> last_knee_;                           // [streams x 2] radians, NaN: none
   std::vector<glm::vec3> poses_;                           // [ring x streams x joints]

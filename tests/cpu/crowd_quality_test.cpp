@@ -108,6 +108,25 @@ TEST(MotionMeter, FeetSlidingLocksClampsAndHeightInContact) {
   EXPECT_NEAR(f.foot_height_in_contact_cm_p95, 1.0, 0.05);
 }
 
+TEST(MotionMeter, SlidingFollowsThePointOnTheGround) {
+  // A heel strike: the left ankle holds still while the foot rolls onto its
+  // toe (the toe comes down and forward at 0.6 m/s). While the frame says
+  // only the heel touches, the heel is what must not slide; once the toe
+  // touches, the toe.
+  const double dt = 1.0 / 30.0;
+  MotionMeter meter(1, kJoints, stick_params(dt));
+  for (int t = 0; t < 20; ++t) {
+    std::vector<glm::vec3> pose = standing(0.0f, 0.0f);
+    const bool rolling = t < 10;
+    pose[4] = pose[3] + glm::vec3(0.0f, -0.06f, 0.12f + float(0.6 * std::min(t, 10) * dt));
+    const std::uint8_t contacts[1] = {std::uint8_t(kContactLeft | (rolling ? kContactLeftHeel : kContactLeftToe))};
+    meter.record({pose, {}, contacts, {}, {}, {}});
+  }
+  // 19 samples: 9 rolling on the heel (0), the one where the toe lands
+  // (still moving, 60 cm/s), 9 on the toe (0).
+  EXPECT_NEAR(meter.figures().foot_sliding_cm_s, 60.0 / 19.0, 1e-3);
+}
+
 TEST(MotionMeter, WithoutLocksOrAnimatedPoseThoseFiguresAreNotMeasured) {
   MotionMeter meter(1, kJoints, stick_params(1.0 / 30.0));
   const std::uint8_t contacts[1] = {kContactLeft | kContactRight};

@@ -69,9 +69,10 @@ Status check_trace_paths(const CrowdOptions& o) {
     std::error_code ec;
     const auto mine = std::filesystem::weakly_canonical(file, ec);
     for (const auto& [option, other] : others) {
-      if (!*other) continue;
-      const auto theirs = std::filesystem::weakly_canonical(**other, ec);
-      if (mine == theirs) return make_error("--trace: " + file.string() + " is also " + option + "'s file");
+      if (ec || !*other) continue;
+      std::error_code other_ec;
+      const auto theirs = std::filesystem::weakly_canonical(**other, other_ec);
+      if (!other_ec && mine == theirs) return make_error("--trace: " + file.string() + " is also " + option + "'s file");
     }
     if (Status writable = check_writable(file); !writable) return make_error("--trace: " + writable.message());
   }

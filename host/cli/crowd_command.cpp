@@ -47,7 +47,7 @@ constexpr const char* kCrowdUsage =
     "  --foot-ik on|off      lock planted feet where they touched down, legs solved by\n"
     "                        two-bone IK (default on)\n"
     "  --continuing-bias B   added to the cost of the frame a character would play anyway\n"
-    "                        (default -1: a jump must win by 1)\n"
+    "                        (default -2: a jump must win by 2)\n"
     "  --continuing-multiplier M  multiplies that frame's cost first (finite, >= 0; default 1)\n"
     "  --exclusion-window N  frames within N of that frame in its clip are no candidates\n"
     "                        (default 0)\n"
@@ -55,7 +55,8 @@ constexpr const char* kCrowdUsage =
     "  --trace FILE          write the displayed world joint positions of the first\n"
     "                        --trace-agents characters every tick: float32 x, y, z per\n"
     "                        joint, [ticks x agents x joints], and FILE.json beside it\n"
-    "                        (joint names, parents, tick rate, contacts, foot locks)\n"
+    "                        (joint names, parents, tick rate, contacts, foot locks);\n"
+    "                        held in memory until the run ends, at most 512 MiB\n"
     "  --trace-agents M      characters in the trace (default 1)\n";
 
 // One entry per shipped set, its description wrapped under the usage's
@@ -185,13 +186,14 @@ int run_crowd(Args args, const char* argv0) {
   std::fprintf(stderr,
                "mmvk crowd: %llu ticks in %.2f s (%.1fx real time): %llu searches (%llu without a candidate), "
                "search %.2f / %.2f ms, tick %.2f / %.2f ms (p50 / p99)\n"
-               "mmvk crowd: trajectory error %.3f m at 1 s (median), foot sliding %.2f cm/s (the clips alone: %.2f), "
+               "mmvk crowd: trajectory error %.3f m at 1 s (median), "
                "%.2f transitions "
                "per agent per second; chosen frames 0x%016llx\n",
                static_cast<unsigned long long>(s.ticks), s.wall_seconds, s.realtime_factor,
                static_cast<unsigned long long>(s.searches), static_cast<unsigned long long>(s.no_candidate),
                s.search_ms_p50, s.search_ms_p99, s.tick_ms_p50, s.tick_ms_p99, s.trajectory_error_m_1s,
-               s.foot_sliding_cm_s, s.foot_sliding_database_cm_s, s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
+               s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
+  std::fputs(crowd::describe_motion(s).c_str(), stderr);
   if (options.summary) {
     if (Status written = crowd::write_summary(s, *options.summary); !written) return fail(written.message());
     std::fprintf(stderr, "mmvk crowd: summary written to %s\n", options.summary->string().c_str());

@@ -1,27 +1,34 @@
 #include "crowd_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "clip_quality.hpp"
 #include "crowd_backend.hpp"
 #include "crowd_recorder.hpp"
-#include "database_sliding.hpp"
 #include "default_data.hpp"
 #include "mmvk/hash.hpp"
 #include "gait_plan.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
+#include "mmvk/file_io.hpp"
+#include "mmvk/query_builder.hpp"
 #include "mmvk/trajectory.hpp"
+#include "motion_meter.hpp"
 #include "observed_search.hpp"
 #include "progress_line.hpp"
 #include "quality_meter.hpp"
 #include "scenario.hpp"
 #include "steering.hpp"
+#include "trace.hpp"
 
 #if defined(MMVK_CROWD_HAS_VIEWER)
 #include "viewer/viewer_html.hpp"
@@ -45,6 +52,31 @@ Status check_options(const CrowdOptions& o) {
     return make_error("--search-interval must be a positive number (seconds)");
   }
   if (o.seconds * o.rate_hz > 1.0e7) return make_error("--seconds x --rate is over 10 million ticks");
+  if (o.continuing_bias && !std::isfinite(*o.continuing_bias)) return make_error("--continuing-bias must be finite");
+  if (o.continuing_multiplier && !(std::isfinite(*o.continuing_multiplier) && *o.continuing_multiplier >= 0.0f)) {
+    return make_error("--continuing-multiplier must be finite and >= 0");
+  }
+  return {};
+}
+
+// The trace's files must not be another output of the run (nor its input):
+// the last one written would silently win.
+Status check_trace_paths(const CrowdOptions& o) {
+  if (!o.trace) return {};
+  const std::filesystem::path files[2] = {*o.trace, trace_sidecar_path(*o.trace)};
+  const std::pair<const char*, const std::optional<std::filesystem::path>*> others[] = {
+      {"--summary", &o.summary}, {"--html", &o.html}, {"--data", &o.data}, {"--scenario", &o.scenario}};
+  for (const auto& file : files) {
+    std::error_code ec;
+    const auto mine = std::filesystem::weakly_canonical(file, ec);
+    for (const auto& [option, other] : others) {
+      if (ec || !*other) continue;
+      std::error_code other_ec;
+      const auto theirs = std::filesystem::weakly_canonical(**other, other_ec);
+      if (!other_ec && mine == theirs) return make_error("--trace: " + file.string() + " is also " + option + "'s file");
+    }
+    if (Status writable = check_writable(file); !writable) return make_error("--trace: " + writable.message());
+  }
   return {};
 }
 
@@ -103,10 +135,31 @@ constexpr float kContinuingBias = -2.0f;
 // The 1 s horizon of the trajectory error, as the controller would predict it.
 constexpr float kErrorHorizon[1] = {1.0f};
 
+// --weights on every character's query options; errors name --weights.
+Status apply_weights(const CrowdOptions& options, const Database& database, std::span<QueryParams> params) {
+  if (options.weights.empty()) return {};
+  QueryParams weighted;
+  for (const auto& [channel, weight] : options.weights) {
+    if (Status set = set_channel_weight(database.schema(), weighted, channel, weight); !set) {
+      return make_error("--weights: " + set.message());
+    }
+  }
+  for (QueryParams& p : params) p.channel_weights = weighted.channel_weights;
+  return {};
+}
+
+// The spacing of the pose acceleration samples: the database's frame
+// interval in ticks (motion_meter.hpp).
+std::uint32_t acceleration_step(double rate_hz, double fps) {
+  return std::uint32_t(std::clamp(std::lround(rate_hz / fps), 1L, 16L));
+}
+
 }  // namespace
 
 Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_TRY(check_options(options));
+  // Before the database, which may take a while to build.
+  MMVK_TRY(check_trace_paths(options));
   MMVK_ASSIGN_OR_RETURN(const DataChoice data, choose_data(options.data, options.executable));
   MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
   const Database& db = opened.database;
@@ -122,11 +175,15 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
-  params.continuing_bias = kContinuingBias;
+  params.continuing_bias = options.continuing_bias.value_or(kContinuingBias);
+  params.continuing_multiplier = options.continuing_multiplier.value_or(params.continuing_multiplier);
+  params.exclusion_window = options.exclusion_window.value_or(params.exclusion_window);
+  params.foot_ik.enabled = options.foot_ik;
   Result<CrowdController> created = CrowdController::create(db, agents, params);
   if (!created) return make_error(db_name + ": " + created.message());
   CrowdController controller = std::move(created.value());
   MMVK_TRY(apply_tags(scenario, db, controller.query_params()));
+  MMVK_TRY(apply_weights(options, db, controller.query_params()));
   for (std::uint32_t b = 0; b < agents; ++b) {
     const AgentPlan& plan = scenario.agents[b];
     const float yaw = std::atan2(plan.goals[0][0] - plan.start[0], plan.goals[0][1] - plan.start[1]);
@@ -151,9 +208,29 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   const float dt = float(1.0 / options.rate_hz);
   const auto ticks = std::uint64_t(std::llround(options.seconds * options.rate_hz));
+  const AnimationData& animation = controller.animation();
+  const std::size_t joints = animation.joint_count();
+  std::optional<TraceWriter> trace;
+  if (options.trace) {
+    const TraceLayout layout{ticks, options.trace_agents, std::uint32_t(joints), options.rate_hz};
+    Result<TraceWriter> writer =
+        TraceWriter::create(*options.trace, layout, animation.skeleton, animation.contact_joints, agents);
+    if (!writer) return writer.error();
+    trace.emplace(std::move(writer.value()));
+  }
   Steering steering(scenario, *speeds);
   ObservedSearch observed(*search.deferred, agents);
-  QualityMeter meter(agents, 2, dt);
+  QualityMeter meter(agents, dt);
+  // The clips first: their planted toe height is the crowd's floor.
+  const ClipQuality clips = measure_clip_quality(db, pool);
+  MotionMeterParams motion_params;
+  motion_params.legs = find_leg_joints(animation);
+  motion_params.planted_height = clips.planted_height;
+  motion_params.dt = dt;
+  motion_params.acceleration_step = acceleration_step(options.rate_hz, db.fps());
+  // Three half-lives: the inertialization's blend has done 90% of its work.
+  motion_params.jump_window_s = 3.0 * params.inertialization_half_life;
+  MotionMeter motion(agents, joints, motion_params);
   std::unique_ptr<CrowdRecorder> recorder;
   if (options.html) {
     const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
@@ -169,15 +246,12 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   // Per tick, [N] each; sized once.
   std::vector<float> x(agents), z(agents), vx(agents), vz(agents), desired_xz(2 * agents), root_xz(2 * agents);
-  std::vector<glm::vec3> desired(agents), world(std::size_t(agents) * controller.animation().joint_count());
-  std::vector<float> foot_xz(4 * std::size_t(agents));
-  std::vector<std::uint8_t> contact(2 * std::size_t(agents));
+  std::vector<glm::vec3> desired(agents), world(agents * joints), animated(agents * joints);
   std::vector<std::uint32_t> searched_before, searched_now, frames_before(agents);
   std::vector<std::uint8_t> kinds_before(agents, 0);  // controller.searched() of the tick before
   searched_before.reserve(agents), searched_now.reserve(agents);
   glm::vec3 horizon_pos[1];
   float horizon_yaw[1];
-  const auto feet = controller.animation().contact_joints;
 
   std::vector<double> search_ms, tick_ms;
   search_ms.reserve(ticks), tick_ms.reserve(ticks);
@@ -213,23 +287,16 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
       root_xz[2 * b] = roots_now[b].x, root_xz[2 * b + 1] = roots_now[b].z;
     }
     meter.record_trajectory(desired_xz, root_xz);
-    if (feet[0] >= 0 && feet[1] >= 0) {
-      controller.world_positions(world, pool);
-      const auto contacts = controller.contacts();
-      const std::size_t joints = controller.animation().joint_count();
-      for (std::uint32_t b = 0; b < agents; ++b) {
-        for (int f = 0; f < 2; ++f) {
-          const glm::vec3& p = world[b * joints + std::size_t(feet[f])];
-          foot_xz[4 * b + 2 * f] = p.x, foot_xz[4 * b + 2 * f + 1] = p.z;
-          contact[2 * b + f] = (contacts[b] & (f == 0 ? kContactLeft : kContactRight)) ? 1 : 0;
-        }
-      }
-      meter.record_feet(foot_xz, contact);
-    }
     meter.add_transitions(controller.last_tick().jumps);
     meter.end_tick();
+    // The pose as displayed (after foot IK) and as animated (before).
+    controller.world_positions(world, pool);
+    controller.animated_world_positions(animated, pool);
+    motion.record({world, animated, controller.contacts(), controller.foot_locked(), controller.ik_reach_clamped(),
+                   controller.jumped()});
+    if (trace) trace->record(world, controller.contacts(), controller.foot_locked());
 
-    if (recorder) recorder->record_tick(t, matches, searched_before, kinds_before, frames_before);
+    if (recorder) recorder->record_tick(t, matches, searched_before, kinds_before, frames_before, world);
     searched_now.clear();
     const auto kinds = controller.searched();
     for (std::uint32_t b = 0; b < agents; ++b) {
@@ -271,8 +338,10 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.wall_seconds = wall;
   s.realtime_factor = wall > 0.0 ? s.seconds / wall : 0.0;
   s.trajectory_error_m_1s = meter.trajectory_error_m_median();
-  s.foot_sliding_cm_s = meter.foot_sliding_cm_s();
-  s.foot_sliding_database_cm_s = database_foot_sliding_cm_s(db, pool);
+  s.foot_ik = options.foot_ik;
+  s.motion = motion.figures();
+  s.clips = clips.figures;
+  s.planted_height_m = clips.planted_height;
   s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
   s.chosen_frames_hash = chosen.digest();
@@ -280,6 +349,10 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }
 
+  if (trace) {
+    MMVK_TRY(trace->finish());
+    s.trace = options.trace->string();
+  }
   if (options.html) {
 #if defined(MMVK_CROWD_HAS_VIEWER)
     Recording recording = recorder->finish(pool);

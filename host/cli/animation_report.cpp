@@ -6,6 +6,7 @@
 
 #include "mmvk/file_io.hpp"
 #include "cli_args.hpp"
+#include "contact_report.hpp"
 
 namespace mmvk::cli {
 
@@ -13,21 +14,6 @@ namespace {
 
 const char* encoding_name(RotationEncoding encoding) {
   return encoding == RotationEncoding::Float32 ? "float32" : "quantized16";
-}
-
-// Frames with each foot in contact.
-std::pair<std::uint64_t, std::uint64_t> contact_frames(const AnimationData& a) {
-  std::uint64_t left = 0;
-  std::uint64_t right = 0;
-  for (std::uint8_t c : a.contacts) {
-    left += (c & kContactLeft) ? 1 : 0;
-    right += (c & kContactRight) ? 1 : 0;
-  }
-  return {left, right};
-}
-
-std::string joint_name(const AnimationData& a, int joint) {
-  return joint < 0 ? std::string("none") : a.skeleton.names[static_cast<std::size_t>(joint)];
 }
 
 }  // namespace
@@ -38,24 +24,17 @@ void print_animation(const Database& database) {
     std::printf("animation: none (features only; rebuild without --no-animation to add poses)\n");
     return;
   }
-  const auto [left, right] = contact_frames(*a);
-  const double frames = a->frame_count > 0 ? double(a->frame_count) : 1.0;
   std::printf("animation: %zu joints (%zu translated per frame), rotations %s; %zu bytes per frame in the file, "
               "%zu in memory (%s bytes in the file)\n",
               a->joint_count(), a->translated_joints.size(), encoding_name(a->encoding), a->bytes_per_frame_in_file(),
               a->bytes_per_frame_in_memory(),
               thousands(static_cast<unsigned long long>(a->bytes_per_frame_in_file()) * a->frame_count).c_str());
-  std::printf("contacts: %s %.0f%% of frames, %s %.0f%% (height < %s%g m, speed < %g m/s)\n",
-              joint_name(*a, a->contact_joints[0]).c_str(), 100.0 * double(left) / frames,
-              joint_name(*a, a->contact_joints[1]).c_str(), 100.0 * double(right) / frames,
-              a->contact_params.height_above_clip_floor ? "clip floor + " : "", double(a->contact_params.max_height),
-              double(a->contact_params.max_speed));
+  print_contacts(database);
 }
 
 nlohmann::json animation_json(const Database& database) {
   const AnimationData* a = database.animation();
   if (a == nullptr) return {{"present", false}};
-  const auto [left, right] = contact_frames(*a);
   nlohmann::json joints = nlohmann::json::array();
   for (std::size_t j = 0; j < a->joint_count(); ++j) {
     const glm::vec3& r = a->skeleton.rest_offsets[j];
@@ -70,12 +49,7 @@ nlohmann::json animation_json(const Database& database) {
           {"rotation_encoding", encoding_name(a->encoding)},
           {"bytes_per_frame_file", a->bytes_per_frame_in_file()},
           {"bytes_per_frame_memory", a->bytes_per_frame_in_memory()},
-          {"contact_joints", {joint_name(*a, a->contact_joints[0]), joint_name(*a, a->contact_joints[1])}},
-          {"contact_max_height", a->contact_params.max_height},
-          {"contact_height_above_clip_floor", a->contact_params.height_above_clip_floor},
-          {"contact_floor_percentile", a->contact_params.floor_percentile},
-          {"contact_max_speed", a->contact_params.max_speed},
-          {"contact_frames", {left, right}}};
+          {"contacts", contacts_json(database)}};
 }
 
 Status export_animation(const Database& database, const std::string& source, const std::filesystem::path& values,
@@ -131,7 +105,8 @@ Status export_animation(const Database& database, const std::string& source, con
       "metres, radians, Y up; rotations are local quaternions (x, y, z, w) relative to the parent, except that "
       "joints above the hips are the identity and the hips (and any joint without a parent) are relative to the "
       "character root; root.x/root.z/root.yaw place the character root in its clip's world (yaw 0 faces +Z, "
-      "facing = (sin yaw, 0, cos yaw)); untranslated joints use rest_offset; contacts: bit 0 left, bit 1 right";
+      "facing = (sin yaw, 0, cos yaw)); untranslated joints use rest_offset; contacts: bit 0 left foot planted, bit 1 right, bit 2 left heel, "
+      "bit 3 left toe, bit 4 right heel, bit 5 right toe (a foot is planted when its heel or toe is)";
   out["clips"] = nlohmann::json::array();
   for (const Clip& clip : database.clips()) {
     out["clips"].push_back({{"name", clip.name}, {"first_frame", clip.first_frame}, {"frame_count", clip.frame_count},

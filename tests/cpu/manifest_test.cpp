@@ -133,6 +133,66 @@ TEST(Manifest, ErrorsNameTheField) {
   EXPECT_NE(manifest_error(R"({"schema": "missing.json", "clips": ["a.bvh"]})").find("missing.json"), std::string::npos);
 }
 
+TEST(Manifest, ContactsBlock) {
+  Result<Manifest> manifest = parse_manifest_json(R"({
+      "contacts": {"left_toe": "ToeL", "right_toe": "ToeR", "left_heel": "AnkleL", "right_heel": "AnkleR",
+                   "enter_height": 0.01, "exit_height": 0.04, "enter_speed": 0.02, "exit_speed": 0.09,
+                   "min_contact_seconds": 0.2, "min_gap_seconds": 0, "speed_step_seconds": 0.05,
+                   "height_above_clip_floor": false, "floor_percentile": 0.1, "heel_height_extra": 0.07},
+      "clips": ["a.bvh"]})",
+                                                  "m.json", "/base");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  const FootContactParams& c = manifest->contacts;
+  EXPECT_EQ(c.left_toe, "ToeL");
+  EXPECT_EQ(c.right_toe, "ToeR");
+  EXPECT_EQ(c.left_heel, "AnkleL");
+  EXPECT_EQ(c.right_heel, "AnkleR");
+  EXPECT_EQ(c.enter_height, 0.01f);
+  EXPECT_EQ(c.exit_height, 0.04f);
+  EXPECT_EQ(c.enter_speed, 0.02f);
+  EXPECT_EQ(c.exit_speed, 0.09f);
+  EXPECT_EQ(c.min_contact_seconds, 0.2f);
+  EXPECT_EQ(c.min_gap_seconds, 0.0f);
+  EXPECT_EQ(c.speed_step_seconds, 0.05f);
+  EXPECT_FALSE(c.height_above_clip_floor);
+  EXPECT_EQ(c.floor_percentile, 0.1f);
+  EXPECT_EQ(c.heel_height_extra, 0.07f);
+
+  // Fields left out keep the documented defaults.
+  manifest = parse_manifest_json(R"({"contacts": {"exit_speed": 0.3}, "clips": ["a.bvh"]})", "m.json", "/base");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  EXPECT_EQ(manifest->contacts.exit_speed, 0.3f);
+  EXPECT_EQ(manifest->contacts.enter_speed, FootContactParams{}.enter_speed);
+  EXPECT_EQ(manifest->contacts.left_toe, "@left_toe");
+}
+
+TEST(Manifest, ContactsErrorsNameTheField) {
+  const auto error = [](std::string_view contacts) {
+    return manifest_error(std::string(R"({"contacts": )") + std::string(contacts) + R"(, "clips": ["a.bvh"]})");
+  };
+  EXPECT_NE(error("[]").find("m.json: contacts: expected an object"), std::string::npos);
+  EXPECT_NE(error(R"({"max_speed": 1})").find("m.json: contacts.max_speed: unknown field"), std::string::npos);
+  EXPECT_NE(error(R"({"enter_speed": -0.1})").find("m.json: contacts.enter_speed: must be a finite number >= 0, got -0.1"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"exit_height": -1e-3})").find("m.json: contacts.exit_height: must be a finite number >= 0"),
+            std::string::npos);
+  // JSON has no NaN or infinity; a number beyond float's range is the way in.
+  EXPECT_NE(error(R"({"min_gap_seconds": 1e39})").find("m.json: contacts.min_gap_seconds: not a finite number"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"exit_speed": "fast"})").find("m.json: contacts.exit_speed: expected a number"), std::string::npos);
+  EXPECT_NE(error(R"({"enter_speed": 0.2, "exit_speed": 0.1})")
+                .find("m.json: contacts.exit_speed: must be >= enter_speed (0.2), got 0.1"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"exit_height": 0.001})").find("m.json: contacts.exit_height: must be >= enter_height"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"floor_percentile": 1.5})").find("m.json: contacts.floor_percentile: must be in [0, 1]"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"left_toe": ""})").find("m.json: contacts.left_toe: empty bone name"), std::string::npos);
+  EXPECT_NE(error(R"({"right_heel": 3})").find("m.json: contacts.right_heel: expected a string"), std::string::npos);
+  EXPECT_NE(error(R"({"height_above_clip_floor": 1})").find("m.json: contacts.height_above_clip_floor: expected true or false"),
+            std::string::npos);
+}
+
 TEST(Manifest, LoadsSchemaFilesRelativeToTheManifest) {
   const auto dir = test::make_temp_dir();
   {

@@ -47,8 +47,15 @@ struct AnimationData {
   // in character space), ascending. Every other joint uses
   // skeleton.rest_offsets, which hold the effective constant translation.
   std::vector<std::uint32_t> translated_joints;
-  std::array<int, 2> contact_joints{-1, -1};  // left, right bone used for contacts
-  FootContactParams contact_params;           // the thresholds the contacts were detected with
+  // The contact points of each foot (left, right): the toe, and the heel
+  // (the ankle joint, "@left_foot"). A skeleton without a toe (DAZ) has its
+  // heel in both, and no toe bits in `contacts`. -1 where neither resolved.
+  std::array<int, 2> contact_joints{-1, -1};
+  std::array<int, 2> heel_joints{-1, -1};
+  FootContactParams contact_params;  // the thresholds the contacts were detected with
+  // Contacts loaded from a format 2 or 3 file: detected on 3-D speed without
+  // hysteresis or minimum durations; rebuilding the database relabels them.
+  bool legacy_contacts = false;
   RotationEncoding encoding = RotationEncoding::Float32;
 
   std::uint32_t frame_count = 0;                 // = Database::frame_count()
@@ -56,7 +63,7 @@ struct AnimationData {
   std::vector<glm::vec3> local_translations;     // [frames x translated_joints.size()], metres
   std::vector<glm::vec3> root_positions;         // [frames], the clip's world space, y = 0, metres
   std::vector<float> root_yaws;                  // [frames], radians
-  std::vector<std::uint8_t> contacts;            // [frames], FootContact bits
+  std::vector<std::uint8_t> contacts;            // [frames], FootContact bits (foot_contacts.hpp)
 
   std::size_t joint_count() const { return skeleton.size(); }
   // Bytes one frame takes in memory (rotations, translations, root, contacts).

@@ -72,7 +72,6 @@ struct BuildProgress {
 struct AnimationBuildOptions {
   bool enabled = true;  // false = features only (mmvk build --no-animation)
   std::function<void(const std::string&)> warning;
-  FootContactParams contacts;
   RotationEncoding encoding = RotationEncoding::Float32;  // how the .mmdb file keeps rotations
 };
 
@@ -103,6 +102,7 @@ struct MotionBuildSettings {
   CharacterRootOptions character_root;
   EdgeRule edge_rule = EdgeRule::Exclude;
   AnimationBuildOptions animation;
+  FootContactParams contacts;  // the animation's contacts and the foot_contact channel (Manifest::contacts)
 };
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings);

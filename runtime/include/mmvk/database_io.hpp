@@ -15,29 +15,40 @@
 //                              f32 cost bias, u32 first frame, u32 frame count
 //                         u32  frames, then frames x u32 frame flags
 //                         f32  features [frames x dims], row-major, normalized
-//                         u8   1 when per-frame modifiers follow (version 3 on;
-//                              version 3 is written only for a database that has them):
+//                         u8   1 when per-frame modifiers follow, else 0 (version 3
+//                              on; version 3 is written only for a database that has them):
 //                              u64 tags [frames], f32 cost multiplier [frames],
 //                              f32 cost bias [frames] (the manifest's tag_ranges
 //                              and cost_ranges; without them the clips' values hold)
-//                         u8   1 when the clips' import units follow (version 4
-//                              only, which is written only for a database that
-//                              records them): f32 metres per file unit [clips]
+//                         u8   1 when the clips' import units follow, else 0
+//                              (version 4 on; version 4 is written only for a
+//                              database that records them and has no animation):
+//                              f32 metres per file unit [clips]
 //                         u8   1 when the animation section follows, else 0 (version 2)
 //                         the animation section (version 2, animation_data.hpp):
 //                              u32 joints, then per joint: str name, i32 parent,
 //                              f32 x3 rest offset, i32 mirror partner;
 //                              u32 T, then T x u32 translated joints;
-//                              i32 left, i32 right contact joint, str left bone,
-//                              str right bone, f32 max height, f32 max speed,
-//                              f32 ankle height extra, u8 height above clip floor,
-//                              f32 floor percentile;
+//                              the contact setup (foot_contacts.hpp), version 5:
+//                                i32 left, right contact joint (toe), i32 left,
+//                                right heel joint, str left toe, right toe, left
+//                                heel, right heel bone, f32 enter height, exit
+//                                height, enter speed, exit speed, min contact
+//                                seconds, min gap seconds, speed step seconds,
+//                                floor percentile, heel height extra, u8 height
+//                                above clip floor;
+//                              versions 2 to 4:
+//                                i32 left, i32 right contact joint, str left bone,
+//                                str right bone, f32 max height, f32 max speed,
+//                                f32 ankle height extra, u8 height above clip
+//                                floor, f32 floor percentile;
 //                              u8 rotation encoding (0 float32, 1 quantized16);
 //                              u32 frames, then rotations [frames x joints]
 //                              (x, y, z, w as f32, or as i16 / 32767 with w >= 0),
 //                              f32 x3 translations [frames x T],
 //                              f32 x2 root (x, z) [frames], f32 root yaw [frames],
-//                              u8 contacts [frames]
+//                              u8 contacts [frames] (FootContact bits; versions 2
+//                              to 4 have the planted bits alone)
 //                       (str = u32 byte length + UTF-8 bytes)
 //   24 + P     u64      FNV-1a 64 of bytes [0, 24 + P)
 // Loading checks, in order: the length covers the header, the magic, the
@@ -57,11 +68,15 @@
 namespace mmvk {
 
 // Version 2 adds the optional animation section, version 3 the per-frame
-// tags and cost modifiers, version 4 the clips' import units (each written
-// only for a database that has them, so others stay version 2 or 3 files);
-// version 1 to 3 files still load (version 1: features only,
-// Database::animation() null; before 4: Clip::metres_per_unit 0).
-inline constexpr std::uint32_t kDatabaseFormatVersion = 4;
+// tags and cost modifiers, version 4 the clips' import units, version 5 the
+// contact labels of foot_contacts.hpp (toe and heel bits, hysteresis and
+// minimum durations on horizontal speed). A file gets the oldest version
+// that holds it: 5 with animation, else 4 with import units, else 3 with
+// per-frame modifiers, else 2. Versions 1 to 4 still load (version 1:
+// features only, Database::animation() null; before 4: Clip::metres_per_unit
+// 0; before 5: the planted bits gain the bit of the point they were detected
+// on, and AnimationData::legacy_contacts is set).
+inline constexpr std::uint32_t kDatabaseFormatVersion = 5;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 
 // The file's bytes.

@@ -121,8 +121,8 @@ std::uint32_t window_frames(float window_seconds, float fps);
 // window longer than the clip (2 x window + 1 frames > frames); on a
 // non-looping clip with past trajectory offsets, a reach before and after
 // that leaves no frame inside the edges; an unknown curve; a LimbVector whose
-// second_bone does not hang below its bone; FootContact bones that resolve
-// on neither side.
+// second_bone does not hang below its bone; for FootContact, a foot whose toe
+// and heel both fail to resolve.
 // Preconditions: root arrays sized motion.frame_count.
 Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& root, const FeatureSchema& schema,
                                      const FeatureExtractionOptions& options);

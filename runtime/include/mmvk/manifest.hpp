@@ -13,6 +13,9 @@
 //                              // left/right pairs that override the name heuristics
 //   "mirror_map": { "phase": { "swap": [[0, 2], [1, 3]], "negate": [4] } },
 //                              // how a custom (sidecar) channel's dims mirror
+//   "contacts": { "enter_speed": 0.1, "exit_speed": 0.2, ... },
+//                              // foot contact detection: any FootContactParams
+//                              // field by name (foot_contacts.hpp; defaults there)
 //   "clips": [
 //     { "file": "walk.bvh",    // relative paths are relative to the manifest's folder
 //       "range": [0.5, 1.4],   // only this part of the file, seconds (default: all of it)
@@ -43,6 +46,7 @@
 
 #include "mmvk/character.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/foot_contacts.hpp"
 #include "mmvk/motion.hpp"
 #include "mmvk/status.hpp"
 
@@ -142,6 +146,7 @@ struct Manifest {
   EdgeRule edge_rule = EdgeRule::Exclude;
   std::vector<BonePair> mirror_bones;     // overrides mirror_pairs()' heuristics
   std::vector<SidecarMirror> mirror_map;
+  FootContactParams contacts;      // the animation's contacts and the foot_contact channel
   std::vector<ManifestClip> clips;
 };
 

@@ -103,7 +103,12 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
   }
 
   ClipContacts contacts = detect_foot_contacts(motion.skeleton, positions, frames, motion.fps, params);
-  out.contact_joints = contacts.joints;
+  // A side without a toe keeps its heel as its contact joint, so readers of
+  // contact_joints (sliding meters, the viewer) always have a point.
+  for (std::size_t s = 0; s < 2; ++s) {
+    out.contact_joints[s] = contacts.toes[s] >= 0 ? contacts.toes[s] : contacts.heels[s];
+  }
+  out.heel_joints = contacts.heels;
   out.contacts = std::move(contacts.bits);
   return out;
 }
@@ -130,6 +135,7 @@ Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, c
   out.contact_params = contacts;
   out.encoding = encoding;
   out.contact_joints = first.contact_joints;
+  out.heel_joints = first.heel_joints;
   out.frame_count = static_cast<std::uint32_t>(frames);
 
   // A joint needs per-frame translations when it varies in some clip or

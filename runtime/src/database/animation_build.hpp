@@ -21,7 +21,8 @@ struct ClipAnimation {
   Skeleton skeleton;
   std::string source;                         // names the clip in errors
   std::uint32_t frame_count = 0;
-  std::array<int, 2> contact_joints{-1, -1};
+  std::array<int, 2> contact_joints{-1, -1};  // AnimationData::contact_joints
+  std::array<int, 2> heel_joints{-1, -1};
   std::vector<glm::quat> rotations;           // [frames x joints]
   std::vector<glm::vec3> constant;            // [joints]: the translation of non-varying joints
   std::vector<std::uint32_t> varying;         // joints whose translation varies, ascending

@@ -48,8 +48,10 @@ Status AnimationData::validate(std::uint32_t frames) const {
       return make_error(where + "translated_joints must be ascending joint indices");
     }
   }
-  for (int c : contact_joints) {
-    if (c < -1 || c >= static_cast<int>(joints)) return make_error(where + "contact joint out of range");
+  for (std::size_t s = 0; s < 2; ++s) {
+    for (int c : {contact_joints[s], heel_joints[s]}) {
+      if (c < -1 || c >= static_cast<int>(joints)) return make_error(where + "contact joint out of range");
+    }
   }
   if (frame_count != frames) {
     return make_error(where + std::to_string(frame_count) + " frames, the database has " + std::to_string(frames));
@@ -77,8 +79,17 @@ Status AnimationData::validate(std::uint32_t frames) const {
     if (!finite(root_positions[f]) || !std::isfinite(root_yaws[f])) {
       return make_error(where + "root of frame " + std::to_string(f) + " is not finite");
     }
-    if ((contacts[f] & ~(kContactLeft | kContactRight)) != 0) {
+    if ((contacts[f] & ~kContactAllBits) != 0) {
       return make_error(where + "frame " + std::to_string(f) + " has unknown contact bits");
+    }
+    // A point on the ground means the foot is planted. The converse is not
+    // required: a planted bit alone (contacts made in code) reads as the heel.
+    for (int side = 0; side < 2; ++side) {
+      const bool point = (contacts[f] & (contact_heel_bit(side) | contact_toe_bit(side))) != 0;
+      if (point && !(contacts[f] & contact_planted_bit(side))) {
+        return make_error(where + "frame " + std::to_string(f) + ": the " + (side == 0 ? "left" : "right") +
+                          " foot's heel or toe is in contact but the foot is not planted");
+      }
     }
   }
   return {};

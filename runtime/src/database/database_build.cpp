@@ -138,7 +138,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   options.loop = meta.loop;
   options.source = source;
   options.custom = custom;
-  options.contacts = settings.animation.contacts;  // foot_contact channels agree with the animation's contacts
+  options.contacts = settings.contacts;  // foot_contact channels agree with the animation's contacts
   if (settings.edge_rule == EdgeRule::Extrapolate) options.extrapolate_seconds = kExtrapolateSeconds;
   Result<RawFeatures> raw = extract_features(motion, *root, settings.schema, options);
   if (!raw.ok()) return raw.error();
@@ -174,7 +174,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   if (settings.animation.enabled) {
     Result<detail::ClipAnimation> animation =
         detail::extract_clip_animation(motion, *root, settings.character_root.source_bone,
-                                       settings.animation.contacts, source);
+                                       settings.contacts, source);
     if (!animation.ok()) return animation.error();
     out.animation = std::move(*animation);
   }
@@ -198,6 +198,7 @@ void keep_frames(Motion& motion, std::vector<std::vector<float>>& custom, std::u
 
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
+                          const FootContactParams& contacts,
                           const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
                           const std::string& source) {
   if (clips.empty()) return make_error(source + ": no clips");
@@ -215,7 +216,7 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
     animations.reserve(clips.size());
     for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
     Result<AnimationData> data =
-        detail::assemble_animation(animations, animation.contacts, animation.encoding, mirror_bones);
+        detail::assemble_animation(animations, contacts, animation.encoding, mirror_bones);
     if (data.ok()) {
       parts.animation = std::move(*data);
     } else if (animation.warning) {
@@ -353,7 +354,8 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
     }
     keep_frames(*motion, custom, first, end - first);
   }
-  const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation};
+  const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation,
+                                     manifest.contacts};
   Result<ProcessedClip> processed = process_motion(meta, *motion, custom, false, settings);
   if (!processed.ok()) return fail(processed.message());
   // The units the import used, recorded so that `mmvk inspect` can show them.
@@ -384,6 +386,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     Status valid = manifest.schema.validate();
     if (!valid.ok()) return make_error(source + ": " + valid.message());
   }
+  MMVK_TRY(validate_foot_contact_params(manifest.contacts, source + ": contacts"));
   if (manifest.clips.empty()) return make_error(source + ": no clips");
   // 0 keeps the source rate; anything else is a resampling target (the
   // manifest parser checks this too, but --fps overrides it afterwards).
@@ -436,11 +439,12 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     for (ProcessedClip& processed : clip.clips) clips.push_back(std::move(processed));
     clip.clips.clear();
   }
-  return assemble(clips, manifest.schema, fps, options.animation, manifest.mirror_bones, source);
+  return assemble(clips, manifest.schema, fps, manifest.contacts, options.animation, manifest.mirror_bones, source);
 }
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings) {
   MMVK_TRY(settings.schema.validate());
+  MMVK_TRY(validate_foot_contact_params(settings.contacts, "build_database_from_motions: contacts"));
   if (clips.empty()) return make_error("build_database_from_motions: no clips");
   const float fps = clips[0].motion.fps;
   std::vector<ProcessedClip> processed;
@@ -453,7 +457,8 @@ Result<Database> build_database_from_motions(std::span<const MotionClip> clips, 
     if (!one.ok()) return one.error();
     processed.push_back(std::move(*one));
   }
-  return assemble(processed, settings.schema, fps, settings.animation, {}, "build_database_from_motions");
+  return assemble(processed, settings.schema, fps, settings.contacts, settings.animation, {},
+                  "build_database_from_motions");
 }
 
 }  // namespace mmvk

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <span>
 
+#include "mmvk/character.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/hash.hpp"
 
@@ -121,6 +122,78 @@ std::uint32_t read_u32_at(std::string_view bytes, std::size_t at) {
 // error is about 4e-3 degree (tests/cpu/animation_io_test.cpp measures it).
 std::int16_t quantize(float c) { return static_cast<std::int16_t>(std::lround(std::clamp(c, -1.0f, 1.0f) * 32767.0f)); }
 
+// The contact setup of a version 5 animation section: the joints and the
+// detection parameters (database_io.hpp).
+void write_contact_setup(Writer& file, const AnimationData& a) {
+  for (const auto& joints : {a.contact_joints, a.heel_joints}) {
+    for (int j : joints) file.u32(static_cast<std::uint32_t>(j));
+  }
+  const FootContactParams& c = a.contact_params;
+  for_each_contact_bone(c, [&](const char*, const std::string& bone) { file.str(bone); });
+  for_each_contact_number(c, [&](const char*, float value) { file.f32(value); });
+  file.u8(c.height_above_clip_floor ? 1 : 0);
+}
+
+std::string read_contact_setup(Reader& in, AnimationData& a) {
+  for (auto* joints : {&a.contact_joints, &a.heel_joints}) {
+    for (int& j : *joints) {
+      std::uint32_t v = 0;
+      if (!in.u32(v)) return "animation contact joints";
+      j = static_cast<int>(v);
+    }
+  }
+  FootContactParams& c = a.contact_params;
+  bool read = true;
+  for_each_contact_bone(c, [&](const char*, std::string& bone) { read = read && in.str(bone); });
+  for_each_contact_number(c, [&](const char*, float& value) { read = read && in.f32(value); });
+  std::uint8_t above_floor = 0;
+  if (!read || !in.u8(above_floor)) return "animation contact parameters";
+  if (above_floor > 1) return "contact height mode";
+  c.height_above_clip_floor = above_floor != 0;
+  return {};
+}
+
+// Versions 2 to 4: one contact joint per side (the toe, or the ankle where
+// the skeleton has none) and one threshold pair on 3-D speed. Kept as
+// thresholds that mean the same (enter = exit, no minimum durations).
+std::string read_legacy_contact_setup(Reader& in, AnimationData& a) {
+  std::uint32_t left = 0;
+  std::uint32_t right = 0;
+  std::uint8_t above_floor = 0;
+  FootContactParams& c = a.contact_params;
+  if (!in.u32(left) || !in.u32(right) || !in.str(c.left_toe) || !in.str(c.right_toe) || !in.f32(c.enter_height) ||
+      !in.f32(c.enter_speed) || !in.f32(c.heel_height_extra) || !in.u8(above_floor) || !in.f32(c.floor_percentile)) {
+    return "animation contacts";
+  }
+  if (above_floor > 1) return "contact height mode";
+  c.height_above_clip_floor = above_floor != 0;
+  c.exit_height = c.enter_height;
+  c.exit_speed = c.enter_speed;
+  c.min_contact_seconds = 0.0f;
+  c.min_gap_seconds = 0.0f;
+  c.speed_step_seconds = 0.0f;  // central differences, in fact
+  a.contact_joints = {static_cast<int>(left), static_cast<int>(right)};
+  a.legacy_contacts = true;
+  return {};
+}
+
+// A legacy file's planted bits gain the bit of the point they were detected
+// on: the heel where the contact joint is the ankle, else the toe.
+void relabel_legacy_contacts(AnimationData& a) {
+  std::uint8_t point[2] = {};
+  for (int s = 0; s < 2; ++s) {
+    const std::size_t side = static_cast<std::size_t>(s);
+    Result<int> ankle = find_bone(a.skeleton, s == 0 ? a.contact_params.left_heel : a.contact_params.right_heel);
+    a.heel_joints[side] = ankle.ok() ? *ankle : -1;
+    point[side] = ankle.ok() && *ankle == a.contact_joints[side] ? contact_heel_bit(s) : contact_toe_bit(s);
+  }
+  for (std::uint8_t& bits : a.contacts) {
+    for (int s = 0; s < 2; ++s) {
+      if (bits & contact_planted_bit(s)) bits |= point[s];
+    }
+  }
+}
+
 void write_animation(Writer& file, const AnimationData& a) {
   file.u32(static_cast<std::uint32_t>(a.joint_count()));
   for (std::size_t j = 0; j < a.joint_count(); ++j) {
@@ -133,15 +206,7 @@ void write_animation(Writer& file, const AnimationData& a) {
   }
   file.u32(static_cast<std::uint32_t>(a.translated_joints.size()));
   for (std::uint32_t j : a.translated_joints) file.u32(j);
-  file.u32(static_cast<std::uint32_t>(a.contact_joints[0]));
-  file.u32(static_cast<std::uint32_t>(a.contact_joints[1]));
-  file.str(a.contact_params.left_bone);
-  file.str(a.contact_params.right_bone);
-  file.f32(a.contact_params.max_height);
-  file.f32(a.contact_params.max_speed);
-  file.f32(a.contact_params.ankle_height_extra);
-  file.u8(a.contact_params.height_above_clip_floor ? 1 : 0);
-  file.f32(a.contact_params.floor_percentile);
+  write_contact_setup(file, a);
   file.u8(static_cast<std::uint8_t>(a.encoding));
   file.u32(a.frame_count);
   for (const glm::quat& q : a.local_rotations) {
@@ -167,7 +232,7 @@ void write_animation(Writer& file, const AnimationData& a) {
 
 // Reads the section; sizes are checked against what is left before any
 // allocation. Returns an empty string on success, else what is corrupt.
-std::string read_animation(Reader& in, AnimationData& a) {
+std::string read_animation(Reader& in, std::uint32_t version, AnimationData& a) {
   std::uint32_t joints = 0;
   if (!in.u32(joints) || std::uint64_t{joints} * 24 > in.left()) return "animation joint count";
   a.skeleton.names.resize(joints);
@@ -191,20 +256,14 @@ std::string read_animation(Reader& in, AnimationData& a) {
   for (std::uint32_t& j : a.translated_joints) {
     if (!in.u32(j)) return "translated joints";
   }
-  std::uint32_t left = 0;
-  std::uint32_t right = 0;
-  std::uint8_t encoding = 0;
-  std::uint8_t above_floor = 0;
-  FootContactParams& c = a.contact_params;
-  if (!in.u32(left) || !in.u32(right) || !in.str(c.left_bone) || !in.str(c.right_bone) || !in.f32(c.max_height) ||
-      !in.f32(c.max_speed) || !in.f32(c.ankle_height_extra) || !in.u8(above_floor) || !in.f32(c.floor_percentile) ||
-      !in.u8(encoding) || !in.u32(a.frame_count)) {
-    return "animation contacts and encoding";
+  if (version >= 5) {
+    if (std::string what = read_contact_setup(in, a); !what.empty()) return what;
+  } else if (std::string what = read_legacy_contact_setup(in, a); !what.empty()) {
+    return what;
   }
-  if (above_floor > 1) return "contact height mode";
-  c.height_above_clip_floor = above_floor != 0;
+  std::uint8_t encoding = 0;
+  if (!in.u8(encoding) || !in.u32(a.frame_count)) return "animation encoding and frame count";
   if (encoding > static_cast<std::uint8_t>(RotationEncoding::Quantized16)) return "rotation encoding";
-  a.contact_joints = {static_cast<int>(left), static_cast<int>(right)};
   a.encoding = static_cast<RotationEncoding>(encoding);
   const std::uint64_t frames = a.frame_count;
   const std::uint64_t rotation_bytes = a.encoding == RotationEncoding::Float32 ? 16 : 8;
@@ -239,6 +298,7 @@ std::string read_animation(Reader& in, AnimationData& a) {
   in.f32_array(a.root_yaws);
   a.contacts.resize(frames);
   for (std::uint8_t& x : a.contacts) (void)in.u8(x);
+  if (a.legacy_contacts) relabel_legacy_contacts(a);
   return {};
 }
 
@@ -250,12 +310,13 @@ std::string serialize_database(const Database& database) {
   Writer file;
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
-  // Version 3 only when the per-frame section is needed: a database without
-  // time ranges stays a version 2 file that older builds read.
+  // The oldest version that holds the database, so that older builds read
+  // what they can: 5 with an animation section (its contact layout), else 4
+  // with import units, else 3 with per-frame modifiers, else 2.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
   const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
                                  [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
-  const std::uint32_t version = units ? 4u : per_frame ? 3u : 2u;
+  const std::uint32_t version = parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
   file.u32(version);
   file.u32(0);
   file.u64(0);
@@ -291,8 +352,8 @@ std::string serialize_database(const Database& database) {
     file.f32_array(database.frame_multiplier());
     file.f32_array(database.frame_bias());
   }
-  if (version >= 4) {
-    file.u8(1);
+  if (version >= 4) file.u8(units ? 1 : 0);
+  if (units) {
     for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
   file.u8(parts.animation ? 1 : 0);
@@ -431,7 +492,7 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
     if (!in.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");
     if (has_animation) {
       parts.animation.emplace();
-      if (std::string what = read_animation(in, *parts.animation); !what.empty()) return corrupt(what);
+      if (std::string what = read_animation(in, version, *parts.animation); !what.empty()) return corrupt(what);
     } else if (in.left() != 0) {
       return corrupt(std::to_string(in.left()) + " bytes after the features");
     }

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 #include <system_error>
 
@@ -260,6 +261,33 @@ Result<std::vector<SidecarMirror>> read_mirror_map(const Json& value, const Feat
   return out;
 }
 
+// The "contacts" block: any subset of FootContactParams' fields, by their
+// names; the result is validated whole (exit >= enter needs both).
+Result<FootContactParams> read_contacts(const Json& value, const std::string& where) {
+  if (!value.is_object()) return make_error(where + ": expected an object");
+  FootContactParams params;
+  std::set<std::string> known = {"height_above_clip_floor"};
+  for_each_contact_bone(params, [&](const char* name, std::string&) { known.insert(name); });
+  for_each_contact_number(params, [&](const char* name, float&) { known.insert(name); });
+  MMVK_TRY(check_fields(value, where, known));
+  std::optional<Error> error;
+  auto read = [&](const char* name, auto& target, auto parse) {
+    if (error || !value.contains(name)) return;
+    auto parsed = parse(value[name], where + "." + name);
+    if (parsed.ok()) {
+      target = *parsed;
+    } else {
+      error = parsed.error();
+    }
+  };
+  for_each_contact_bone(params, [&](const char* name, std::string& bone) { read(name, bone, read_string); });
+  for_each_contact_number(params, [&](const char* name, float& number) { read(name, number, json_float); });
+  read("height_above_clip_floor", params.height_above_clip_floor, read_bool);
+  if (error) return *error;
+  MMVK_TRY(validate_foot_contact_params(params, where));
+  return params;
+}
+
 bool is_bvh(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -298,7 +326,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   const Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"clips\"");
   MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "mirror_bones",
-                                          "mirror_map", "clips"}));
+                                          "mirror_map", "contacts", "clips"}));
 
   Manifest manifest;
   manifest.source = name;
@@ -380,6 +408,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   if (root.contains("mirror_map")) {
     MMVK_READ(manifest.mirror_map, read_mirror_map(root["mirror_map"], manifest.schema, at + "mirror_map"));
   }
+  if (root.contains("contacts")) MMVK_READ(manifest.contacts, read_contacts(root["contacts"], at + "contacts"));
   if (!root.contains("clips") || !root["clips"].is_array()) {
     return make_error(at + "clips: expected an array of clips");
   }

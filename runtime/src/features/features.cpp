@@ -205,10 +205,10 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
   if (needs_contacts) {
     detail::ClipContacts contacts =
         detail::detect_foot_contacts(motion.skeleton, clip.global, frames, motion.fps, options.contacts);
-    if (contacts.joints[0] < 0 || contacts.joints[1] < 0) {
-      return make_error(source + ": foot contacts: neither the contact bones ('" + options.contacts.left_bone +
-                        "', '" + options.contacts.right_bone +
-                        "') nor the ankles (@left_foot, @right_foot) resolve on the clip's skeleton");
+    if (!contacts.resolved()) {
+      return make_error(source + ": foot contacts: neither the toes ('" + options.contacts.left_toe + "', '" +
+                        options.contacts.right_toe + "') nor the heels ('" + options.contacts.left_heel + "', '" +
+                        options.contacts.right_heel + "') of both feet resolve on the clip's skeleton");
     }
     clip.contacts = std::move(contacts.bits);
   }

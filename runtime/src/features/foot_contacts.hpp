@@ -16,8 +16,11 @@
 namespace mmvk::detail {
 
 struct ClipContacts {
-  std::array<int, 2> joints{-1, -1};  // left, right contact bone; -1 when a side did not resolve
-  std::vector<std::uint8_t> bits;     // [frames], FootContact bits; all 0 when a side did not resolve
+  std::array<int, 2> toes{-1, -1};   // left, right toe joint; -1 where the skeleton has none
+  std::array<int, 2> heels{-1, -1};  // left, right heel (ankle) joint; -1 where it does not resolve
+  std::vector<std::uint8_t> bits;    // [frames], FootContact bits
+  // Both feet have a contact point (a toe or a heel); else bits are all 0.
+  bool resolved() const { return (toes[0] >= 0 || heels[0] >= 0) && (toes[1] >= 0 || heels[1] >= 0); }
 };
 
 // `positions` are the model-space joint positions [frames x joints] of a clip

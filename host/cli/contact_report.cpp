@@ -89,7 +89,7 @@ void print_contacts(const Database& database) {
   if (a == nullptr) return;
   const FootContactParams& c = a->contact_params;
   if (a->legacy_contacts) {
-    std::printf("contacts: from a format 2-3 file (3-D speed < %g m/s, height < %s%g m, no hysteresis or minimum "
+    std::printf("contacts: from a format 2-4 file (3-D speed < %g m/s, height < %s%g m, no hysteresis or minimum "
                 "duration); rebuild the database to relabel them\n",
                 double(c.enter_speed), c.height_above_clip_floor ? "clip floor + " : "", double(c.enter_height));
   } else {

@@ -53,7 +53,7 @@ struct AnimationData {
   std::array<int, 2> contact_joints{-1, -1};
   std::array<int, 2> heel_joints{-1, -1};
   FootContactParams contact_params;  // the thresholds the contacts were detected with
-  // Contacts loaded from a format 2 or 3 file: detected on 3-D speed without
+  // Contacts loaded from a format 2 to 4 file: detected on 3-D speed without
   // hysteresis or minimum durations; rebuilding the database relabels them.
   bool legacy_contacts = false;
   RotationEncoding encoding = RotationEncoding::Float32;

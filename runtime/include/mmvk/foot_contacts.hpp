@@ -19,7 +19,7 @@ namespace mmvk {
 // the toe bit is set, else the heel). The detection sets the planted bit
 // exactly when the heel or toe bit is; AnimationData::validate() requires a
 // heel or toe bit to come with the planted bit, and allows a planted bit
-// alone (contacts made in code), which reads as the heel.
+// alone (contacts made in code), which the foot locker reads as the toe.
 enum FootContact : std::uint8_t {
   kContactLeft = 1u << 0,
   kContactRight = 1u << 1,

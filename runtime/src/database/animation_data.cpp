@@ -83,7 +83,7 @@ Status AnimationData::validate(std::uint32_t frames) const {
       return make_error(where + "frame " + std::to_string(f) + " has unknown contact bits");
     }
     // A point on the ground means the foot is planted. The converse is not
-    // required: a planted bit alone (contacts made in code) reads as the heel.
+    // required: a planted bit alone (contacts made in code) is allowed.
     for (int side = 0; side < 2; ++side) {
       const bool point = (contacts[f] & (contact_heel_bit(side) | contact_toe_bit(side))) != 0;
       if (point && !(contacts[f] & contact_planted_bit(side))) {

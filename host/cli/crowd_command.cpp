@@ -47,7 +47,7 @@ constexpr const char* kCrowdUsage =
     "  --foot-ik on|off      lock planted feet where they touched down, legs solved by\n"
     "                        two-bone IK (default on)\n"
     "  --continuing-bias B   added to the cost of the frame a character would play anyway\n"
-    "                        (default -2: a jump must win by 2)\n"
+    "                        (default -2.5: a jump must win by 2.5)\n"
     "  --continuing-multiplier M  multiplies that frame's cost first (finite, >= 0; default 1)\n"
     "  --exclusion-window N  frames within N of that frame in its clip are no candidates\n"
     "                        (default 0)\n"

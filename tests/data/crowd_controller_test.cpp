@@ -41,21 +41,32 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   ASSERT_TRUE(controller.ok()) << controller.message();
   const std::size_t joints = controller->animation().joint_count();
   std::vector<glm::vec3> previous(test::kCrowdCharacters * joints), current(previous.size());
-  float worst_jump_step = 0.0f;  // joint displacement relative to the root on a jump tick, metres
-  float worst_step = 0.0f;       // the same on ticks without a jump
+  std::vector<glm::vec3> previous_shown(previous.size()), shown(previous.size());
+  // Joint displacement relative to the root per tick, metres, of the
+  // animated pose (what blending makes continuous) on jump ticks and on the
+  // others, and of the displayed pose (after foot IK) on any tick.
+  float worst_jump_step = 0.0f;
+  float worst_step = 0.0f;
+  float worst_shown_step = 0.0f;
+  auto step_of = [joints](const std::vector<glm::vec3>& now, const std::vector<glm::vec3>& before, std::size_t b,
+                          std::size_t j) {
+    const std::size_t i = b * joints + j;
+    return glm::length((now[i] - now[b * joints]) - (before[i] - before[b * joints]));
+  };
   auto observe = [&](const CrowdController& c, int tick) {
-    c.world_positions(current, pool);
+    c.animated_world_positions(current, pool);
+    c.world_positions(shown, pool);
     if (tick > 0) {
       for (std::uint32_t b = 0; b < c.size(); ++b) {
         for (std::size_t j = 0; j < joints; ++j) {
-          const std::size_t i = b * joints + j;
-          const float step = glm::length((current[i] - current[b * joints]) - (previous[i] - previous[b * joints]));
           float& worst = c.jumped()[b] ? worst_jump_step : worst_step;
-          worst = std::max(worst, step);
+          worst = std::max(worst, step_of(current, previous, b, j));
+          worst_shown_step = std::max(worst_shown_step, step_of(shown, previous_shown, b, j));
         }
       }
     }
     std::swap(previous, current);
+    std::swap(previous_shown, shown);
   };
   Result<test::CrowdRun> run = test::run_crowd(
       *controller, [&](CrowdController& c, const CrowdInput& in) { return c.tick(test::kCrowdDt, in, reference, pool); },
@@ -63,9 +74,9 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   ASSERT_TRUE(run.ok()) << run.message();
   const TickStats& totals = run->totals;
   std::printf("searches %u (forced %u), jumps %u, no candidate %u; worst root gap %.3f m; worst joint step %.3f m "
-              "without a jump, %.3f m on jumps\n",
+              "without a jump, %.3f m on jumps, %.3f m displayed\n",
               totals.searches, totals.forced, totals.jumps, totals.no_candidate, double(run->worst_root_gap),
-              double(worst_step), double(worst_jump_step));
+              double(worst_step), double(worst_jump_step), double(worst_shown_step));
   EXPECT_EQ(totals.no_candidate, 0u);
   EXPECT_EQ(totals.applied, totals.searches);
   EXPECT_GT(totals.jumps, 50u);
@@ -104,6 +115,10 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   // the tick after a jump moves joints by up to 0.8 m.
   EXPECT_LT(worst_jump_step, 1.25f * worst_step);
   EXPECT_LT(std::max(worst_step, worst_jump_step), 0.3f);
+  // Foot IK moves the displayed legs further on a few ticks: a lock released
+  // at unlock_distance (0.5 m) springs back to its animation within about
+  // 0.3 s. Measured: 0.36 m at worst (0.22 m animated).
+  EXPECT_LT(worst_shown_step, 0.4f);
 }
 
 TEST_F(CrowdControllerData, DeferredAndSplitBatchesMatchTheirReferences) {

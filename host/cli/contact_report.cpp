@@ -22,6 +22,10 @@ struct PointStats {
   const char* what = "";
   int joint = -1;
   std::uint8_t bit = 0;
+  // The planted foot: on frames where only the heel is down, its speed is
+  // the heel's (`heel_joint`, with `heel_only` the bits that say so).
+  int heel_joint = -1;
+  std::uint8_t heel_only[2] = {0, 0};  // {heel bit, toe bit}
   std::uint64_t frames = 0;       // frames with the bit
   double speed_sum = 0.0;         // m/s, over consecutive flagged frame pairs of a clip
   std::uint64_t pairs = 0;
@@ -35,8 +39,10 @@ struct PointStats {
   }
 };
 
-// [side][planted, toe, heel]. The planted foot's speed is its contact joint's
-// (the toe where there is one), as the crowd measures sliding.
+// [side][planted, toe, heel]. The planted foot's speed is that of its point
+// on the ground, as the crowd measures sliding (host/crowd/motion_meter.hpp):
+// the heel while only the heel bit is set, else the contact joint (the toe
+// where there is one); a toe rolling down after a heel strike is no slide.
 using FootStats = std::array<std::array<PointStats, 3>, 2>;
 
 FootStats measure(const Database& database, const AnimationData& a) {
@@ -44,7 +50,8 @@ FootStats measure(const Database& database, const AnimationData& a) {
   for (int s = 0; s < 2; ++s) {
     const std::size_t side = static_cast<std::size_t>(s);
     const bool has_toe = a.contact_joints[side] >= 0 && a.contact_joints[side] != a.heel_joints[side];
-    out[side] = {PointStats{"planted", a.contact_joints[side], contact_planted_bit(s)},
+    out[side] = {PointStats{"planted", a.contact_joints[side], contact_planted_bit(s), a.heel_joints[side],
+                            {contact_heel_bit(s), contact_toe_bit(s)}},
                  PointStats{"toe", has_toe ? a.contact_joints[side] : -1, contact_toe_bit(s)},
                  PointStats{"heel", a.heel_joints[side], contact_heel_bit(s)}};
   }
@@ -64,9 +71,11 @@ FootStats measure(const Database& database, const AnimationData& a) {
         for (PointStats& point : foot) {
           if (!(bits & point.bit)) continue;
           ++point.frames;
-          if (!(before & point.bit) || point.joint < 0) continue;
-          const glm::vec3 p = positions[std::size_t{f} * joints + std::size_t(point.joint)];
-          const glm::vec3 q = positions[std::size_t{f - 1} * joints + std::size_t(point.joint)];
+          const bool on_heel = point.heel_joint >= 0 && (bits & point.heel_only[0]) && !(bits & point.heel_only[1]);
+          const int joint = on_heel ? point.heel_joint : point.joint;
+          if (!(before & point.bit) || joint < 0) continue;
+          const glm::vec3 p = positions[std::size_t{f} * joints + std::size_t(joint)];
+          const glm::vec3 q = positions[std::size_t{f - 1} * joints + std::size_t(joint)];
           const double speed = std::hypot(double(p.x) - q.x, double(p.z) - q.z) * database.fps();
           point.speed_sum += speed;
           ++point.pairs;

@@ -15,6 +15,8 @@ void print_contacts(const Database& database);
 // {"toe_joints", "heel_joints", "legacy", "params", "feet": {"left": {"planted",
 // "toe", "heel"}, "right": ...}}, each with "joint", "frames", "fraction",
 // "mean_speed_cm_s" and "fast_fraction"; null without an animation section.
+// The planted foot's speed is its point on the ground's: the heel while only
+// the heel bit is set, else "joint" (the toe), as the crowd measures sliding.
 nlohmann::json contacts_json(const Database& database);
 
 }  // namespace mmvk::cli

@@ -94,10 +94,10 @@ TEST_F(FootContactsData, DefaultCrowdDataKeepsItsFigures) {
   for (const char* side : {"left", "right"}) {
     SCOPED_TRACE(side);
     const nlohmann::json& planted = c["feet"][side]["planted"];
-    // Measured 38.1% at 3.94 cm/s (noisier CMU markers; the old labels
+    // Measured 38.1% at 3.27 cm/s (noisier CMU markers; the old labels
     // flagged 48% at 8.8 cm/s).
     EXPECT_GE(planted["fraction"].get<double>(), 0.33);
-    EXPECT_LE(planted["mean_speed_cm_s"].get<double>(), 4.5);
+    EXPECT_LE(planted["mean_speed_cm_s"].get<double>(), 4.0);
   }
   // Mirrored copies make the two feet alike.
   EXPECT_EQ(c["feet"]["left"]["planted"]["frames"], c["feet"]["right"]["planted"]["frames"]);

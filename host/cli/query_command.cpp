@@ -41,7 +41,8 @@ constexpr const char* kQueryUsage =
     "Reads B queries as raw little-endian float32 [B x dims] (dims and their order\n"
     "as in `mmvk export`'s sidecar). Values are raw features, normalized here with\n"
     "the database's offsets and scales, or already normalized with --normalized.\n"
-    "(--features is a synonym of --queries.)\n"
+    "(--features is a synonym of --queries.) The queries may come from a pipe\n"
+    "(--queries /dev/stdin); every other input must be a regular file.\n"
     "--pose-targets: one pose-matching query instead, from end-effector targets\n"
     "  {\"targets\": [{\"bone\": \"@left_foot\", \"position\": [x, y, z], \"velocity\": [x, y, z]}]}\n"
     "  (character space, metres and m/s; see docs/search.md): only the targeted\n"
@@ -295,7 +296,9 @@ int run_query(Args args) {
     }
   }
   Result<std::vector<float>> features =
-      pose ? Result<std::vector<float>>(pose->features) : read_f32_rows(*queries_path, db->dims());
+      pose ? Result<std::vector<float>>(pose->features)
+           : read_f32_rows(*queries_path, db->dims(), std::nullopt,
+                           ReadOptions{std::uint64_t{kMaxBatch} * db->dims() * 4, /*allow_stream=*/true});
   if (!features) return fail(features.message());
   const std::size_t count = features->size() / db->dims();
   if (!pose && !parsed->has("--normalized")) {

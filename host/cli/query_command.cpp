@@ -260,8 +260,14 @@ int run_query(Args args) {
     if (!value) return report_error("query", value.message(), 2);
     threads = *value;
   }
-  if (const auto out = parsed->value("--out")) {
-    if (Status writable = check_writable(*out); !writable) return fail(writable.message());
+  {
+    // Before any work: --out must be writable and no input.
+    std::vector<NamedPath> paths = {{"the database", parsed->positional[0], false}};
+    if (queries_path) paths.push_back({parsed->value("--queries") ? "--queries" : "--features", *queries_path, false});
+    if (pose_path) paths.push_back({"--pose-targets", *pose_path, false});
+    if (const auto table = parsed->value("--clusters")) paths.push_back({"--clusters", *table, false});
+    if (const auto out = parsed->value("--out")) paths.push_back({"--out", *out, true});
+    if (Status checked = check_command_paths(paths); !checked) return fail(checked.message());
   }
   // A mistyped backend is reported before the database loads (seconds for
   // a large one), in the words the registry would use.

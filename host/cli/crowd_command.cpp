@@ -29,16 +29,21 @@ constexpr const char* kCrowdUsage =
     "                        folder of BVH (built once and cached). Default: the CMU subject\n"
     "                        131 walks shipped with mmvk, cached in $XDG_CACHE_HOME/mmvk\n"
     "                        (or ~/.cache/mmvk)\n"
-    "  --agents N            characters (default 1000; with --scenario, its count)\n"
-    "  --seconds S           simulated time (default 10)\n"
-    "  --rate HZ             simulation ticks per second (default 30)\n"
-    "  --search-interval S   seconds between a character's regular searches (default 0.1)\n"
+    "  --agents N            characters (default 1000, at most 10,000,000; with --scenario, its count)\n"
+    "  --seconds S           simulated time (default 10; 1 to 10,000,000 ticks)\n"
+    "  --rate HZ             simulation ticks per second (default 30; 1 to 1000)\n"
+    "  --search-interval S   seconds between a character's regular searches (default 0.1; 0.001 to 3600)\n"
     "  --backend NAME        the search backend (default vulkan-brute, on the best device)\n"
     "  --device N            the Vulkan device index (default: the best one)\n"
     "  --seed N              the random scenario's seed (default 1)\n"
     "  --scenario FILE       starts, goals, speeds and tags from JSON (see host/crowd/scenario.hpp)\n"
     "  --summary FILE        write the run's figures as JSON\n"
-    "  --html FILE           write the viewer: one self-contained page\n";
+    "  --html FILE           write the viewer: one self-contained page\n"
+    "\n"
+    "Inputs are regular files (a FIFO or device is refused); outputs are checked\n"
+    "before the run, may be a FIFO or device (written in place) but never an input,\n"
+    "and a run that would need more memory than this machine allows is refused\n"
+    "with its estimate (docs/files-and-limits.md).\n";
 
 }  // namespace
 

@@ -9,6 +9,8 @@
 #include <glm/vec3.hpp>
 
 #include "crowd_backend.hpp"
+#include "crowd_limits.hpp"
+#include "crowd_paths.hpp"
 #include "crowd_recorder.hpp"
 #include "database_sliding.hpp"
 #include "default_data.hpp"
@@ -43,8 +45,7 @@ Status check_options(const CrowdOptions& o) {
   if (!(o.search_interval_s > 0.0) || !std::isfinite(o.search_interval_s)) {
     return make_error("--search-interval must be a positive number (seconds)");
   }
-  if (o.seconds * o.rate_hz > 1.0e7) return make_error("--seconds x --rate is over 10 million ticks");
-  return {};
+  return check_time_options(o);
 }
 
 Result<OpenedDatabase> open_crowd_database(const CrowdOptions& options, std::FILE* log) {
@@ -106,6 +107,7 @@ constexpr float kErrorHorizon[1] = {1.0f};
 
 Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_TRY(check_options(options));
+  MMVK_TRY(check_crowd_paths(options));
   MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(options, log));
   const Database& db = opened.database;
   const std::string db_name = (options.data ? options.data->string() : std::string("the CMU 131 walks (default)"));
@@ -114,7 +116,9 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   }
   Result<GaitSpeeds> speeds = measure_gait_speeds(db);
   if (!speeds) return make_error(db_name + ": " + speeds.message());
+  MMVK_TRY(check_crowd_memory(options, db, nullptr));
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options));
+  MMVK_TRY(check_crowd_memory(options, db, &scenario));
   const auto agents = std::uint32_t(scenario.agents.size());
 
   ControllerParams params;

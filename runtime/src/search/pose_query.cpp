@@ -124,7 +124,7 @@ Result<std::vector<PoseTarget>> parse_pose_targets_json(std::string_view json_te
 }
 
 Result<std::vector<PoseTarget>> load_pose_targets(const std::filesystem::path& path) {
-  MMVK_ASSIGN_OR_RETURN(const std::string text, read_file(path));
+  MMVK_ASSIGN_OR_RETURN(const std::string text, read_file(path, ReadOptions{kMaxJsonBytes, false}));
   return parse_pose_targets_json(text, path.string());
 }
 

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/hash.hpp"
 
 namespace mmvk::cli {
 
@@ -41,7 +42,7 @@ nlohmann::json sidecar(const Database& db, const std::string& source, const std:
   out["frames"] = db.frame_count();
   out["dims"] = db.dims();
   out["fps"] = db.fps();
-  out["content_hash"] = db.content_hash();
+  out["content_hash"] = hash_hex(db.content_hash());
   out["channels"] = nlohmann::json::array();
   std::vector<std::uint32_t> groups;
   std::vector<float> weights;

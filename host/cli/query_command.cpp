@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -180,7 +181,9 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
 Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
   QueryParams params;
   if (const auto text = args.value("--continuing")) {
-    MMVK_ASSIGN_OR_RETURN(params.continuing_frame, parse_u32("--continuing", *text));
+    // A frame of the database: 4294967295 (kNoFrame inside the library) is
+    // no way to say "none"; leave the option out for that.
+    MMVK_ASSIGN_OR_RETURN(params.continuing_frame, parse_u32("--continuing", *text, 0, db.frame_count() - 1));
   }
   if (const auto text = args.value("--continuing-bias")) {
     MMVK_ASSIGN_OR_RETURN(params.continuing_bias, parse_float("--continuing-bias", *text));
@@ -199,9 +202,13 @@ Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
     }
   }
   if (const auto text = args.value("--weights")) {
+    std::set<std::string> seen;
     for (const std::string& item : split_list(*text)) {
       const std::size_t equals = item.find('=');
       if (equals == std::string::npos) return make_error("--weights: expected CHANNEL=WEIGHT, got '" + item + "'");
+      if (!seen.insert(item.substr(0, equals)).second) {
+        return make_error("--weights: channel '" + item.substr(0, equals) + "' is given twice");
+      }
       MMVK_ASSIGN_OR_RETURN(const float weight, parse_float("--weights", item.substr(equals + 1)));
       MMVK_TRY(set_channel_weight(db.schema(), params, item.substr(0, equals), weight));
     }

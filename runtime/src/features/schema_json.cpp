@@ -37,6 +37,10 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
   }
   channel.kind = info->kind;
   if (object.contains("bone")) {
+    // Unknown fields are errors, and so is a field the kind would ignore.
+    if (!has_field(info->fields, ChannelField::Bone)) {
+      return make_error(where + ".bone: a " + kind + " channel reads no bone");
+    }
     if (!object["bone"].is_string()) return make_error(where + ".bone: expected a string");
     channel.bone = object["bone"].get<std::string>();
   }

@@ -329,6 +329,27 @@ TEST_F(HostileCli, HashesPrintInHexEverywhere) {
   expect_clean_error(foreign, {"another database", "this database's is " + hash}, "a foreign table");
 }
 
+// Issue 23: names that are not UTF-8 (a Latin-1 file name becomes a clip
+// name) are replaced in every JSON output instead of aborting after an
+// output was already replaced.
+TEST_F(HostileCli, NamesThatAreNotUtf8AreReplacedInEveryJsonOutput) {
+  fs::create_directories(dir_ / "latin1");
+  fs::copy_file(bvh_, dir_ / "latin1" / "w\xe9lk.bvh");
+  const std::string db = (dir_ / "latin1.mmdb").string();
+  const Ran built = run(mmvk_ + " build " + (dir_ / "latin1").string() + " --edge-rule clamp -o " + db);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const std::string features = (dir_ / "l.f32").string(), animation = (dir_ / "a.f32").string();
+  const Ran exported = run(mmvk_ + " export " + db + " --features " + features + " --animation " + animation);
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  const Ran inspected = run(mmvk_ + " inspect --json " + db + " > " + (dir_ / "i.json").string());
+  ASSERT_EQ(inspected.exit_code, 0) << inspected.output;
+  for (const fs::path& json : {fs::path(features + ".json"), fs::path(animation + ".json"), dir_ / "i.json"}) {
+    const std::string text = read_text(json);
+    EXPECT_NE(text.find("w\xef\xbf\xbdlk"), std::string::npos) << json;  // U+FFFD for the 0xE9 byte
+    EXPECT_EQ(text.find("w\xe9lk"), std::string::npos) << json;
+  }
+}
+
 // Issue 23: a manifest may name any file (.. and absolute paths are
 // allowed), but one that is not BVH is rejected without echoing its content.
 TEST_F(HostileCli, ANonBvhClipIsRejectedWithoutEchoingIt) {

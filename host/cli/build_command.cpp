@@ -28,7 +28,7 @@ constexpr const char* kBuildUsage =
     "  --fps N                resample every clip to N frames/s (default: keep the source rate)\n"
     "  --schema FILE          feature schema JSON (overrides the manifest's)\n"
     "  --mirror               also add a mirrored copy of every clip\n"
-    "  --edge-rule RULE       exclude | clamp (overrides the manifest's)\n"
+    "  --edge-rule RULE       exclude | clamp | extrapolate (overrides the manifest's)\n"
     "  --threads N            threads loading clips (default 0: all cores; at most 1024)\n"
     "  --no-animation         store features only (no skeleton, poses, root motion or contacts)\n"
     "  --quantize-rotations   store joint rotations as 16-bit integers (8 instead of 16 bytes per joint)\n"
@@ -87,14 +87,12 @@ int run_build(Args args) {
     manifest->schema = std::move(*schema);
   }
   if (auto rule = parsed->value("--edge-rule")) {
-    if (*rule == "exclude") {
-      manifest->edge_rule = EdgeRule::Exclude;
-    } else if (*rule == "clamp") {
-      manifest->edge_rule = EdgeRule::Clamp;
-    } else {
-      std::fprintf(stderr, "mmvk build: --edge-rule expects exclude or clamp, got '%s'\n", rule->c_str());
+    Result<EdgeRule> parsed_rule = parse_edge_rule(*rule);
+    if (!parsed_rule.ok()) {
+      std::fprintf(stderr, "mmvk build: --edge-rule: %s\n", parsed_rule.message().c_str());
       return 2;
     }
+    manifest->edge_rule = *parsed_rule;
   }
   if (parsed->has("--mirror")) {
     for (ManifestClip& clip : manifest->clips) clip.mirror = true;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 
 #include <unistd.h>
 
@@ -96,6 +97,33 @@ Result<double> parse_positive(std::string_view option, std::string_view text) {
     return make_error(expected(option, "a positive number", text));
   }
   return value;
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+Result<std::vector<std::pair<std::string, float>>> parse_weight_list(std::string_view option, const std::string& text) {
+  std::vector<std::pair<std::string, float>> weights;
+  for (const std::string& item : split_list(text)) {
+    const std::size_t equals = item.find('=');
+    if (equals == std::string::npos) {
+      return make_error(std::string(option) + ": expected CHANNEL=WEIGHT, got '" + item + "'");
+    }
+    std::string channel = item.substr(0, equals);
+    MMVK_ASSIGN_OR_RETURN(const float weight, parse_float(option, item.substr(equals + 1)));
+    for (const auto& seen : weights) {
+      if (seen.first == channel) return make_error(std::string(option) + ": channel '" + channel + "' is given twice");
+    }
+    weights.emplace_back(std::move(channel), weight);
+  }
+  return weights;
 }
 
 int report_error(std::string_view command, std::string_view message, int exit_code) {

@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -42,6 +43,12 @@ Result<std::uint32_t> parse_u32(std::string_view option, std::string_view text, 
 Result<float> parse_float(std::string_view option, std::string_view text);
 // A finite number > 0.
 Result<double> parse_positive(std::string_view option, std::string_view text);
+
+// "a,b,,c" -> {"a", "b", "c"}.
+std::vector<std::string> split_list(const std::string& text);
+// "CHANNEL=W,CHANNEL=W" -> (channel, weight) pairs, each weight a finite
+// float; a malformed item or a channel named twice is an error naming `option`.
+Result<std::vector<std::pair<std::string, float>>> parse_weight_list(std::string_view option, const std::string& text);
 
 // Prints "mmvk <command>: <message>" to stderr and returns `exit_code`.
 int report_error(std::string_view command, std::string_view message, int exit_code);

@@ -11,6 +11,7 @@
 #include "mmvk/hash.hpp"
 #include "mmvk/normalization.hpp"
 #include "animation_report.hpp"
+#include "units_report.hpp"
 
 namespace mmvk::cli {
 
@@ -19,9 +20,10 @@ namespace {
 constexpr const char* kInspectUsage =
     "usage: mmvk inspect db.mmdb [--json]\n"
     "\n"
-    "Prints the database's frames, clips, fps, tags, frame flag counts and, per\n"
-    "channel and dimension, the normalization offset and scale and the raw\n"
-    "(unnormalized) mean, std, min and max.\n"
+    "Prints the database's frames, clips, fps, tags, frame flag counts, the metres\n"
+    "per file unit the import used, the skeleton's standing height, the walk and run\n"
+    "speeds the crowd measures and, per channel and dimension, the normalization\n"
+    "offset and scale and the raw (unnormalized) mean, std, min and max.\n"
     "  --json   the same as one JSON object on stdout\n";
 
 // Names come from files anyone can write: control characters (an escape
@@ -136,6 +138,7 @@ int run_inspect(Args args) {
       out["channels"].push_back(std::move(ch));
     }
     out["animation"] = animation_json(db);
+    out["units"] = units_json(db);
     out["clips"] = nlohmann::json::array();
     for (const Clip& clip : db.clips()) {
       out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
@@ -154,6 +157,7 @@ int run_inspect(Args args) {
               looping, db.dims(), double(db.fps()));
   std::printf("content hash: %s\n", hash_hex(db.content_hash()).c_str());
   print_animation(db);
+  print_units(db);
   std::printf("frame flags: %s do_not_use, %s block_transition, %s edge_excluded; %s candidate frames\n",
               thousands(do_not_use).c_str(), thousands(block).c_str(), thousands(edge).c_str(),
               thousands(candidates).c_str());

@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -70,16 +69,6 @@ constexpr const char* kQueryUsageOptions =
     "\n"
     "The vulkan-* backends keep their pipeline cache between runs in\n"
     "$XDG_CACHE_HOME/mmvk (else ~/.cache/mmvk), one file per device.\n";
-
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
-    if (!item.empty()) items.push_back(item);
-  }
-  return items;
-}
 
 #if defined(MMVK_HAS_VULKAN)
 using ContextHolder = std::unique_ptr<vulkan::Context>;
@@ -202,16 +191,8 @@ Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
     }
   }
   if (const auto text = args.value("--weights")) {
-    std::set<std::string> seen;
-    for (const std::string& item : split_list(*text)) {
-      const std::size_t equals = item.find('=');
-      if (equals == std::string::npos) return make_error("--weights: expected CHANNEL=WEIGHT, got '" + item + "'");
-      if (!seen.insert(item.substr(0, equals)).second) {
-        return make_error("--weights: channel '" + item.substr(0, equals) + "' is given twice");
-      }
-      MMVK_ASSIGN_OR_RETURN(const float weight, parse_float("--weights", item.substr(equals + 1)));
-      MMVK_TRY(set_channel_weight(db.schema(), params, item.substr(0, equals), weight));
-    }
+    MMVK_ASSIGN_OR_RETURN(const auto weights, parse_weight_list("--weights", *text));
+    for (const auto& [channel, weight] : weights) MMVK_TRY(set_channel_weight(db.schema(), params, channel, weight));
   }
   return params;
 }

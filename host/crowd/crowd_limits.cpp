@@ -34,7 +34,7 @@ std::string gib(std::uint64_t bytes) {
 // cgroup v2's limit for this process's group ("max" or bytes); none when
 // the file is absent (cgroup v1, no limit, not Linux).
 std::uint64_t cgroup_limit() {
-  const Result<std::string> text = read_file("/sys/fs/cgroup/memory.max", ReadOptions{64, false});
+  const Result<std::string> text = read_file("/sys/fs/cgroup/memory.max", ReadOptions{4096, false});
   if (!text) return std::numeric_limits<std::uint64_t>::max();
   std::uint64_t value = 0;
   const char* first = text->data();

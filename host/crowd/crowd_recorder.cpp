@@ -1,7 +1,11 @@
 #include "crowd_recorder.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
+#include "mmvk/character.hpp"
 #include "mmvk/pose_batch.hpp"
 
 namespace mmvk::crowd {
@@ -22,6 +26,21 @@ std::vector<std::uint32_t> matched_trajectory_dims(const Database& database, std
   }
   return {};
 }
+
+// The joints foot IK moves: each leg's knee, ankle and toe that resolve.
+std::vector<std::int32_t> ik_leg_joints(const Skeleton& skeleton) {
+  std::vector<std::int32_t> joints;
+  for (const char* role : {"@left_lower_leg", "@left_foot", "@left_toe", "@right_lower_leg", "@right_foot",
+                           "@right_toe"}) {
+    if (Result<int> joint = find_bone(skeleton, role)) joints.push_back(*joint);
+  }
+  std::sort(joints.begin(), joints.end());
+  joints.erase(std::unique(joints.begin(), joints.end()), joints.end());
+  return joints;
+}
+
+// A locked foot whose anchor moved further than this starts a new event.
+constexpr float kAnchorMoveM = 0.001f;
 
 }  // namespace
 
@@ -44,12 +63,16 @@ CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& 
   r.joint_parents.assign(skeleton.parents.begin(), skeleton.parents.end());
   frame_seen_.assign(controller.database().frame_count(), 0);
   matched_dims_ = matched_trajectory_dims(controller.database(), offsets);
+  r.leg_joints = ik_leg_joints(skeleton);
+  r.foot_events.resize(r.agent_count);
+  feet_now_.assign(r.agent_count, FootEvent{});
+  for (FootEvent& now : feet_now_) now.state = 0xff;  // none yet: the first tick adds one
 }
 
 void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> collected,
                                 std::span<const std::uint32_t> searched_before,
                                 std::span<const std::uint8_t> kinds_before,
-                                std::span<const std::uint32_t> frames_before) {
+                                std::span<const std::uint32_t> frames_before, std::span<const glm::vec3> world) {
   const auto jumped = controller_.jumped();
   // The searches ran at the end of the previous tick.
   const float searched_at = float(tick) * dt_;
@@ -64,10 +87,36 @@ void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> colle
     event.cost = std::isfinite(collected[i].cost) ? collected[i].cost : 0.0f;
     recording_.searches[b].push_back(event);
   }
-  if (tick % ticks_per_sample_ == 0) sample(tick);
+  // Samples and foot events carry the time of the tick they were taken after.
+  record_feet(float(tick) * dt_);
+  if (tick % ticks_per_sample_ == 0) sample(world);
 }
 
-void CrowdRecorder::sample(std::uint64_t /*tick*/) {
+void CrowdRecorder::record_feet(float time_s) {
+  const auto contacts = controller_.contacts();
+  const auto locked = controller_.foot_locked();
+  const auto anchors = controller_.foot_anchors();
+  for (std::size_t b = 0; b < recording_.agent_count; ++b) {
+    FootEvent next;
+    next.time_s = time_s;
+    next.state = std::uint8_t(((contacts[b] & kContactLeft) ? kFootPlantedLeft : 0) |
+                              ((contacts[b] & kContactRight) ? kFootPlantedRight : 0));
+    bool moved = false;
+    for (std::size_t foot = 0; foot < 2; ++foot) {
+      if (!locked[2 * b + foot]) continue;
+      next.state |= std::uint8_t(foot == 0 ? kFootLockedLeft : kFootLockedRight);
+      const glm::vec3& anchor = anchors[2 * b + foot];
+      next.anchor[foot] = {anchor.x, anchor.y, anchor.z};
+      const auto& was = feet_now_[b].anchor[foot];
+      moved = moved || glm::length(anchor - glm::vec3(was[0], was[1], was[2])) > kAnchorMoveM;
+    }
+    if (next.state == feet_now_[b].state && !moved) continue;
+    recording_.foot_events[b].push_back(next);
+    feet_now_[b] = next;
+  }
+}
+
+void CrowdRecorder::sample(std::span<const glm::vec3> world) {
   Recording& r = recording_;
   const std::size_t n = r.agent_count;
   const std::size_t points = r.trajectory_points();
@@ -95,6 +144,13 @@ void CrowdRecorder::sample(std::uint64_t /*tick*/) {
       const float z = row[d + 1] * norm[d + 1].scale + norm[d + 1].offset;
       r.matched_x.push_back(roots[b].x + c * x + s * z);
       r.matched_z.push_back(roots[b].z - s * x + c * z);
+    }
+  }
+  const std::size_t joints = controller_.animation().joint_count();
+  for (std::size_t b = 0; b < n; ++b) {
+    for (const std::int32_t j : r.leg_joints) {
+      const glm::vec3& p = world[b * joints + std::size_t(j)];
+      r.leg_positions.insert(r.leg_positions.end(), {p.x, p.y, p.z});
     }
   }
   ++r.sample_count;

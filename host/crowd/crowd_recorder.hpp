@@ -1,6 +1,7 @@
 // Fills the viewer's Recording (recording.hpp) while a crowd runs: the
-// sampled roots, frames and desired trajectories, each search as an event,
-// and at the end the character-space poses of every frame that was played.
+// sampled roots, frames, desired trajectories and legs as displayed, each
+// search and each change of the feet (contacts, locks) as an event, and at
+// the end the character-space poses of every frame that was played.
 #pragma once
 
 #include <cstdint>
@@ -23,17 +24,19 @@ class CrowdRecorder {
   // `collected` are the matches the tick applied, for the characters that
   // searched in the tick before (`searched_before`, ascending), with that
   // tick's CrowdController::searched() (`kinds_before`, [characters]: 2
-  // marks a forced search), and `frames_before` the frames they played when
-  // they searched.
+  // marks a forced search), `frames_before` the frames they played when
+  // they searched, and `world` the displayed world joint positions
+  // [characters x joints] after the tick (CrowdController::world_positions).
   void record_tick(std::uint64_t tick, std::span<const Match> collected,
                    std::span<const std::uint32_t> searched_before, std::span<const std::uint8_t> kinds_before,
-                   std::span<const std::uint32_t> frames_before);
+                   std::span<const std::uint32_t> frames_before, std::span<const glm::vec3> world);
 
   // Adds the poses of the frames seen and returns the recording.
   Recording finish(ThreadPool& pool);
 
  private:
-  void sample(std::uint64_t tick);
+  void sample(std::span<const glm::vec3> world);
+  void record_feet(float time_s);
 
   const CrowdController& controller_;
   Recording recording_;
@@ -43,6 +46,7 @@ class CrowdRecorder {
   // The database's trajectory_position features, to draw the matched
   // trajectory: first dim of each offset's (x, z), or empty.
   std::vector<std::uint32_t> matched_dims_;
+  std::vector<FootEvent> feet_now_;  // [characters] the state of the last event
 };
 
 }  // namespace mmvk::crowd

@@ -1,28 +1,36 @@
 #include "crowd_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "clip_quality.hpp"
 #include "crowd_backend.hpp"
 #include "crowd_limits.hpp"
 #include "crowd_paths.hpp"
 #include "crowd_recorder.hpp"
-#include "database_sliding.hpp"
 #include "default_data.hpp"
 #include "mmvk/hash.hpp"
+#include "gait_plan.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
+#include "mmvk/file_io.hpp"
+#include "mmvk/query_builder.hpp"
 #include "mmvk/trajectory.hpp"
+#include "motion_meter.hpp"
 #include "observed_search.hpp"
 #include "progress_line.hpp"
 #include "quality_meter.hpp"
 #include "scenario.hpp"
 #include "steering.hpp"
+#include "trace.hpp"
 
 #if defined(MMVK_CROWD_HAS_VIEWER)
 #include "viewer/viewer_html.hpp"
@@ -45,27 +53,26 @@ Status check_options(const CrowdOptions& o) {
   if (!(o.search_interval_s > 0.0) || !std::isfinite(o.search_interval_s)) {
     return make_error("--search-interval must be a positive number (seconds)");
   }
+  if (o.continuing_bias && !std::isfinite(*o.continuing_bias)) return make_error("--continuing-bias must be finite");
+  if (o.continuing_multiplier && !(std::isfinite(*o.continuing_multiplier) && *o.continuing_multiplier >= 0.0f)) {
+    return make_error("--continuing-multiplier must be finite and >= 0");
+  }
   return check_time_options(o);
 }
 
-Result<OpenedDatabase> open_crowd_database(const CrowdOptions& options, std::FILE* log) {
+Result<OpenedDatabase> open_crowd_database(const DataChoice& data, const CrowdOptions& options, std::FILE* log) {
   auto say = [log](const std::string& line) {
     if (log) std::fprintf(log, "mmvk crowd: %s\n", line.c_str());
   };
-  if (options.data) return open_database(*options.data, options.cache_dir, say);
-  for (const auto& candidate : default_manifest_candidates(options.executable)) {
-    std::error_code ec;
-    if (std::filesystem::exists(candidate, ec)) return open_database(candidate, options.cache_dir, say);
-  }
-  return make_error("the default motion data (host/crowd/data/cmu131) was not found beside the program or in "
-                    "its source tree; pass --data DIR|manifest.json|db.mmdb");
+  return open_database(data.source, options.cache_dir, say);
 }
 
-Result<Scenario> make_scenario(const CrowdOptions& options) {
+Result<Scenario> make_scenario(const CrowdOptions& options, bool can_run) {
   if (!options.scenario) {
     RandomScenarioOptions random;
     random.agents = options.agents.value_or(1000);
     random.seed = options.seed;
+    if (!can_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     return make_random_scenario(random);
   }
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, load_scenario(*options.scenario));
@@ -93,41 +100,73 @@ Status apply_tags(const Scenario& scenario, const Database& database, std::span<
 }
 
 // Added to the cost of the frame a character would play anyway: a jump must
-// win by this much. Measured on the CMU 131 walks (200 characters, 10 s,
-// seed 1): 0 gives 2.25 transitions per character per second and 35.9 cm/s
-// foot sliding, -1 gives 1.34 and 17.7 cm/s with the same trajectory error
-// (0.05 m); -2 slides no less and follows worse. Feature costs are sums of
-// squared z-scores, so the scale carries over to other databases.
-constexpr float kContinuingBias = -1.0f;
+// win by this much. Queries measure the pose the character shows, which
+// (blended) lies further from every stored row than the row of the frame
+// it plays did, so the bias that holds jumps to the same rate is larger.
+// Measured with clusters, 200 characters, 10 s, seed 1, 30 Hz (trajectory
+// error at 1 s, foot sliding before IK, transitions per character per s):
+//   CMU 131:  -1: 0.046 m, 19.3 cm/s, 1.70;  -2: 0.050 m, 19.5, 1.27;  -3: 0.051 m, 20.2, 1.09
+//   Bandai:   -1: 0.042 m, 24.9 cm/s, 2.50;  -2: 0.045 m, 24.8, 1.90
+// (queries copied from the played frame's row, bias -1: CMU 0.055 m, 18.5,
+// 1.32; Bandai 0.045 m, 25.8, 2.05). Feature costs are sums of squared
+// z-scores, so the scale carries over to other databases.
+constexpr float kContinuingBias = -2.0f;
 
 // The 1 s horizon of the trajectory error, as the controller would predict it.
 constexpr float kErrorHorizon[1] = {1.0f};
+
+// --weights on every character's query options; errors name --weights.
+Status apply_weights(const CrowdOptions& options, const Database& database, std::span<QueryParams> params) {
+  if (options.weights.empty()) return {};
+  QueryParams weighted;
+  for (const auto& [channel, weight] : options.weights) {
+    if (Status set = set_channel_weight(database.schema(), weighted, channel, weight); !set) {
+      return make_error("--weights: " + set.message());
+    }
+  }
+  for (QueryParams& p : params) p.channel_weights = weighted.channel_weights;
+  return {};
+}
+
+// The spacing of the pose acceleration samples: the database's frame
+// interval in ticks (motion_meter.hpp).
+std::uint32_t acceleration_step(double rate_hz, double fps) {
+  return std::uint32_t(std::clamp(std::lround(rate_hz / fps), 1L, 16L));
+}
 
 }  // namespace
 
 Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_TRY(check_options(options));
-  MMVK_TRY(check_crowd_paths(options));
-  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(options, log));
+  MMVK_ASSIGN_OR_RETURN(const DataChoice data, choose_data(options.data, options.executable));
+  // Before the database, which may take a while to build: every output
+  // writable, none of them an input or another output (crowd_paths.hpp).
+  MMVK_TRY(check_crowd_paths(options, data.source));
+  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
   const Database& db = opened.database;
-  const std::string db_name = (options.data ? options.data->string() : std::string("the CMU 131 walks (default)"));
+  const std::string& db_name = data.label;
   if (!db.animation()) {
     return make_error(db_name + ": " + missing_animation_error("mmvk crowd").message);
   }
   Result<GaitSpeeds> speeds = measure_gait_speeds(db);
   if (!speeds) return make_error(db_name + ": " + speeds.message());
   MMVK_TRY(check_crowd_memory(options, db, nullptr));
-  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options));
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options, speeds->has_run));
   MMVK_TRY(check_crowd_memory(options, db, &scenario));
+  MMVK_TRY(resolve_gaits(scenario, *speeds));
   const auto agents = std::uint32_t(scenario.agents.size());
 
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
-  params.continuing_bias = kContinuingBias;
+  params.continuing_bias = options.continuing_bias.value_or(kContinuingBias);
+  params.continuing_multiplier = options.continuing_multiplier.value_or(params.continuing_multiplier);
+  params.exclusion_window = options.exclusion_window.value_or(params.exclusion_window);
+  params.foot_ik.enabled = options.foot_ik;
   Result<CrowdController> created = CrowdController::create(db, agents, params);
   if (!created) return make_error(db_name + ": " + created.message());
   CrowdController controller = std::move(created.value());
   MMVK_TRY(apply_tags(scenario, db, controller.query_params()));
+  MMVK_TRY(apply_weights(options, db, controller.query_params()));
   for (std::uint32_t b = 0; b < agents; ++b) {
     const AgentPlan& plan = scenario.agents[b];
     const float yaw = std::atan2(plan.goals[0][0] - plan.start[0], plan.goals[0][1] - plan.start[1]);
@@ -138,9 +177,11 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_ASSIGN_OR_RETURN(CrowdSearch search,
                         make_crowd_search(options.backend, options.device, db, agents, pool, options.cache_dir));
   if (log) {
-    std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, run %.2f m/s)\n",
-                 agents, options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps,
-                 speeds->run_mps);
+    char run[48] = "no run: every character walks";
+    if (speeds->has_run) std::snprintf(run, sizeof(run), "run %.2f m/s", double(speeds->run_mps));
+    std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, %s)\n", agents,
+                 options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps, run);
+    if (!speeds->has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds->no_run_reason.c_str());
     std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
                  search.device.c_str());
     if (!search.pipeline_cache_note.empty()) {
@@ -150,18 +191,37 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   const float dt = float(1.0 / options.rate_hz);
   const auto ticks = std::uint64_t(std::llround(options.seconds * options.rate_hz));
+  const AnimationData& animation = controller.animation();
+  const std::size_t joints = animation.joint_count();
+  std::optional<TraceWriter> trace;
+  if (options.trace) {
+    const TraceLayout layout{ticks, options.trace_agents, std::uint32_t(joints), options.rate_hz};
+    Result<TraceWriter> writer =
+        TraceWriter::create(*options.trace, layout, animation.skeleton, animation.contact_joints, agents);
+    if (!writer) return writer.error();
+    trace.emplace(std::move(writer.value()));
+  }
   Steering steering(scenario, *speeds);
   ObservedSearch observed(*search.deferred, agents);
-  QualityMeter meter(agents, 2, dt);
+  QualityMeter meter(agents, dt);
+  // The clips first: their planted toe height is the crowd's floor.
+  const ClipQuality clips = measure_clip_quality(db, pool);
+  MotionMeterParams motion_params;
+  motion_params.legs = find_leg_joints(animation);
+  motion_params.planted_height = clips.planted_height;
+  motion_params.dt = dt;
+  motion_params.acceleration_step = acceleration_step(options.rate_hz, db.fps());
+  // Three half-lives: the inertialization's blend has done 90% of its work.
+  motion_params.jump_window_s = 3.0 * params.inertialization_half_life;
+  MotionMeter motion(agents, joints, motion_params);
   std::unique_ptr<CrowdRecorder> recorder;
   if (options.html) {
     const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
     // Short enough for the page's header: "1000 agents · locomotion-normal · vulkan-brute-force on llvmpipe".
     const std::string device = search.device.substr(0, search.device.find(" ("));
-    const std::string data = options.data ? options.data->filename().string() : std::string("CMU 131 walks");
     recorder = std::make_unique<CrowdRecorder>(
         controller, scenario,
-        std::to_string(agents) + " agents \u00b7 " + data + " \u00b7 " + std::string(search.backend->name()) + " on " + device,
+        std::to_string(agents) + " agents \u00b7 " + data.short_label + " \u00b7 " + std::string(search.backend->name()) + " on " + device,
         dt, per_sample);
   }
   ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,
@@ -169,15 +229,12 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   // Per tick, [N] each; sized once.
   std::vector<float> x(agents), z(agents), vx(agents), vz(agents), desired_xz(2 * agents), root_xz(2 * agents);
-  std::vector<glm::vec3> desired(agents), world(std::size_t(agents) * controller.animation().joint_count());
-  std::vector<float> foot_xz(4 * std::size_t(agents));
-  std::vector<std::uint8_t> contact(2 * std::size_t(agents));
+  std::vector<glm::vec3> desired(agents), world(agents * joints), animated(agents * joints);
   std::vector<std::uint32_t> searched_before, searched_now, frames_before(agents);
   std::vector<std::uint8_t> kinds_before(agents, 0);  // controller.searched() of the tick before
   searched_before.reserve(agents), searched_now.reserve(agents);
   glm::vec3 horizon_pos[1];
   float horizon_yaw[1];
-  const auto feet = controller.animation().contact_joints;
 
   std::vector<double> search_ms, tick_ms;
   search_ms.reserve(ticks), tick_ms.reserve(ticks);
@@ -213,23 +270,16 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
       root_xz[2 * b] = roots_now[b].x, root_xz[2 * b + 1] = roots_now[b].z;
     }
     meter.record_trajectory(desired_xz, root_xz);
-    if (feet[0] >= 0 && feet[1] >= 0) {
-      controller.world_positions(world, pool);
-      const auto contacts = controller.contacts();
-      const std::size_t joints = controller.animation().joint_count();
-      for (std::uint32_t b = 0; b < agents; ++b) {
-        for (int f = 0; f < 2; ++f) {
-          const glm::vec3& p = world[b * joints + std::size_t(feet[f])];
-          foot_xz[4 * b + 2 * f] = p.x, foot_xz[4 * b + 2 * f + 1] = p.z;
-          contact[2 * b + f] = (contacts[b] & (f == 0 ? kContactLeft : kContactRight)) ? 1 : 0;
-        }
-      }
-      meter.record_feet(foot_xz, contact);
-    }
     meter.add_transitions(controller.last_tick().jumps);
     meter.end_tick();
+    // The pose as displayed (after foot IK) and as animated (before).
+    controller.world_positions(world, pool);
+    controller.animated_world_positions(animated, pool);
+    motion.record({world, animated, controller.contacts(), controller.foot_locked(), controller.ik_reach_clamped(),
+                   controller.jumped()});
+    if (trace) trace->record(world, controller.contacts(), controller.foot_locked());
 
-    if (recorder) recorder->record_tick(t, matches, searched_before, kinds_before, frames_before);
+    if (recorder) recorder->record_tick(t, matches, searched_before, kinds_before, frames_before, world);
     searched_now.clear();
     const auto kinds = controller.searched();
     for (std::uint32_t b = 0; b < agents; ++b) {
@@ -255,7 +305,9 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.database = opened.path.empty() ? db_name : opened.path.string();
   s.database_frames = db.frame_count();
   s.walk_mps = speeds->walk_mps;
-  s.run_mps = speeds->run_mps;
+  s.run_mps = speeds->has_run ? speeds->run_mps : std::nan("");  // null in the JSON
+  s.runners = count_runners(scenario);
+  if (!speeds->has_run) s.notes.push_back("run_mps is null: the data has no run (" + speeds->no_run_reason + ")");
   s.backend = std::string(search.backend->name());
   s.device = search.device;
   s.searches = searches;
@@ -269,8 +321,10 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.wall_seconds = wall;
   s.realtime_factor = wall > 0.0 ? s.seconds / wall : 0.0;
   s.trajectory_error_m_1s = meter.trajectory_error_m_median();
-  s.foot_sliding_cm_s = meter.foot_sliding_cm_s();
-  s.foot_sliding_database_cm_s = database_foot_sliding_cm_s(db, pool);
+  s.foot_ik = options.foot_ik;
+  s.motion = motion.figures();
+  s.clips = clips.figures;
+  s.planted_height_m = clips.planted_height;
   s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
   s.chosen_frames_hash = chosen.digest();
@@ -278,6 +332,10 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }
 
+  if (trace) {
+    MMVK_TRY(trace->finish());
+    s.trace = options.trace->string();
+  }
   if (options.html) {
 #if defined(MMVK_CROWD_HAS_VIEWER)
     Recording recording = recorder->finish(pool);

@@ -45,15 +45,52 @@ std::string hex(std::uint64_t value) {
 
 }  // namespace
 
-std::vector<std::filesystem::path> default_manifest_candidates(const std::filesystem::path& executable) {
+std::span<const ShippedData> shipped_data() {
+  static constexpr ShippedData kShipped[] = {
+      {"cmu-walks", "cmu131", "CMU 131 walks",
+       "CMU subject 131: start/walk/stop and curved walks at 0.2-0.7 m/s (stylised, slow); no run. "
+       "8 takes, 2,876 frames at 30 fps, mirrored"},
+      {"cmu-walk-run", "cmu16", "CMU 16 walks and runs",
+       "CMU subject 16: walks (veer left, 90-degree left turn) at 1.6 m/s, jogs (90-degree turns, a jog "
+       "to a stop) at 1.7-2.4 m/s, a run (veer right) at 3.6 m/s; tagged walk/jog/run. 6 short takes, 329 "
+       "frames (11 s) at 30 fps, mirrored, trajectories extrapolated past the takes' ends"},
+  };
+  return kShipped;
+}
+
+const ShippedData* find_shipped_data(std::string_view name) {
+  for (const ShippedData& data : shipped_data()) {
+    if (data.name == name) return &data;
+  }
+  return nullptr;
+}
+
+std::vector<std::filesystem::path> shipped_manifest_candidates(const ShippedData& data,
+                                                               const std::filesystem::path& executable) {
   std::vector<std::filesystem::path> candidates;
   if (!executable.empty()) {
-    candidates.push_back(executable.parent_path() / ".." / "share" / "mmvk" / "crowd" / "cmu131" / "manifest.json");
+    candidates.push_back(executable.parent_path() / ".." / "share" / "mmvk" / "crowd" / data.folder / "manifest.json");
   }
 #if defined(MMVK_CROWD_SOURCE_DATA_DIR)
-  candidates.push_back(std::filesystem::path(MMVK_CROWD_SOURCE_DATA_DIR) / "cmu131" / "manifest.json");
+  candidates.push_back(std::filesystem::path(MMVK_CROWD_SOURCE_DATA_DIR) / data.folder / "manifest.json");
 #endif
   return candidates;
+}
+
+Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,
+                               const std::filesystem::path& executable) {
+  const ShippedData* shipped = data ? find_shipped_data(data->string()) : &shipped_data()[0];
+  if (!shipped) return DataChoice{*data, data->string(), data->filename().string()};
+  for (const auto& candidate : shipped_manifest_candidates(*shipped, executable)) {
+    std::error_code ec;
+    if (std::filesystem::exists(candidate, ec)) {
+      return DataChoice{candidate, "the " + std::string(shipped->label) + " (" + std::string(shipped->name) + ")",
+                        std::string(shipped->label)};
+    }
+  }
+  return make_error("the shipped motion set '" + std::string(shipped->name) + "' (host/crowd/data/" +
+                    std::string(shipped->folder) +
+                    ") was not found beside the program or in its source tree; pass --data DIR|manifest.json|db.mmdb");
 }
 
 Result<OpenedDatabase> open_database(const std::filesystem::path& source, const std::filesystem::path& cache_dir,

@@ -1,6 +1,7 @@
 // The database `mmvk crowd` animates: an .mmdb as it is, or a manifest or a
-// folder of BVH built once and cached. Without --data, the trimmed CMU
-// subject 131 walks shipped in host/crowd/data/cmu131.
+// folder of BVH built once and cached, or one of the motion sets shipped in
+// host/crowd/data by name (--data cmu-walks). Without --data, the default
+// set: the trimmed CMU subject 131 walks (cmu-walks).
 //
 // A built database is cached as <cache dir>/crowd-<name>-<digest>.mmdb, where
 // the digest covers the manifest, every BVH it names and the .mmdb format
@@ -11,7 +12,10 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mmvk/database.hpp"
@@ -19,10 +23,36 @@
 
 namespace mmvk::crowd {
 
-// Where the shipped manifest may be: beside an installed binary
-// (<prefix>/share/mmvk/crowd/cmu131) and in the source tree the binary was
+// A motion set shipped with mmvk, chosen by name with --data.
+struct ShippedData {
+  std::string_view name;         // the --data name, e.g. "cmu-walks"
+  std::string_view folder;       // under host/crowd/data (installed: <prefix>/share/mmvk/crowd)
+  std::string_view label;        // short, for the viewer's header: "CMU 131 walks"
+  std::string_view description;  // what it holds, for --help and the README
+};
+
+// Every shipped set; the first is the default.
+std::span<const ShippedData> shipped_data();
+// The set named `name`, or nullptr.
+const ShippedData* find_shipped_data(std::string_view name);
+
+// Where a shipped set's manifest may be: beside an installed binary
+// (<prefix>/share/mmvk/crowd/<folder>) and in the source tree the binary was
 // built from. `executable` is the running program's path (may be empty).
-std::vector<std::filesystem::path> default_manifest_candidates(const std::filesystem::path& executable);
+std::vector<std::filesystem::path> shipped_manifest_candidates(const ShippedData& data,
+                                                               const std::filesystem::path& executable);
+
+// What --data names, resolved: a shipped set's manifest (a shipped name wins
+// over a file of that name in the working directory: write ./cmu-walks for
+// the file), or the path as given.
+struct DataChoice {
+  std::filesystem::path source;  // an .mmdb, a manifest or a folder of BVH
+  std::string label;             // for messages: "the CMU subject 131 walks (cmu-walks)"
+  std::string short_label;       // for the viewer's header
+};
+// `data` none: the default set. Error: a shipped set whose files are missing.
+Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,
+                               const std::filesystem::path& executable);
 
 struct OpenedDatabase {
   Database database;

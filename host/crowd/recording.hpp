@@ -16,6 +16,7 @@
 //   index helpers at the end compute their offsets.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -32,6 +33,18 @@ struct SearchEvent {
   int32_t to_frame = -1;    // best match found (equals the continuation when not jumped); -1: no candidate
   float cost = 0.0f;        // the match's cost (the search's distance, unitless)
 };
+
+// A change of one agent's feet: the state from time_s on.
+struct FootEvent {
+  float time_s = 0.0f;
+  // Bit 0 / 1: the left / right foot is flagged planted (the played frame's
+  // contact); bit 2 / 3: the left / right foot is locked (held by foot IK).
+  std::uint8_t state = 0;
+  // Where each locked foot is held (left, right), world metres; (0, 0, 0)
+  // for a foot that is not locked.
+  std::array<std::array<float, 3>, 2> anchor{};
+};
+inline constexpr std::uint8_t kFootPlantedLeft = 1, kFootPlantedRight = 2, kFootLockedLeft = 4, kFootLockedRight = 8;
 
 struct Recording {
   // Shown in the page's header, e.g. "1000 agents, vulkan (llvmpipe), bandai".
@@ -91,6 +104,18 @@ struct Recording {
   std::vector<int32_t> pose_frames;
   std::vector<float> pose_positions;
 
+  // --- the feet as displayed (optional: both empty when not recorded) -----
+  // The joints foot IK moves (each leg's knee, ankle and toe, where the
+  // skeleton has them), ascending; at each sample their displayed world
+  // positions (after foot IK) replace the played frame's, and the joints
+  // below them (end sites) move with them.
+  std::vector<int32_t> leg_joints;
+  // [sample_count x agent_count x leg_joints.size() x 3], world metres.
+  std::vector<float> leg_positions;
+  // [agent_count][events] (or empty): every change of each agent's feet, in
+  // time order, the first at time 0.
+  std::vector<std::vector<FootEvent>> foot_events;
+
   std::size_t joint_count() const { return joint_parents.size(); }
   std::size_t trajectory_points() const { return trajectory_times_s.size(); }
 
@@ -103,6 +128,9 @@ struct Recording {
   }
   std::size_t pose_index(std::size_t pose, std::size_t joint) const {
     return (pose * joint_count() + joint) * 3;
+  }
+  std::size_t leg_index(std::size_t sample, std::size_t agent, std::size_t leg_joint) const {
+    return ((sample * agent_count + agent) * leg_joints.size() + leg_joint) * 3;
   }
 };
 

@@ -8,7 +8,8 @@
 //     { "start": [x, z],                 // metres on the ground plane (Y up)
 //       "goals": [[x, z], ...],          // visited in order, then from the first again
 //       "speed": "walk" | "run" | 1.3,   // optional, default "walk"; metres/second
-//                                        //   when a number, capped to the database's run speed
+//                                        //   when a number, capped to the database's run speed;
+//                                        //   "run" on data without a run is an error (gait_plan.hpp)
 //       "require_tags": ["walk"],        // optional: every searched frame carries all of them
 //       "exclude_tags": ["run"] }        // optional: and none of these
 //   ]

@@ -15,6 +15,14 @@ namespace {
 // JSON has no NaN: a figure that could not be measured is null.
 nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr); }
 
+// The figures both the crowd and the clips have, under the same keys.
+void add_motion(nlohmann::ordered_json& j, const MotionFigures& m) {
+  j["foot_sliding_cm_s"] = number(m.foot_sliding_cm_s);
+  j["knee_speed_p99_deg_s"] = number(m.knee_speed_p99_deg_s);
+  j["foot_height_in_contact_cm"] = {{"mean", number(m.foot_height_in_contact_cm_mean)},
+                                    {"p95", number(m.foot_height_in_contact_cm_p95)}};
+}
+
 }  // namespace
 
 std::string summary_to_json(const CrowdSummary& s) {
@@ -30,6 +38,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["database_frames"] = s.database_frames;
   j["walk_mps"] = number(s.walk_mps);
   j["run_mps"] = number(s.run_mps);
+  j["runners"] = s.runners;
   j["backend"] = s.backend;
   j["device"] = s.device;
   j["searches"] = s.searches;
@@ -43,19 +52,48 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["wall_seconds"] = number(s.wall_seconds);
   j["realtime_factor"] = number(s.realtime_factor);
   j["trajectory_error_m_1s"] = number(s.trajectory_error_m_1s);
-  j["foot_sliding_cm_s"] = number(s.foot_sliding_cm_s);
-  j["foot_sliding_database_cm_s"] = number(s.foot_sliding_database_cm_s);
+  j["foot_ik"] = s.foot_ik;
+  add_motion(j, s.motion);
+  j["foot_sliding_before_ik_cm_s"] = number(s.motion.foot_sliding_before_ik_cm_s);
+  j["foot_sliding_database_cm_s"] = number(s.clips.foot_sliding_cm_s);
+  j["foot_lock_fraction"] = number(s.motion.foot_lock_fraction);
+  j["ik_reach_clamped_fraction"] = number(s.motion.ik_reach_clamped_fraction);
+  j["pose_acceleration_p99_m_s2"] = {{"at_jumps", number(s.motion.pose_acceleration_p99_at_jumps_m_s2)},
+                                     {"elsewhere", number(s.motion.pose_acceleration_p99_m_s2)}};
+  nlohmann::ordered_json clips;
+  add_motion(clips, s.clips);
+  clips["pose_acceleration_p99_m_s2"] = number(s.clips.pose_acceleration_p99_m_s2);
+  clips["planted_height_m"] = {number(s.planted_height_m[0]), number(s.planted_height_m[1])};
+  j["clips"] = clips;
   j["transitions_per_agent_s"] = number(s.transitions_per_agent_s);
   j["goals_reached"] = s.goals_reached;
   // A string: a 64-bit value is not exact in every JSON reader's doubles.
   j["chosen_frames_hash"] = hash_hex(s.chosen_frames_hash);
+  j["notes"] = s.notes;
   if (!s.html.empty()) {
     j["html"] = s.html;
     j["html_bytes"] = s.html_bytes;
   }
-  // A scenario or database path may hold any bytes: invalid UTF-8 is
-  // replaced (U+FFFD) instead of thrown as an exception.
-  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+  if (!s.trace.empty()) j["trace"] = s.trace;
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+std::string describe_motion(const CrowdSummary& s) {
+  const MotionFigures& m = s.motion;
+  const MotionFigures& c = s.clips;
+  char text[768];
+  std::snprintf(text, sizeof(text),
+                "mmvk crowd: feet%s: sliding in contact %.2f cm/s (before IK %.2f, the clips %.2f), "
+                "%.1f%% of planted foot-ticks locked, %.2f%% of foot-ticks reach-clamped, toe height in contact "
+                "%.2f / %.2f cm mean / p95 (the clips %.2f / %.2f)\n"
+                "mmvk crowd: knees %.0f deg/s p99 (the clips %.0f); pose acceleration p99 %.1f m/s^2 at jumps, "
+                "%.1f elsewhere (the clips %.1f)\n",
+                s.foot_ik ? "" : " (foot IK off)", m.foot_sliding_cm_s, m.foot_sliding_before_ik_cm_s,
+                c.foot_sliding_cm_s, 100.0 * m.foot_lock_fraction, 100.0 * m.ik_reach_clamped_fraction,
+                m.foot_height_in_contact_cm_mean, m.foot_height_in_contact_cm_p95, c.foot_height_in_contact_cm_mean,
+                c.foot_height_in_contact_cm_p95, m.knee_speed_p99_deg_s, c.knee_speed_p99_deg_s,
+                m.pose_acceleration_p99_at_jumps_m_s2, m.pose_acceleration_p99_m_s2, c.pose_acceleration_p99_m_s2);
+  return text;
 }
 
 Status write_summary(const CrowdSummary& summary, const std::filesystem::path& path) {

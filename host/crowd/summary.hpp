@@ -1,11 +1,14 @@
 // The --summary JSON of a crowd run: what ran, how fast and how well.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "mmvk/status.hpp"
+#include "motion_meter.hpp"
 
 namespace mmvk::crowd {
 
@@ -21,7 +24,8 @@ struct CrowdSummary {
   std::string database;            // the .mmdb or source folder
   std::uint64_t database_frames = 0;
   double walk_mps = 0.0;           // measured in the database
-  double run_mps = 0.0;
+  double run_mps = 0.0;            // NaN (null in the JSON) when the data has no run
+  std::uint64_t runners = 0;       // characters that prefer to run
   std::string backend;
   std::string device;              // "cpu" for CPU backends
   // How fast.
@@ -35,17 +39,24 @@ struct CrowdSummary {
   double realtime_factor = 0.0;    // simulated seconds per wall second
   // How well.
   double trajectory_error_m_1s = 0.0;
-  double foot_sliding_cm_s = 0.0;
-  double foot_sliding_database_cm_s = 0.0;  // the same measure on the database's own clips (the floor)
+  bool foot_ik = true;             // --foot-ik
+  MotionFigures motion;            // the crowd's displayed pose (motion_meter.hpp)
+  MotionFigures clips;             // the same measures on the database's own clips (clip_quality.hpp)
+  std::array<float, 2> planted_height_m{0.0f, 0.0f};  // the toes' height when planted, from the clips
   double transitions_per_agent_s = 0.0;
   std::uint64_t goals_reached = 0;
   std::uint64_t chosen_frames_hash = 0;
-  // The viewer, when written.
+  std::vector<std::string> notes;  // what the data cannot do (no run, ...)
+  // The viewer and the trace, when written.
   std::string html;
   std::uint64_t html_bytes = 0;
+  std::string trace;
 };
 
 std::string summary_to_json(const CrowdSummary& summary);
+// The motion figures for the user, two lines ending in '\n', each figure
+// with the clips' beside it.
+std::string describe_motion(const CrowdSummary& summary);
 Status write_summary(const CrowdSummary& summary, const std::filesystem::path& path);
 
 }  // namespace mmvk::crowd

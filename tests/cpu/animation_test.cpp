@@ -17,8 +17,9 @@
 namespace mmvk {
 namespace {
 
-// A small database with a 3-joint animation: one 60-frame looping clip of a
-// root walking along +Z at 1 m/s, a child swinging about X.
+// A small database with an 11-joint animation: one 60-frame looping clip of
+// a root walking along +Z at 1 m/s, a spine swinging about X, legs (which the
+// default schema's foot channels name) standing straight.
 DatabaseParts make_parts(bool animation, FeatureSchema schema = default_schema()) {
   DatabaseParts parts;
   parts.schema = std::move(schema);
@@ -38,10 +39,16 @@ DatabaseParts make_parts(bool animation, FeatureSchema schema = default_schema()
   for (std::uint32_t i = 0; i < frames * dims; ++i) parts.features.push_back(uniform(rng));
   if (animation) {
     AnimationData a;
-    a.skeleton.names = {"Hips", "Spine", "Head"};
-    a.skeleton.parents = {-1, 0, 1};
-    a.skeleton.rest_offsets = {glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 0.3f, 0.0f), glm::vec3(0.0f, 0.4f, 0.0f)};
-    a.mirror_pairs = {0, 1, 2};
+    a.skeleton.names = {"Hips",        "Spine",      "Head",     "LeftUpLeg", "LeftLeg",     "LeftFoot",
+                        "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"};
+    a.skeleton.parents = {-1, 0, 1, 0, 3, 4, 5, 0, 7, 8, 9};
+    a.skeleton.rest_offsets = {glm::vec3(0.0f, 1.0f, 0.0f),   glm::vec3(0.0f, 0.3f, 0.0f),
+                               glm::vec3(0.0f, 0.4f, 0.0f),   glm::vec3(0.1f, -0.05f, 0.0f),
+                               glm::vec3(0.0f, -0.45f, 0.0f), glm::vec3(0.0f, -0.42f, 0.0f),
+                               glm::vec3(0.0f, -0.06f, 0.12f), glm::vec3(-0.1f, -0.05f, 0.0f),
+                               glm::vec3(0.0f, -0.45f, 0.0f), glm::vec3(0.0f, -0.42f, 0.0f),
+                               glm::vec3(0.0f, -0.06f, 0.12f)};
+    a.mirror_pairs = {0, 1, 2, 7, 8, 9, 10, 3, 4, 5, 6};
     a.translated_joints = {0};
     a.frame_count = frames;
     for (std::uint32_t f = 0; f < frames; ++f) {
@@ -49,6 +56,7 @@ DatabaseParts make_parts(bool animation, FeatureSchema schema = default_schema()
       a.local_rotations.push_back(glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
       a.local_rotations.push_back(glm::angleAxis(0.5f * std::sin(6.0f * t), glm::vec3(1.0f, 0.0f, 0.0f)));
       a.local_rotations.push_back(glm::angleAxis(0.2f * t, glm::vec3(0.0f, 1.0f, 0.0f)));
+      for (int leg = 0; leg < 8; ++leg) a.local_rotations.push_back(glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
       a.local_translations.push_back(glm::vec3(0.0f, 1.0f + 0.05f * std::sin(12.0f * t), 0.0f));
       a.root_positions.push_back(glm::vec3(0.0f, 0.0f, t));
       a.root_yaws.push_back(0.0f);
@@ -105,8 +113,9 @@ TEST(Inertializer, ContinuousAtTheJumpAndDecays) {
   const Database db = make_database(true);
   const AnimationData& a = *db.animation();
   Inertializer inertializer(2, a);
-  std::vector<glm::quat> src(3), dst(3), out(3);
-  std::vector<glm::vec3> src_t(3), dst_t(3), out_t(3), zero(3, glm::vec3(0.0f));
+  const std::size_t joints = a.joint_count();
+  std::vector<glm::quat> src(joints), dst(joints), out(joints);
+  std::vector<glm::vec3> src_t(joints), dst_t(joints), out_t(joints), zero(joints, glm::vec3(0.0f));
   sample_pose(a, 23, src, src_t);
   sample_pose(a, 8, dst, dst_t);
   Inertializer::PoseState source{src, zero, src_t, zero, glm::vec3(1.0f, 0.0f, 0.0f), 0.5f};
@@ -116,7 +125,7 @@ TEST(Inertializer, ContinuousAtTheJumpAndDecays) {
   out = dst;
   out_t = dst_t;
   Inertializer::RootOffset root = inertializer.update(1, 0.1f, 0.0f, out, out_t);
-  for (std::size_t j = 0; j < 3; ++j) {
+  for (std::size_t j = 0; j < joints; ++j) {
     EXPECT_LT(angle_between(out[j], src[j]), 1e-5f) << j;
     EXPECT_LT(glm::length(out_t[j] - src_t[j]), 1e-6f) << j;
   }
@@ -285,6 +294,51 @@ TEST(CrowdController, DeferredAppliesResultsOneTickLater) {
   EXPECT_EQ(controller->last_tick().no_candidate, 0u);
   // A search still in flight cannot be submitted over.
   EXPECT_FALSE(deferred.submit(QueryBatch{}).ok() && deferred.submit(QueryBatch{}).ok());
+}
+
+// Answers every query with its continuing frame (or frame 0 without one),
+// recording the continuing frames it was asked with.
+class ContinuingSearch final : public SearchBackend {
+ public:
+  explicit ContinuingSearch(const Database& database) : database_(database) {}
+  std::string_view name() const override { return "continuing"; }
+  const Database& database() const override { return database_; }
+  Status search(const QueryBatch& batch, std::uint32_t, std::span<Match> out) override {
+    for (std::size_t i = 0; i < batch.size; ++i) {
+      const std::uint32_t continuing = batch.params[i].continuing_frame;
+      asked.push_back(continuing);
+      out[i] = Match{continuing == kNoFrame ? 0u : continuing, 0.0f};
+    }
+    return {};
+  }
+  SearchStats stats() const override { return {}; }
+  void reset_stats() override {}
+  std::vector<std::uint32_t> asked;
+
+ private:
+  const Database& database_;
+};
+
+TEST(CrowdController, HeldOnAClipsLastFrameGetsNoContinuingBonus) {
+  DatabaseParts parts = make_parts(true);
+  parts.clips[0].loop = false;
+  Result<Database> db = Database::create(std::move(parts));
+  ASSERT_TRUE(db.ok()) << db.message();
+  ContinuingSearch search(*db);
+  ThreadPool pool(1);
+  Result<CrowdController> controller = CrowdController::create(*db, 1);
+  ASSERT_TRUE(controller.ok()) << controller.message();
+  ASSERT_TRUE(controller->place(0, glm::vec3(0.0f), 0.0f, 57).ok());
+  std::vector<glm::vec3> velocity(1, glm::vec3(0.0f, 0.0f, 1.0f));
+  // Frame 57 plays on to 58, then 59, the last, where it is held: that
+  // search has no continuing frame, and its answer (frame 0) is jumped to.
+  for (int tick = 0; tick < 4 && controller->frames()[0] != 0; ++tick) {
+    ASSERT_TRUE(controller->tick(1.0f / 30.0f, CrowdInput{velocity, {}}, search, pool).ok());
+  }
+  ASSERT_FALSE(search.asked.empty());
+  EXPECT_EQ(search.asked.front(), 58u);  // placed: a forced search after one frame, continuing
+  EXPECT_EQ(search.asked.back(), kNoFrame);
+  EXPECT_EQ(controller->frames()[0], 0u);
 }
 
 TEST(DatabaseFile, FormatOneStillLoadsWithoutAnimation) {

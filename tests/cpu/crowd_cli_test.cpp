@@ -62,11 +62,20 @@ TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
   std::ifstream in(summary);
   const auto json = nlohmann::json::parse(in, nullptr, false);
   ASSERT_FALSE(json.is_discarded());
-  for (const char* key : {"agents", "ticks", "seconds", "backend", "device", "searches", "no_candidate",
+  for (const char* key : {"agents", "ticks", "seconds", "walk_mps", "run_mps", "runners", "notes", "backend", "device", "searches", "no_candidate",
                           "search_ms_p50", "search_ms_p99", "tick_ms_p50", "tick_ms_p99", "trajectory_error_m_1s",
-                          "foot_sliding_cm_s", "transitions_per_agent_s", "chosen_frames_hash"}) {
+                          "foot_sliding_cm_s", "transitions_per_agent_s", "chosen_frames_hash", "foot_ik",
+                          "foot_sliding_before_ik_cm_s", "foot_sliding_database_cm_s", "foot_lock_fraction",
+                          "ik_reach_clamped_fraction", "knee_speed_p99_deg_s", "foot_height_in_contact_cm",
+                          "pose_acceleration_p99_m_s2", "clips"}) {
     EXPECT_TRUE(json.contains(key)) << key;
   }
+  for (const char* key : {"foot_sliding_cm_s", "knee_speed_p99_deg_s", "foot_height_in_contact_cm",
+                          "pose_acceleration_p99_m_s2", "planted_height_m"}) {
+    EXPECT_TRUE(json["clips"].contains(key)) << "clips." << key;
+  }
+  EXPECT_TRUE(json["foot_height_in_contact_cm"].contains("p95"));
+  EXPECT_GT(json["clips"]["knee_speed_p99_deg_s"].get<double>(), 0.0);
   EXPECT_EQ(json["agents"], 20);
   EXPECT_EQ(json["ticks"], 30);
   EXPECT_GT(json["searches"].get<int>(), 20);
@@ -78,12 +87,55 @@ TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
   expect_failure("--agents 0", "--agents expects an integer in [1, 10000000], got '0'");
   expect_failure("--rate 0", "--rate expects a positive number");
   expect_failure("--rate -30", "--rate expects a positive number");
+  expect_failure("--rate inf", "--rate expects a positive number");
+  expect_failure("--rate nan", "--rate expects a positive number");
+  expect_failure("--foot-ik maybe", "--foot-ik expects on or off, got 'maybe'");
+  expect_failure("--trace-agents 2", "--trace-agents needs --trace FILE");
   expect_failure("--search-interval 0", "--search-interval expects a positive number");
   expect_failure("--seconds nan", "--seconds expects a positive number");
   expect_failure("--agents many", "--agents expects an integer");
   expect_failure("--data /nonexistent/db.mmdb", "/nonexistent/db.mmdb");
   expect_failure("--frobnicate", "unknown option '--frobnicate'");
   expect_failure("--agents 5 --seconds 1 --backend reference --device 0", "--device picks a Vulkan device");
+}
+
+TEST_F(CrowdCli, ControlsAndTraceErrorsNameTheOption) {
+  const std::string run = "--backend fast-box --agents 3 --seconds 1 ";
+  expect_failure(run + "--weights moonwalk=1", "--weights");
+  expect_failure(run + "--weights moonwalk=1", "moonwalk");
+  expect_failure(run + "--weights left_foot_position=1,left_foot_position=2",
+                 "channel 'left_foot_position' is given twice");
+  expect_failure(run + "--weights left_foot_position=-1", "--weights");
+  expect_failure(run + "--continuing-multiplier -1", "--continuing-multiplier must be >= 0");
+  const std::string trace = (dir_ / "t.f32").string();
+  expect_failure(run + "--trace " + trace + " --trace-agents 5", "--trace-agents 5 must be in [1, 3]");
+  expect_failure(run + "--trace " + trace + " --summary " + trace, "name the same file");
+  // An unwritable trace is refused before the database is built.
+  const auto unwritable = run_command(mmvk_ + " crowd " + run + "--trace /nonexistent/folder/t.f32");
+  EXPECT_EQ(unwritable.exit_code, 1) << unwritable.output;
+  EXPECT_NE(unwritable.output.find("--trace"), std::string::npos) << unwritable.output;
+  EXPECT_NE(unwritable.output.find("/nonexistent/folder"), std::string::npos) << unwritable.output;
+  EXPECT_EQ(unwritable.output.find("building the database"), std::string::npos) << unwritable.output;
+}
+
+TEST_F(CrowdCli, TraceWritesThePositionsAndTheSidecar) {
+  const fs::path trace = dir_ / "walk.f32";
+  const auto ran = run_command(mmvk_ + " crowd --backend fast-box --agents 4 --seconds 1 --rate 60 --foot-ik off " +
+                               "--continuing-bias -1.5 --continuing-multiplier 0.9 --exclusion-window 3 " +
+                               "--weights left_foot_position=2 --trace " + trace.string() + " --trace-agents 2");
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  EXPECT_NE(ran.output.find("trace written to " + trace.string()), std::string::npos) << ran.output;
+  std::ifstream in(trace.string() + ".json");
+  const auto sidecar = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_FALSE(sidecar.is_discarded());
+  EXPECT_EQ(sidecar["ticks"], 60);
+  EXPECT_EQ(sidecar["agents"], 2);
+  EXPECT_EQ(sidecar["tick_rate_hz"], 60.0);
+  const auto joints = sidecar["joints"].get<std::uint64_t>();
+  EXPECT_EQ(sidecar["joint_names"].size(), joints);
+  EXPECT_EQ(sidecar["contacts"].size(), 60u);
+  EXPECT_EQ(sidecar["foot_locks"][0].size(), 2u);
+  EXPECT_EQ(fs::file_size(trace), 60u * 2u * joints * 12u);
 }
 
 TEST_F(CrowdCli, ScenarioErrorsNameTheFileAndTheField) {
@@ -94,6 +146,46 @@ TEST_F(CrowdCli, ScenarioErrorsNameTheFileAndTheField) {
   std::ofstream(tags) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "require_tags": ["moonwalk"]}]})";
   expect_failure("--backend fast-box --scenario " + tags.string(), tags.string() + ": agents[0].require_tags");
   expect_failure("--backend fast-box --agents 3 --scenario " + tags.string(), "defines 1 agents, but --agents asks for 3");
+}
+
+// Reads a --summary file (an empty object when it cannot be parsed).
+nlohmann::json read_summary(const fs::path& path) {
+  std::ifstream in(path);
+  nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+  EXPECT_FALSE(json.is_discarded()) << path;
+  return json.is_discarded() ? nlohmann::json::object() : json;
+}
+
+TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
+  // The CMU 131 walks (cmu-walks) never reach 2 m/s and tag no run.
+  const fs::path summary = dir_ / "walks.json";
+  const auto walks = run_command(mmvk_ + " crowd --data cmu-walks --agents 50 --seconds 1 --backend fast-box "
+                                 "--summary " + summary.string());
+  ASSERT_EQ(walks.exit_code, 0) << walks.output;
+  EXPECT_NE(walks.output.find("no run: every character walks"), std::string::npos) << walks.output;
+  nlohmann::json json = read_summary(summary);
+  EXPECT_TRUE(json["run_mps"].is_null()) << json.dump();
+  EXPECT_EQ(json["runners"], 0);
+  ASSERT_EQ(json["notes"].size(), 1u) << json.dump();
+  EXPECT_NE(json["notes"][0].get<std::string>().find("run_mps is null: the data has no run (no frame is tagged 'run'"),
+            std::string::npos)
+      << json.dump();
+  // A scenario that asks for a run there is an error naming the gait.
+  const fs::path runner = dir_ / "runner.json";
+  std::ofstream(runner) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "speed": "run"}]})";
+  expect_failure("--data cmu-walks --backend fast-box --scenario " + runner.string(),
+                 runner.string() + ": agents[0].speed: asks for the 'run' gait, but the motion data has no run");
+
+  // The CMU 16 walks and runs do run: a pedestrian walk, a run over 2.5 m/s
+  // and a fifth of the crowd running.
+  const auto both = run_command(mmvk_ + " crowd --data cmu-walk-run --agents 50 --seconds 1 --backend fast-box "
+                                "--summary " + summary.string());
+  ASSERT_EQ(both.exit_code, 0) << both.output;
+  json = read_summary(summary);
+  EXPECT_GE(json["walk_mps"].get<double>(), 1.1) << json.dump();
+  EXPECT_GE(json["run_mps"].get<double>(), 2.5) << json.dump();
+  EXPECT_GT(json["runners"].get<int>(), 0) << json.dump();
+  EXPECT_TRUE(json["notes"].empty()) << json.dump();
 }
 
 TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {

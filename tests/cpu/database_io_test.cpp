@@ -19,7 +19,8 @@
 namespace mmvk {
 namespace {
 
-Database make_database() {
+// `units`: the clips record the import's metres per unit (a version 4 file).
+Database make_database(bool units = false) {
   DatabaseParts parts;
   parts.schema = default_schema();
   parts.schema.channels[2].weight = 1.0f / 3.0f;
@@ -43,6 +44,7 @@ Database make_database() {
     clip.cost_bias = -0.125f * float(c);
     clip.first_frame = first;
     clip.frame_count = lengths[c];
+    clip.metres_per_unit = units ? (c == 1 ? 0.01f : 0.05644f) : 0.0f;
     first += lengths[c];
     parts.clips.push_back(clip);
   }
@@ -75,6 +77,7 @@ void expect_identical(const Database& a, const Database& b) {
     EXPECT_EQ(x.cost_bias, y.cost_bias);
     EXPECT_EQ(x.first_frame, y.first_frame);
     EXPECT_EQ(x.frame_count, y.frame_count);
+    EXPECT_EQ(x.metres_per_unit, y.metres_per_unit);
   }
   EXPECT_EQ(a.content_hash(), b.content_hash());
 }
@@ -110,6 +113,23 @@ TEST(DatabaseIo, RoundTripIsBitExact) {
   Result<Database> loaded = load_database(dir / "db.mmdb");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
   expect_identical(db, *loaded);
+}
+
+TEST(DatabaseIo, ImportUnitsMakeAVersion4FileAndRoundTrip) {
+  const Database without = make_database();
+  EXPECT_EQ(serialize_database(without)[8], char(2)) << "nothing newer to record: older builds read it";
+  const Database with = make_database(true);
+  const std::string bytes = serialize_database(with);
+  EXPECT_EQ(bytes[8], char(4));
+  Result<Database> back = deserialize_database(bytes, "db.mmdb");
+  ASSERT_TRUE(back.ok()) << back.message();
+  expect_identical(with, *back);
+  EXPECT_EQ(back->clips()[1].metres_per_unit, 0.01f);
+  EXPECT_EQ(serialize_database(*back), bytes);
+  EXPECT_EQ(back->content_hash(), without.content_hash()) << "units do not change what a search sees";
+  for (std::size_t size = 0; size < bytes.size(); size += 7) {
+    EXPECT_FALSE(deserialize_database(std::string_view(bytes).substr(0, size), "db.mmdb").ok()) << size;
+  }
 }
 
 TEST(DatabaseIo, TruncatedFilesAreRejectedAtEveryLength) {

@@ -8,6 +8,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mmvk/database_build.hpp"
+#include "mmvk/feature_schema.hpp"
 #include "mmvk/features.hpp"
 #include "mmvk/normalization.hpp"
 #include "support/motion_fixtures.hpp"
@@ -17,34 +18,7 @@ namespace {
 
 constexpr float kFps = 30.0f;
 
-// Bandai-style names so the bone roles resolve: Hips, UpperLeg_L/R, Foot_L/R.
-// The character walks along `heading` (radians from +Z towards +X) at `speed`
-// m/s while turning at `turn_rate` rad/s; legs swing with `swing` radians.
-Motion walker(std::uint32_t frames, float speed, float heading, float turn_rate = 0.0f, float swing = 0.0f) {
-  Motion m;
-  m.skeleton.names = {"Hips", "UpperLeg_L", "Foot_L", "UpperLeg_R", "Foot_R"};
-  m.skeleton.parents = {-1, 0, 1, 0, 3};
-  m.skeleton.rest_offsets = {glm::vec3(0, 1, 0), glm::vec3(0.1f, -0.05f, 0), glm::vec3(0, -0.9f, 0),
-                             glm::vec3(-0.1f, -0.05f, 0), glm::vec3(0, -0.9f, 0)};
-  m.fps = kFps;
-  m.frame_count = frames;
-  glm::vec3 position(0.0f, 1.0f, 0.0f);
-  float yaw = heading;
-  for (std::uint32_t f = 0; f < frames; ++f) {
-    const float t = float(f) / kFps;
-    const glm::quat hips = glm::angleAxis(yaw, glm::vec3(0, 1, 0));
-    const float phase = std::sin(2.0f * 3.14159265f * 1.5f * t);
-    const glm::quat left = glm::angleAxis(swing * phase, glm::vec3(1, 0, 0));
-    const glm::quat right = glm::angleAxis(-swing * phase, glm::vec3(1, 0, 0));
-    const glm::quat identity(1, 0, 0, 0);
-    for (std::size_t j = 0; j < 5; ++j) m.local_positions.push_back(j == 0 ? position : m.skeleton.rest_offsets[j]);
-    for (const glm::quat& q : {hips, left, identity, right, identity}) m.local_rotations.push_back(q);
-    position += glm::vec3(std::sin(yaw), 0.0f, std::cos(yaw)) * (speed / kFps);
-    yaw += turn_rate / kFps;
-  }
-  return m;
-}
-
+using test::walker;
 using test::feature;
 using test::root_of;
 
@@ -99,6 +73,58 @@ TEST(Features, TurningWalkIsTheSameFromAnyStartingHeading) {
   // Turning left (positive yaw rate, towards +X = the character's left).
   EXPECT_GT(feature(*fa, schema, 30, "trajectory_position[2].x"), 0.1f);
   EXPECT_GT(feature(*fa, schema, 30, "trajectory_direction[2].x"), 0.5f);
+}
+
+TEST(Features, ExtrapolateContinuesTheClipsSpeedAndTurningRate) {
+  // A walk turning at a constant rate, and its first 60 frames: the cut
+  // clip's extrapolated trajectory is where the full walk really went.
+  const FeatureSchema schema = default_schema();
+  const Motion full = walker(90, 1.2f, 0.3f, 0.8f, 0.4f);
+  const Motion cut = walker(60, 1.2f, 0.3f, 0.8f, 0.4f);
+  Result<RawFeatures> truth = extract_features(full, root_of(full), schema, {});
+  FeatureExtractionOptions options;
+  options.extrapolate_seconds = 0.1f;
+  Result<RawFeatures> guess = extract_features(cut, root_of(cut), schema, options);
+  ASSERT_TRUE(truth.ok() && guess.ok());
+  for (std::uint32_t f = 30; f < 60; ++f) {
+    for (const char* name : {"trajectory_position[2].x", "trajectory_position[2].z", "trajectory_direction[2].x",
+                             "trajectory_direction[1].z"}) {
+      EXPECT_NEAR(feature(*guess, schema, f, name), feature(*truth, schema, f, name), 1e-4f) << name << " " << f;
+    }
+  }
+  EXPECT_GT(feature(*guess, schema, 59, "trajectory_position[2].x"), 0.3f) << "still turning left past the end";
+  for (std::uint8_t past : guess->past_end) EXPECT_EQ(past, 0) << "extrapolated frames are not past the end";
+
+  // Straight on past the end and back before the start, with past offsets.
+  Result<FeatureSchema> past = parse_schema_json(
+      R"({"channels": [{"name": "path", "kind": "trajectory_position", "offsets_seconds": [-0.5, 1.0]}]})", "s");
+  ASSERT_TRUE(past.ok()) << past.message();
+  const Motion straight = walker(40, 1.5f, 1.0f);
+  Result<RawFeatures> line = extract_features(straight, root_of(straight), *past, options);
+  ASSERT_TRUE(line.ok()) << line.message();
+  EXPECT_NEAR(feature(*line, *past, 39, "path[1].z"), 1.5f, 1e-4f);
+  EXPECT_NEAR(feature(*line, *past, 0, "path[0].z"), -0.75f, 1e-4f);
+  EXPECT_NEAR(feature(*line, *past, 0, "path[0].x"), 0.0f, 1e-4f);
+
+  // Phase windows still clamp at the edges and count as past the end.
+  Result<FeatureSchema> phase = parse_schema_json(
+      R"({"channels": [{"name": "path", "kind": "trajectory_position", "offsets_seconds": [1.0]},
+                       {"name": "p", "kind": "phase", "curves": ["Foot_L.height"], "window_seconds": 0.2}]})",
+      "s");
+  ASSERT_TRUE(phase.ok()) << phase.message();
+  const Motion swinging = walker(40, 1.5f, 0.0f, 0.0f, 0.4f);
+  Result<RawFeatures> windows = extract_features(swinging, root_of(swinging), *phase, options);
+  ASSERT_TRUE(windows.ok()) << windows.message();
+  for (std::uint32_t f = 0; f < 40; ++f) EXPECT_EQ(windows->past_end[f], f < 6 || f + 6 > 39 ? 1 : 0) << f;
+
+  // A looping clip wraps whatever the option says.
+  options.loop = true;
+  Result<RawFeatures> looped = extract_features(straight, root_of(straight), *past, options);
+  FeatureExtractionOptions loop_only;
+  loop_only.loop = true;
+  Result<RawFeatures> wrapped = extract_features(straight, root_of(straight), *past, loop_only);
+  ASSERT_TRUE(looped.ok() && wrapped.ok());
+  EXPECT_EQ(looped->values, wrapped->values);
 }
 
 TEST(Features, CustomChannelsAndErrors) {
@@ -225,6 +251,23 @@ TEST(DatabaseFromMotions, FlagsTagsMirrorsAndNormalization) {
   Result<Database> clamped = build_database_from_motions(clips, settings);
   ASSERT_TRUE(clamped.ok()) << clamped.message();
   for (std::uint32_t flags : clamped->frame_flags()) EXPECT_EQ(flags & kFrameEdgeExcluded, 0u);
+
+  // Extrapolate keeps them too, with the trajectory continued instead of
+  // clamped (the turning walk's last frame still looks 1 s ahead), all but
+  // the last kExtrapolateEndSeconds (6 frames) of the non-looping clips.
+  settings.edge_rule = EdgeRule::Extrapolate;
+  Result<Database> extrapolated = build_database_from_motions(clips, settings);
+  ASSERT_TRUE(extrapolated.ok()) << extrapolated.message();
+  for (std::uint32_t f = 0; f < 240; ++f) {
+    const bool end = (f >= 84 && f < 90) || f >= 234;  // clips 0 and 2 end at 90 and 240; clip 1 loops
+    EXPECT_EQ(extrapolated->frame_flags()[f] & kFrameEdgeExcluded, end ? kFrameEdgeExcluded : 0u) << f;
+  }
+  const std::uint32_t z = db->schema().offset(5) + 5;  // trajectory_position[2].z
+  const auto raw_of = [&](const Database& d, std::uint32_t f) {
+    return d.row(f)[z] * d.normalization()[z].scale + d.normalization()[z].offset;
+  };
+  EXPECT_LT(raw_of(*clamped, 89), 0.01f);
+  EXPECT_GT(raw_of(*extrapolated, 89), 0.9f);
 
   // Mixed rates name the files.
   clips[1].motion.fps = 60.0f;

@@ -58,6 +58,31 @@ TEST(Manifest, ParsesEveryField) {
   EXPECT_EQ(manifest->clips[2].file, std::filesystem::path("/abs/turn.bvh"));
 }
 
+TEST(Manifest, ClipRange) {
+  Result<Manifest> manifest =
+      parse_manifest_json(R"({"clips": [{"file": "a.bvh", "range": [0.5, 1.4], "loop": true}, "b.bvh"]})", "m.json", "/base");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  ASSERT_TRUE(manifest->clips[0].range.has_value());
+  EXPECT_EQ(manifest->clips[0].range->begin_seconds, 0.5f);
+  EXPECT_EQ(manifest->clips[0].range->end_seconds, 1.4f);
+  EXPECT_FALSE(manifest->clips[1].range.has_value());
+  Result<Manifest> bad = parse_manifest_json(R"({"clips": [{"file": "a.bvh", "range": [2, 1]}]})", "m.json", "/base");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("m.json: clips[0].range: expected 0 <= begin < end"), std::string::npos) << bad.message();
+}
+
+TEST(Manifest, EdgeRulesByName) {
+  for (const EdgeRule rule : {EdgeRule::Exclude, EdgeRule::Clamp, EdgeRule::Extrapolate}) {
+    const std::string json =
+        R"({"edge_rule": ")" + std::string(edge_rule_name(rule)) + R"(", "clips": ["a.bvh"]})";
+    Result<Manifest> manifest = parse_manifest_json(json, "m.json", "/base");
+    ASSERT_TRUE(manifest.ok()) << manifest.message();
+    EXPECT_EQ(manifest->edge_rule, rule) << json;
+  }
+  EXPECT_EQ(edge_rule_name(EdgeRule::Extrapolate), "extrapolate");
+  EXPECT_FALSE(parse_edge_rule("Clamp").ok());
+}
+
 TEST(Manifest, DefaultsAndMirrorAll) {
   Result<Manifest> manifest = parse_manifest_json(R"({"mirror": true, "clips": ["a.bvh"]})", "m.json", "/base");
   ASSERT_TRUE(manifest.ok()) << manifest.message();
@@ -93,7 +118,7 @@ TEST(Manifest, ErrorsNameTheField) {
             std::string::npos);
   EXPECT_NE(manifest_error(R"({"clips": [{"file": "a.bvh", "block_transition": [[0, 1, 2]]}]})").find("clips[0].block_transition[0]"),
             std::string::npos);
-  EXPECT_NE(manifest_error(R"({"edge_rule": "wrap", "clips": ["a.bvh"]})").find("m.json: edge_rule: expected \"exclude\" or \"clamp\""),
+  EXPECT_NE(manifest_error(R"({"edge_rule": "wrap", "clips": ["a.bvh"]})").find("m.json: edge_rule: expected \"exclude\", \"clamp\", \"extrapolate\", got \"wrap\""),
             std::string::npos);
   EXPECT_NE(manifest_error(R"({"fps": -30, "clips": ["a.bvh"]})").find("m.json: fps"), std::string::npos);
   EXPECT_NE(manifest_error(R"({"import": {"up_axis": "x"}, "clips": ["a.bvh"]})").find("m.json: import.up_axis"), std::string::npos);

@@ -16,6 +16,7 @@
 #include "mmvk/database_io.hpp"
 #include "mmvk/features.hpp"
 #include "mmvk/normalization.hpp"
+#include "support/command.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -280,6 +281,23 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   EXPECT_EQ(inspect["clips"].size(), 4u);
   EXPECT_EQ(inspect["channels"].size(), 7u);
   EXPECT_EQ(inspect["tags"][1]["name"], "turn");
+  // Units at a glance: Bandai's centimetres (guessed), an adult's height, a
+  // walking pace, and no run in two walks.
+  EXPECT_EQ(loaded->clips()[1].metres_per_unit, 0.01f);
+  const nlohmann::json& units = inspect["units"];
+  ASSERT_EQ(units["metres_per_unit"].size(), 1u) << units.dump();
+  EXPECT_NEAR(units["metres_per_unit"][0]["value"].get<double>(), 0.01, 1e-6);
+  EXPECT_EQ(units["metres_per_unit"][0]["clips"], 4);
+  EXPECT_EQ(units["metres_per_unit"][0]["name"], "centimetres");
+  EXPECT_GT(units["standing_height_m"].get<double>(), 1.2) << units.dump();
+  EXPECT_LT(units["standing_height_m"].get<double>(), 2.0) << units.dump();
+  EXPECT_GT(units["walk_mps"].get<double>(), 0.8) << units.dump();
+  EXPECT_LT(units["walk_mps"].get<double>(), 2.0) << units.dump();
+  EXPECT_TRUE(units["run_mps"].is_null()) << units.dump();
+  EXPECT_NE(units["run_note"].get<std::string>().find("no frame is tagged 'run'"), std::string::npos) << units.dump();
+  const auto text = test::run_command(mmvk.string() + " inspect " + db);
+  EXPECT_NE(text.output.find("units: 0.01 metres per file unit (centimetres)"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("speeds: walk "), std::string::npos) << text.output;
 
   const std::string out = (dir / "out.f32").string();
   ASSERT_EQ(run(mmvk.string() + " export " + db + " --features " + out), 0);

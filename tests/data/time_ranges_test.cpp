@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <span>
 
 #include "mmvk/database_io.hpp"
 #include "mmvk/thread_pool.hpp"
@@ -73,12 +74,9 @@ TEST_F(TimeRanges, PerFrameTagsAndCostsFollowTheRanges) {
   }
   EXPECT_EQ(db->max_multiplier(), 1.25f * 6.0f);
 
-  // The .mmdb keeps them, in a version 3 file; a database without time
-  // ranges stays a version 2 file.
-  EXPECT_EQ(serialize_database(*db)[8], char(3));
-  Result<Database> plain = build_features_only(write_ranges_manifest(data_, "", ""));
-  ASSERT_TRUE(plain.ok()) << plain.message();
-  EXPECT_EQ(serialize_database(*plain)[8], char(2));
+  // The .mmdb keeps them (a version 4 file, since the build also records
+  // the clips' units: version 3 files have per-frame modifiers alone).
+  EXPECT_EQ(serialize_database(*db)[8], char(4));
   Result<Database> back = deserialize_database(serialize_database(*db), "db.mmdb");
   ASSERT_TRUE(back.ok()) << back.message();
   EXPECT_EQ(back->content_hash(), db->content_hash());
@@ -86,6 +84,40 @@ TEST_F(TimeRanges, PerFrameTagsAndCostsFollowTheRanges) {
   EXPECT_TRUE(std::equal(back->frame_multiplier().begin(), back->frame_multiplier().end(),
                          db->frame_multiplier().begin()));
   EXPECT_TRUE(std::equal(back->frame_bias().begin(), back->frame_bias().end(), db->frame_bias().begin()));
+}
+
+TEST_F(TimeRanges, AClipRangeTakesPartOfTheFileAndCanLoop) {
+  // Clip 0 takes [1, 2) s of its file, looped; clip 1 the whole file. The
+  // cut clip's frames are the whole clip's frames 30..59, and its tag range
+  // counts from the cut.
+  Result<Database> whole = build_features_only(write_ranges_manifest(data_, "", ""));
+  Result<Database> cut = build_features_only(
+      write_ranges_manifest(data_, R"(, "range": [1.0, 2.0], "loop": true, "tag_ranges": {"jump": [[0.5, 1.0]]})", ""));
+  ASSERT_TRUE(whole.ok() && cut.ok()) << whole.message() << cut.message();
+  const Clip& a = cut->clips()[0];
+  ASSERT_EQ(a.frame_count, 30u);
+  EXPECT_TRUE(a.loop);
+  EXPECT_EQ(cut->clips()[1].frame_count, whole->clips()[1].frame_count);
+  // The left foot's speed: the same wherever the clip starts (its direction
+  // in character space is not: the facing is smoothed up to the clip's ends).
+  const auto raw = [&](const Database& db, std::uint32_t f) {
+    double sum = 0.0;
+    for (std::uint32_t d = 6; d < 9; ++d) {  // left_foot_velocity
+      const double v = db.row(f)[d] * db.normalization()[d].scale + db.normalization()[d].offset;
+      sum += v * v;
+    }
+    return std::sqrt(sum);
+  };
+  for (std::uint32_t f = 1; f + 1 < 30; ++f) ASSERT_NEAR(raw(*cut, f), raw(*whole, 30 + f), 1e-4) << f;
+  const TagMask jump = *cut->tag_mask(std::vector<std::string>{"jump"});
+  for (std::uint32_t f = 0; f < 30; ++f) EXPECT_EQ((cut->frame_tags()[f] & jump) != 0, f >= 15) << f;
+  for (std::uint32_t flags : std::span(cut->frame_flags()).first(30)) EXPECT_EQ(flags & kFrameEdgeExcluded, 0u);
+
+  // A range that misses the file names the manifest and the field.
+  Result<Database> outside = build_features_only(write_ranges_manifest(data_, R"(, "range": [20, 30])", ""));
+  ASSERT_FALSE(outside.ok());
+  EXPECT_NE(outside.message().find("clips[0].range: [20, 30) s lies outside the clip"), std::string::npos)
+      << outside.message();
 }
 
 TEST_F(TimeRanges, RangesOutsideTheClipNameTheManifestAndField) {

@@ -147,7 +147,7 @@ TEST_F(ViewerChromium, PageDecodesWhatWasRecorded) {
   std::vector<double> v;
   std::stringstream fields(match[1].str());
   for (std::string field; std::getline(fields, field, ',');) v.push_back(std::stod(field));
-  ASSERT_EQ(v.size(), 16u) << match[1].str();
+  ASSERT_EQ(v.size(), 18u) << match[1].str();
 
   const Recording& r = *recording_;
   const std::size_t a = 3, s = 40, i = r.sample_index(s, a), k = r.trajectory_index(s, a, r.trajectory_points() - 1);
@@ -170,6 +170,10 @@ TEST_F(ViewerChromium, PageDecodesWhatWasRecorded) {
   EXPECT_EQ(v[14], double(r.goals[a].size()));
   const auto pose = std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]) - r.pose_frames.begin();
   EXPECT_NEAR(v[15], r.pose_positions[r.pose_index(std::size_t(pose), r.joint_count() - 1) + 1], 0.00051);
+  // The last leg joint's height as displayed: the frame's joint to the
+  // millimetre and the correction to 2 mm.
+  EXPECT_NEAR(v[16], r.leg_positions[r.leg_index(s, a, r.leg_joints.size() - 1) + 1], 0.0016);
+  EXPECT_EQ(v[17], double(r.foot_events[a].size()));
 }
 
 // A negative control: the same page with its data corrupted must say so,
@@ -262,6 +266,40 @@ TEST_F(ViewerChromium, ScreenshotShowsCrowdSkeletonTrajectoriesAndTimeline) {
   EXPECT_GE(desired, 100u);
   EXPECT_GE(achieved, 100u);
   EXPECT_GE(jumps, 30u);
+}
+
+// Zoomed on a walking character's feet while one is locked: the crowd view
+// marks each locked foot on the ground (green), and so does the skeleton.
+TEST_F(ViewerChromium, ZoomedOnTheFeetShowsWhereTheyAreLocked) {
+  const Recording& r = *recording_;
+  // The first agent with a foot locked at a sample after 2 s.
+  std::size_t agent = r.agent_count;
+  float at = 0.0f;
+  for (std::size_t a = 0; a < r.agent_count && agent == r.agent_count; ++a) {
+    for (const FootEvent& event : r.foot_events[a]) {
+      if (event.time_s >= 2.0f && (event.state & (kFootLockedLeft | kFootLockedRight))) {
+        agent = a, at = event.time_s;
+        break;
+      }
+    }
+  }
+  ASSERT_LT(agent, r.agent_count) << "the synthetic crowd locks no foot";
+  const fs::path png = *dir_ / "feet.png";
+  const std::string query =
+      "?t=" + std::to_string(at) + "&agent=" + std::to_string(agent) + "&paused=1&zoom=400&follow=1";
+  run_chromium(*dir_ / "crowd.html", "--screenshot=" + png.string(), "feet", query);
+  const auto image = test::read_png(png);
+  ASSERT_TRUE(image.ok()) << image.message();
+  const auto locked = [](Rgb p) { return near(p, {0x7d, 0xff, 0x8a}); };
+  const std::size_t crowd = count_pixels(*image, 10, 80, 820, 610, locked);
+  const std::size_t skeleton = count_pixels(*image, 840, 80, 1270, 340, locked);
+  const std::size_t timeline = count_pixels(*image, 40, 640, 1270, 780, locked);
+  std::cout << "[ viewer ] agent " << agent << " at " << at << " s, locked-foot pixels: crowd " << crowd
+            << ", skeleton " << skeleton << ", timeline " << timeline << "\n";
+  // A marker is a disc or square of 0.045 m at 400 px/m (18 px across).
+  EXPECT_GE(crowd, 150u);
+  EXPECT_GE(skeleton, 25u);
+  EXPECT_GE(timeline, 100u);
 }
 
 }  // namespace

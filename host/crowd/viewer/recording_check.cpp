@@ -95,6 +95,42 @@ Status check_skeleton(const Recording& r) {
   return check_finite("pose_positions", r.pose_positions);
 }
 
+Status check_feet(const Recording& r) {
+  const std::size_t joints = r.joint_count();
+  for (std::size_t i = 0; i < r.leg_joints.size(); ++i) {
+    const int32_t j = r.leg_joints[i];
+    if (j < 0 || std::size_t(j) >= joints || (i > 0 && j <= r.leg_joints[i - 1])) {
+      return make_error("recording: leg_joints[" + std::to_string(i) + "] = " + std::to_string(j) +
+                        " is not a joint index, or not ascending and unique");
+    }
+  }
+  MMVK_TRY(check_size("leg_positions", r.leg_positions.size(),
+                      r.sample_count * r.agent_count * r.leg_joints.size() * 3,
+                      "sample_count x agent_count x leg_joints x 3"));
+  MMVK_TRY(check_finite("leg_positions", r.leg_positions));
+  if (r.foot_events.empty()) return {};
+  MMVK_TRY(check_size("foot_events", r.foot_events.size(), r.agent_count, "one list per agent, or none"));
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    float previous = 0.0f;
+    for (std::size_t e = 0; e < r.foot_events[a].size(); ++e) {
+      const FootEvent& event = r.foot_events[a][e];
+      const std::string where = "recording: foot_events[" + std::to_string(a) + "][" + std::to_string(e) + "]";
+      if (!std::isfinite(event.time_s) || event.time_s < previous) {
+        return make_error(where + ".time_s = " + std::to_string(event.time_s) +
+                          " is negative, not finite or earlier than the event before");
+      }
+      if (event.state > 15) return make_error(where + ".state = " + std::to_string(event.state) + " is over 15");
+      for (const auto& anchor : event.anchor) {
+        for (float v : anchor) {
+          if (!std::isfinite(v)) return make_error(where + ".anchor is not finite");
+        }
+      }
+      previous = event.time_s;
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Status validate_recording(const Recording& r) {
@@ -117,7 +153,8 @@ Status validate_recording(const Recording& r) {
   MMVK_TRY(check_finite("facing", r.facing));
   MMVK_TRY(check_trajectories(r));
   MMVK_TRY(check_agents(r));
-  return check_skeleton(r);
+  MMVK_TRY(check_skeleton(r));
+  return check_feet(r);
 }
 
 }  // namespace mmvk::crowd

@@ -1,6 +1,7 @@
 #include "viewer/synthetic_recording.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -71,6 +72,62 @@ struct Agent {
   float centre_x, centre_z, radius, speed, angle0;
   bool running;
 };
+
+// The feet's events (a foot is planted while its ankle rests at the pose's
+// floor clamp, and locked where its toe was when it touched down) and the
+// legs' world positions at every sample: the played pose placed at the
+// root, a locked foot's ankle and toe moved to hold the toe on its anchor
+// (the knee half as far), as a crude foot IK would.
+void add_feet(Recording& r) {
+  r.leg_joints = {12, 13, 14, 16, 17, 18};  // below LeftUpLeg and RightUpLeg
+  constexpr int32_t kAnkles[2] = {13, 17}, kToes[2] = {14, 18};
+  const std::size_t legs = r.leg_joints.size();
+  r.leg_positions.assign(r.sample_count * r.agent_count * legs * 3, 0.0f);
+  r.foot_events.assign(r.agent_count, {});
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    FootEvent current;
+    current.state = 0xff;  // none yet: the first sample always adds one
+    for (std::size_t s = 0; s < r.sample_count; ++s) {
+      const std::size_t i = r.sample_index(s, a);
+      const auto pose = std::size_t(std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]) -
+                                    r.pose_frames.begin());
+      const float c = std::cos(r.facing[i]), sn = std::sin(r.facing[i]);
+      auto world = [&](int32_t joint) {
+        const float* q = r.pose_positions.data() + r.pose_index(pose, std::size_t(joint));
+        return std::array<float, 3>{r.root_x[i] + c * q[0] + sn * q[2], q[1], r.root_z[i] - sn * q[0] + c * q[2]};
+      };
+      FootEvent next = current;
+      next.time_s = float(s) / r.sample_rate_hz;
+      next.state = 0;
+      for (int foot = 0; foot < 2; ++foot) {
+        const bool planted = r.pose_positions[r.pose_index(pose, std::size_t(kAnkles[foot])) + 1] <= 0.0801f;
+        const bool was_locked = current.state != 0xff && (current.state & (kFootLockedLeft << foot));
+        if (!planted) {
+          next.anchor[std::size_t(foot)] = {0.0f, 0.0f, 0.0f};
+          continue;
+        }
+        next.state |= std::uint8_t((kFootPlantedLeft | kFootLockedLeft) << foot);
+        if (!was_locked) next.anchor[std::size_t(foot)] = world(kToes[foot]);
+      }
+      if (next.state != current.state) {
+        r.foot_events[a].push_back(next);
+        current = next;
+      }
+      for (std::size_t l = 0; l < legs; ++l) {
+        auto p = world(r.leg_joints[l]);
+        const int foot = l < 3 ? 0 : 1;
+        if (current.state & (kFootLockedLeft << foot)) {
+          const auto toe = world(kToes[foot]);
+          const auto& anchor = current.anchor[std::size_t(foot)];
+          const float share = l % 3 == 0 ? 0.5f : 1.0f;  // the knee, then the ankle and the toe
+          p[0] += share * (anchor[0] - toe[0]);
+          p[2] += share * (anchor[2] - toe[2]);
+        }
+        std::copy(p.begin(), p.end(), r.leg_positions.begin() + std::ptrdiff_t(r.leg_index(s, a, l)));
+      }
+    }
+  }
+}
 
 }  // namespace
 
@@ -164,6 +221,7 @@ Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
       offset = (offset + 1) % clip.length;
     }
   }
+  add_feet(r);
   return r;
 }
 

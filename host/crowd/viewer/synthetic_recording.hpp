@@ -1,7 +1,8 @@
 // A synthetic but realistic Recording, so the viewer can be built and tested
 // without a simulation: agents walk (a few run) circles around their own
 // centres, with a procedural 19-joint walk cycle, staggered searches every
-// 0.1 s and a jump about once a second.
+// 0.1 s and a jump about once a second; its legs are recorded as displayed
+// and each planted foot is locked where its toe touched down.
 #pragma once
 
 #include <cstddef>

@@ -67,9 +67,9 @@
       offset += s.bytes;
     }
     const N = meta.agent_count, S = meta.sample_count, K = meta.trajectory_times_s.length;
-    const J = meta.joint_parents.length, P = meta.pose_count;
+    const J = meta.joint_parents.length, P = meta.pose_count, legJoints = meta.leg_joints || [], L = legJoints.length;
     const d = {
-      N, S, K, J, P, rate: meta.sample_rate_hz,
+      N, S, K, J, P, L, legJoints, rate: meta.sample_rate_hz,
       duration: Math.max(0, (S - 1) / meta.sample_rate_hz),
       times: meta.trajectory_times_s,
       parents: meta.joint_parents, names: meta.joint_names,
@@ -162,6 +162,57 @@
       for (let c = 0; c < J * 3; c++) { prev[c] += r.z(); d.poses[p * J * 3 + c] = prev[c] / 1000; }
     }
     r.finish();
+    if (L > 0) {
+      // The leg joints as displayed (after foot IK), stored as corrections
+      // of the played frame's pose in character space; kept in world space.
+      r = readers.legs;
+      d.legs = new Float64Array(N * S * L * 3);
+      for (let a = 0; a < N; a++) {
+        for (let s = 0; s < S; s++) {
+          const i = a * S + s, slot = d.slot[i], c = Math.cos(d.facing[i]), sn = Math.sin(d.facing[i]);
+          for (let l = 0; l < L; l++) {
+            const v = [0, 0, 0];
+            for (let k = 0; k < 3; k++) {
+              const frameMm = slot >= 0 ? Math.round(d.poses[(slot * J + legJoints[l]) * 3 + k] * 1000) : 0;
+              v[k] = (frameMm + 2 * r.z()) / 1000;  // corrections in 2 mm steps
+            }
+            const base = (i * L + l) * 3;
+            d.legs[base] = d.rootX[i] + c * v[0] + sn * v[2];
+            d.legs[base + 1] = v[1];
+            d.legs[base + 2] = d.rootZ[i] - sn * v[0] + c * v[2];
+          }
+        }
+      }
+      r.finish();
+      // Joints below a recorded one (end sites) move with it.
+      const recorded = new Int32Array(J).fill(-1);
+      legJoints.forEach((j, l) => { recorded[j] = l; });
+      d.legFollow = new Int32Array(J).fill(-1);
+      for (let j = 0; j < J; j++) {
+        const parent = d.parents[j];
+        if (recorded[j] < 0 && parent >= 0) d.legFollow[j] = recorded[parent] >= 0 ? recorded[parent] : d.legFollow[parent];
+      }
+    }
+    if (meta.has_feet) {
+      r = readers.feet;
+      d.feet = [];
+      for (let a = 0; a < N; a++) {
+        const count = r.u(), f = { t: new Float32Array(count), state: new Uint8Array(count), anchor: new Float32Array(count * 6) };
+        let ms = 0;
+        const anchor = new Float64Array(6);
+        for (let i = 0; i < count; i++) {
+          ms += r.z(); f.t[i] = ms / 1000;
+          f.state[i] = r.u();
+          for (let foot = 0; foot < 2; foot++) {
+            if (!(f.state[i] & (4 << foot))) continue;
+            for (let c = 0; c < 3; c++) anchor[3 * foot + c] += r.z();
+            for (let c = 0; c < 3; c++) f.anchor[6 * i + 3 * foot + c] = anchor[3 * foot + c] / 1000;
+          }
+        }
+        d.feet.push(f);
+      }
+      r.finish();
+    }
     return d;
   }
 
@@ -196,7 +247,35 @@
       const v0 = D.poses[slot0 * n + c];
       out[c] = v0 + blend * (D.poses[slot1 * n + c] - v0);
     }
+    // The legs as displayed: their recorded world positions, interpolated
+    // (the displayed motion is continuous, jumps included) and brought into
+    // character space with the interpolated root.
+    if (D.legs) {
+      const c = Math.cos(p.f), sn = Math.sin(p.f), b0 = (a * D.S + p.s0) * D.L * 3, b1 = (a * D.S + p.s1) * D.L * 3;
+      const moved = new Float32Array(D.L * 3);
+      for (let l = 0; l < D.L; l++) {
+        const at = (k) => D.legs[b0 + 3 * l + k] + p.w * (D.legs[b1 + 3 * l + k] - D.legs[b0 + 3 * l + k]);
+        const dx = at(0) - p.x, dz = at(2) - p.z, j = D.legJoints[l];
+        const shown = [c * dx - sn * dz, at(1), sn * dx + c * dz];
+        for (let k = 0; k < 3; k++) { moved[3 * l + k] = shown[k] - out[3 * j + k]; out[3 * j + k] = shown[k]; }
+      }
+      for (let j = 0; j < D.J; j++) {
+        const l = D.legFollow[j];
+        if (l >= 0) for (let k = 0; k < 3; k++) out[3 * j + k] += moved[3 * l + k];
+      }
+    }
     return { pose: out, frame: D.poseFrames[slot0] };
+  }
+
+  // Agent a's feet at time t: the state bits (FootEvent in recording.hpp)
+  // and the anchors of locked feet, world [x y z, x y z]; null without.
+  function feetAt(a, t) {
+    if (!D.feet) return null;
+    const f = D.feet[a];
+    let lo = 0, hi = f.t.length - 1, found = -1;
+    while (lo <= hi) { const mid = (lo + hi) >> 1; if (f.t[mid] <= t + 1e-6) { found = mid; lo = mid + 1; } else hi = mid - 1; }
+    if (found < 0) return { state: 0, anchor: null, index: -1 };
+    return { state: f.state[found], anchor: f.anchor.subarray(6 * found, 6 * found + 6), index: found };
   }
 
   const hue = (a) => (a * 137.508) % 360;
@@ -320,6 +399,7 @@
       ctx.lineTo(sx + Math.sin(p.f) * radius * 1.6, sy + Math.cos(p.f) * radius * 1.6); ctx.stroke();
       drawn++;
       if (v.scale >= 40) drawTopDownPose(ctx, v, w, h, a, p);
+      if (v.scale >= 40) drawLockedFeet(ctx, v, w, h, a);
     }
     state.drawn = drawn;
     drawSelectionOnCrowd(ctx, v, w, h, radius);
@@ -344,9 +424,47 @@
     ctx.stroke();
   }
 
+  // A planted foot held by foot IK: a green mark on the ground where it is
+  // locked (left a disc, right a square), a ring for the selected character's.
+  function footMark(ctx, x, y, size, foot, fill, stroke) {
+    ctx.fillStyle = fill;
+    ctx.beginPath();
+    if (foot === 0) ctx.arc(x, y, size, 0, 2 * Math.PI); else ctx.rect(x - size, y - size, 2 * size, 2 * size);
+    ctx.fill();
+    if (stroke) { ctx.strokeStyle = stroke; ctx.lineWidth = 1.5; ctx.stroke(); }
+  }
+
+  function drawLockedFeet(ctx, v, w, h, a) {
+    const feet = feetAt(a, state.t);
+    if (!feet || !feet.anchor) return;
+    const size = Math.max(2.5, 0.045 * v.scale);
+    for (let foot = 0; foot < 2; foot++) {
+      if (!(feet.state & (4 << foot))) continue;
+      const [sx, sy] = toScreen(v, w, h, feet.anchor[3 * foot], feet.anchor[3 * foot + 2]);
+      footMark(ctx, sx, sy, size, foot, colors.locked, a === state.selected ? '#ffffff' : null);
+    }
+  }
+
+  // The selected character's footprints: where its feet were locked in the
+  // last 2 s, fading with age.
+  function drawFootprints(ctx, v, w, h, a) {
+    if (!D.feet || v.scale < 40) return;
+    const f = D.feet[a], size = Math.max(2, 0.035 * v.scale);
+    for (let i = 0; i < f.t.length && f.t[i] <= state.t; i++) {
+      const age = state.t - f.t[i];
+      if (age > 2) continue;
+      for (let foot = 0; foot < 2; foot++) {
+        if (!(f.state[i] & (4 << foot))) continue;
+        const [sx, sy] = toScreen(v, w, h, f.anchor[6 * i + 3 * foot], f.anchor[6 * i + 3 * foot + 2]);
+        footMark(ctx, sx, sy, size, foot, 'rgba(125,255,138,' + (0.1 + 0.25 * (1 - age / 2)).toFixed(3) + ')', null);
+      }
+    }
+  }
+
   function drawSelectionOnCrowd(ctx, v, w, h, radius) {
     const a = state.selected;
     if (a < 0) return;
+    drawFootprints(ctx, v, w, h, a);
     const g = D.goals[a], goalPts = [];
     for (let i = 0; i < g.length; i += 2) goalPts.push(toScreen(v, w, h, g[i], g[i + 1]));
     polyline(ctx, goalPts, 'rgba(255,255,255,0.55)', 1.5, [4, 4]);
@@ -412,6 +530,18 @@
     }
     const q = now.pose, J = D.J, screen = [];
     for (let j = 0; j < J; j++) screen.push(project(q[3 * j], q[3 * j + 1], q[3 * j + 2]));
+    // Locked feet: their anchors on the ground, in character space.
+    const feet = feetAt(a, state.t);
+    if (feet && feet.anchor) {
+      const c = Math.cos(p.f), sn = Math.sin(p.f);
+      for (let foot = 0; foot < 2; foot++) {
+        if (!(feet.state & (4 << foot))) continue;
+        const dx = feet.anchor[3 * foot] - p.x, dz = feet.anchor[3 * foot + 2] - p.z;
+        const m = project(c * dx - sn * dz, 0, sn * dx + c * dz);
+        footMark(ctx, m[0], m[1], Math.max(5, scale * 0.05), foot, colors.locked, null);
+      }
+      label.textContent += ' \u00b7 ' + feetText(feet.state);
+    }
     // Shadows of the joints on the ground, then bones coloured by side.
     ctx.fillStyle = 'rgba(0,0,0,0.35)';
     for (let j = 0; j < J; j++) { const s = project(q[3 * j], 0, q[3 * j + 2]); ctx.fillRect(s[0] - 2, s[1] - 1, 4, 2); }
@@ -425,6 +555,11 @@
       ctx.beginPath(); ctx.moveTo(screen[parent][0], screen[parent][1]); ctx.lineTo(screen[j][0], screen[j][1]); ctx.stroke();
     }
     dots(ctx, screen, '#fff', Math.max(2, scale * 0.02));
+  }
+
+  function feetText(bits) {
+    const side = (foot) => (bits & (4 << foot) ? 'locked' : bits & (1 << foot) ? 'planted' : 'free');
+    return 'left ' + side(0) + ', right ' + side(1);
   }
 
   // ---- desired against achieved trajectory (character space) -----------
@@ -491,7 +626,11 @@
     const a = state.selected, label = document.getElementById('timeline-label');
     ctx.font = '11px system-ui, sans-serif';
     ctx.fillStyle = colors.dim; ctx.strokeStyle = '#2c323d'; ctx.lineWidth = 1;
-    const top = 24, frameH = (h - top - 22) * 0.55, axisY = top + frameH + 8, costTop = axisY + 6, costH = h - 18 - costTop;
+    // Bands from the top: the played frame, the feet (when recorded: a row
+    // per foot, dim where planted, bright where locked), the searches' axis,
+    // the match costs.
+    const top = 24, feetH = D.feet ? 16 : 0, frameH = (h - top - 22 - feetH) * 0.55;
+    const feetTop = top + frameH + 4, axisY = top + frameH + feetH + 8, costTop = axisY + 6, costH = h - 18 - costTop;
     const tickStep = D.duration > 30 ? 10 : D.duration > 8 ? 2 : 1;
     for (let t = 0; t <= D.duration + 1e-6; t += tickStep) {
       const x = timeToX(t, w);
@@ -510,6 +649,7 @@
       const slot = D.slot[a * D.S + s];
       if (slot >= 0) ctx.fillRect(timeToX(s / D.rate, w) - 1, frameY(D.poseFrames[slot]) - 1, 2, 2);
     }
+    if (D.feet) drawFeetRows(ctx, w, a, feetTop);
     // Searches on the axis: a short grey tick, a tall jump bar from the old
     // frame to the new one, a red cross where no candidate was found.
     let jumps = 0, forced = 0, none = 0, cmax = 0;
@@ -555,6 +695,23 @@
         (e.flags[last] & 1 ? 'jump ' + e.from[last] + ' \u2192 ' + e.to[last] : 'stay at ' + e.from[last]) + ', cost ' + e.cost[last].toFixed(3));
     }
     label.textContent = text;
+  }
+
+  function drawFeetRows(ctx, w, a, y) {
+    const f = D.feet[a], end = D.duration;
+    ctx.font = '8px system-ui, sans-serif';
+    for (let foot = 0; foot < 2; foot++) {
+      const rowY = y + foot * 7;
+      ctx.fillStyle = colors.dim; ctx.fillText(foot === 0 ? 'L' : 'R', 30, rowY + 6);
+      for (let i = 0; i < f.t.length; i++) {
+        const bits = f.state[i], until = i + 1 < f.t.length ? f.t[i + 1] : end;
+        if (!(bits & ((1 | 4) << foot))) continue;
+        ctx.fillStyle = bits & (4 << foot) ? colors.locked : 'rgba(125,255,138,0.3)';
+        const x0 = timeToX(f.t[i], w), x1 = timeToX(Math.min(until, end), w);
+        ctx.fillRect(x0, rowY, Math.max(1, x1 - x0), 5);
+      }
+    }
+    ctx.font = '11px system-ui, sans-serif';
   }
 
   // ---- the loop and the controls ----------------------------------------
@@ -673,7 +830,8 @@
   // as comma-separated numbers, so a test can compare it with the recording:
   // agent, sample, x, z, facing, frame, last desired x z, last matched x z
   // (0 0 without), searches, the last search's from, to and cost, goals,
-  // and the last joint's y in the pose played (0 without).
+  // the last joint's y in the pose played (0 without), the last leg joint's
+  // recorded world y (0 without) and the foot events (0 without).
   function probe() {
     const a = state.selected;
     if (a < 0) return '';
@@ -682,7 +840,8 @@
     return [a, s, D.rootX[i], D.rootZ[i], D.facing[i], slot >= 0 ? D.poseFrames[slot] : -1,
       D.K ? D.desX[k] : 0, D.K ? D.desZ[k] : 0, D.matX && D.K ? D.matX[k] : 0, D.matX && D.K ? D.matZ[k] : 0,
       e.t.length, last >= 0 ? e.from[last] : 0, last >= 0 ? e.to[last] : 0, last >= 0 ? e.cost[last] : 0,
-      D.goals[a].length / 2, slot >= 0 ? D.poses[(slot + 1) * D.J * 3 - 2] : 0].join(',');
+      D.goals[a].length / 2, slot >= 0 ? D.poses[(slot + 1) * D.J * 3 - 2] : 0,
+      D.legs ? D.legs[(i + 1) * D.L * 3 - 2] : 0, D.feet ? D.feet[a].t.length : 0].join(',');
   }
 
   async function main() {
@@ -691,7 +850,7 @@
     const bytes = await inflate(document.getElementById('mmvk-data').textContent);
     D = decodePayload(meta, bytes);
     D.bounds = meta.bounds;
-    for (const name of ['desired', 'achieved', 'matched', 'jump', 'dim']) colors[name] = css('--' + name);
+    for (const name of ['desired', 'achieved', 'matched', 'jump', 'dim', 'locked']) colors[name] = css('--' + name);
     document.getElementById('title').textContent = meta.title || 'mmvk crowd';
     document.getElementById('title').title = meta.title || '';
     if (D.N === 0) state.selected = -1;

@@ -58,6 +58,18 @@ enum class MirrorRule : std::uint8_t {
   Unchanged,   // copied from the source clip (sidecar values), through the manifest's mirror_map when it has an entry
 };
 
+// Where a crowd controller's query takes the kind's values from, measured on
+// what the character shows (query_assembly.hpp).
+enum class ShownSource : std::uint8_t {
+  Trajectory,     // future offsets from the predicted trajectory, past offsets from the root's recorded path
+  JointPosition,  // the bone's position in the displayed pose
+  JointVelocity,  // the bone's velocity in the displayed motion
+  Limb,           // the limb vector of the displayed pose
+  YawRate,        // the root's turning rate
+  Contacts,       // the displayed frame's foot contacts
+  Row,            // not measurable on a pose: the nearest database frame's values
+};
+
 namespace detail {
 struct ChannelExtraction;  // runtime/src/features/channel_extraction.hpp
 }  // namespace detail
@@ -84,6 +96,7 @@ struct ChannelKindInfo {
   MirrorRule mirror;
   float plausible_limit = 0.0f;   // largest plausible |value| (above), 0 = unchecked
   std::string_view limit_unit;    // the limit's unit for messages: "m", "m/s"
+  ShownSource shown;              // what a controller's query measures it on
   ChannelExtractor extract;       // library-internal
 };
 

@@ -7,26 +7,32 @@
 // One tick (dt seconds), synchronous form tick(dt, input, backend, pool):
 //   1. simulate: each simulated root moves toward its desired velocity and
 //      facing (critically damped springs, trajectory.hpp);
-//   2. play: each character advances by dt * fps frames (a looping clip wraps
-//      to its first frame; a non-looping clip holds its last frame); its
-//      animated root moves by the frames' root motion plus the
-//      inertialization's root offset;
+//   2. play: each character's continuous time in its clip advances by
+//      dt * fps frames (playback.hpp: a looping clip wraps to its first
+//      frame; a non-looping clip holds its last frame); its pose is
+//      interpolated between the two neighbouring frames, plus the decaying
+//      inertialization offsets; its animated root moves along the clip's root
+//      path plus the inertialization's root offset, then is corrected toward
+//      the simulated root (step 7); its root path is recorded (RootHistory);
 //   3. decide: a character is due when its search timer runs out (timers
 //      are staggered over the interval so the load per tick is flat), or a
 //      search is forced: first tick, the end of a non-looping clip, a
 //      do_not_use frame, entering a block_transition range, or a desired
 //      velocity or facing that changed sharply since its last search;
 //   4. assemble: one normalized query per due character into a [due x dims]
-//      batch (query_assembly.hpp): pose channels from its current frame,
-//      trajectory channels from its predicted trajectory;
+//      batch (query_assembly.hpp): pose channels measured on the pose it
+//      shows (after blending, before foot IK), past trajectory from its
+//      recorded root path, future trajectory from its prediction;
 //   5. search: the batch on the backend, split into chunks of at most
 //      params.max_batch queries;
-//   6. apply: a character jumps only when its match is not the continuing
-//      frame (the frame it plays now); a jump starts an inertialization
-//      (pose_batch.hpp);
-//   7. blend and correct: the played pose plus decaying offsets is the
-//      output pose; the animated root is pulled toward the simulated root
-//      with a bounded correction (ControllerParams).
+//   6. apply: a character jumps only when its match is neither the
+//      continuing frame (the frame nearest its time) nor within
+//      same_location_window of its time in the same clip; a jump plays on
+//      from the matched frame and starts an inertialization (pose_batch.hpp);
+//   7. correct: the animated root is pulled toward the simulated root with a
+//      bounded correction (ControllerParams); then foot locking holds planted
+//      feet on the ground through two-bone IK (foot_locker.hpp): the
+//      displayed pose.
 // Deferred form tick(dt, input, async, pool): steps 5-6 split: the batch is
 // submitted in step 5 and its results are applied at the start of the next
 // tick (one tick of latency), so a GPU search overlaps the caller's work.
@@ -36,6 +42,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -44,8 +51,10 @@
 
 #include "mmvk/animation_data.hpp"
 #include "mmvk/database.hpp"
+#include "mmvk/foot_locker.hpp"
 #include "mmvk/pose_batch.hpp"
 #include "mmvk/query_assembly.hpp"
+#include "mmvk/root_history.hpp"
 #include "mmvk/search.hpp"
 #include "mmvk/status.hpp"
 #include "mmvk/thread_pool.hpp"
@@ -78,6 +87,16 @@ struct ControllerParams {
   float continuing_multiplier = 1.0f;  // finite, >= 0 (QueryParams::continuing_multiplier)
   std::uint32_t exclusion_window = 0;
   std::uint32_t max_batch = 1024;  // queries per backend call (VulkanSearchOptions::max_batch)
+  // A match in the clip being played, within this many seconds of the
+  // character's time (before or after), is not jumped to: playing on shows
+  // the same motion without a blend (Motion Symphony's "same location"
+  // rule). >= 0; 0 suppresses only the continuing frame.
+  float same_location_window = 0.2f;
+  // Foot locking: planted feet held where they touched down, legs solved by
+  // two-bone IK on the displayed pose (foot_locker.hpp). Its bones are the
+  // roles @hips, @left_/@right_upper_leg, _lower_leg, _foot and _toe;
+  // enabled = false lets a skeleton without them through.
+  FootIkParams foot_ik;
 };
 
 // Per-tick input, [B] each.
@@ -93,7 +112,8 @@ struct TickStats {
   std::uint32_t forced = 0;        // of which forced
   std::uint32_t batches = 0;       // backend calls
   std::uint32_t applied = 0;       // results applied this tick
-  std::uint32_t jumps = 0;         // results that were not the continuing frame
+  std::uint32_t jumps = 0;         // results that were jumped to
+  std::uint32_t same_location = 0; // results not jumped to: within same_location_window of the character's time
   std::uint32_t no_candidate = 0;  // results with no frame (kept playing)
 };
 
@@ -163,6 +183,7 @@ class CrowdController {
 
   // Per-character output, [B] unless noted.
   std::span<const std::uint32_t> frames() const { return frames_; }          // database frame played
+  std::span<const float> frame_fractions() const { return fractions_; }    // of the way to the next frame, [0, 1)
   std::span<const glm::vec3> root_positions() const { return root_pos_; }   // animated root, world, y = 0
   std::span<const float> root_yaws() const { return root_yaw_; }
   std::span<const SimulationState> simulation() const { return sim_; }      // simulated root
@@ -172,7 +193,7 @@ class CrowdController {
   std::span<const std::uint8_t> searched() const { return searched_; }
   std::span<const std::uint8_t> jumped() const { return jumped_; }          // 1: jumped this tick
   std::span<const float> match_costs() const { return match_cost_; }        // last applied match (inf: none)
-  std::span<const std::uint8_t> contacts() const { return contacts_; }      // FootContact bits of the frame
+  std::span<const std::uint8_t> contacts() const { return contacts_; }      // FootContact bits of the nearest frame
   // The trajectory of each character's last search: [B x T] world positions
   // and yaws, T = trajectory_offsets().size().
   std::span<const float> trajectory_offsets() const { return assembler_.trajectory_offsets(); }
@@ -181,6 +202,21 @@ class CrowdController {
   // The output pose, character space: [B x joints] each.
   std::span<const glm::quat> local_rotations() const { return rotations_; }
   std::span<const glm::vec3> local_translations() const { return translations_; }
+  // The animated pose before foot IK (what queries measure), character
+  // space, [B x joints] each, and its world joint positions into out.
+  std::span<const glm::quat> animated_rotations() const { return anim_rotations_; }
+  std::span<const glm::vec3> animated_translations() const { return anim_translations_; }
+  void animated_world_positions(std::span<glm::vec3> out, ThreadPool& pool) const;
+  // Foot locking (ControllerParams::foot_ik), per character and foot
+  // (left, right), [B x 2]: 1 while the foot is held where it was planted;
+  // the world position it is held at (metres); 1 when the leg could not
+  // reach its target this tick and was soft-clamped. All 0 with foot IK off.
+  std::span<const std::uint8_t> foot_locked() const;
+  std::span<const glm::vec3> foot_anchors() const;
+  std::span<const std::uint8_t> ik_reach_clamped() const;
+  // The locker itself (hip drops, corrections), or null with foot IK off
+  // on a skeleton without legs.
+  const FootLocker* foot_locker() const { return locker_ ? &*locker_ : nullptr; }
 
  private:
   CrowdController() = default;
@@ -193,6 +229,18 @@ class CrowdController {
   // continuing[count]; updates last_.
   void apply(std::span<const Match> matches, std::span<const std::uint32_t> characters,
              std::span<const std::uint32_t> continuing, ThreadPool& pool);
+  // Steps 1-3 and the blend for character b.
+  void play(std::uint32_t b, float dt, const CrowdInput& input, float correction);
+  // The measurements of b's animated pose that queries read: its joint
+  // positions, joint velocities and yaw rate; `fresh`: no previous tick.
+  void measure_shown(std::uint32_t b, float dt, bool fresh);
+  // b's displayed pose: the animated one with its feet locked (foot IK),
+  // and its world joint positions.
+  void display(std::uint32_t b, float dt);
+  // Pulls b's animated root toward its simulated root (step 7).
+  void correct_root(std::uint32_t b, float dt, float correction);
+  // b's match `to` is close enough to its time to play on instead.
+  bool same_location(std::uint32_t b, std::uint32_t to) const;
   void jump(std::uint32_t b, std::uint32_t to, unsigned thread);
   void ensure_scratch(unsigned threads);
 
@@ -209,14 +257,16 @@ class CrowdController {
 
   // Per character, [B].
   std::vector<std::uint32_t> frames_;
-  std::vector<float> frame_time_;        // fraction of a frame played past frames_
+  std::vector<float> fractions_;         // of the way from frames_ to the next frame, [0, 1)
   std::vector<float> search_timer_;      // seconds to the next regular search
   std::vector<std::uint8_t> force_;      // forced search pending (placed, first tick)
   std::vector<std::uint8_t> due_flag_;   // 0 no search, 1 regular, 2 forced
-  std::vector<std::uint8_t> searched_, jumped_, contacts_;
+  std::vector<std::uint8_t> searched_, jumped_, suppressed_, contacts_;
   std::vector<float> match_cost_;
   std::vector<glm::vec3> root_pos_;
   std::vector<float> root_yaw_;
+  std::vector<float> yaw_rate_;             // the animated root's turning rate, rad/s
+  RootHistory history_;
   std::vector<glm::vec3> played_velocity_;  // root velocity of the played frames, character space, m/s
   std::vector<float> played_yaw_rate_;      // rad/s
   std::vector<SimulationState> sim_;
@@ -225,14 +275,27 @@ class CrowdController {
   std::vector<QueryParams> query_params_;
   std::vector<glm::vec3> pred_pos_;      // [B x T]
   std::vector<float> pred_yaw_;          // [B x T]
-  std::vector<glm::quat> rotations_;     // [B x joints]
-  std::vector<glm::vec3> translations_;  // [B x joints]
+  std::vector<glm::quat> rotations_;     // [B x joints] displayed
+  std::vector<glm::vec3> translations_;  // [B x joints] displayed
+  std::vector<glm::quat> anim_rotations_;     // [B x joints] animated, before IK
+  std::vector<glm::vec3> anim_translations_;  // [B x joints]
+  std::vector<glm::vec3> joint_positions_;    // [B x joints] character space, of the animated pose
+  std::vector<glm::vec3> velocity_world_;     // [B x V] world positions of the assembler's velocity joints
+  std::vector<glm::vec3> joint_velocities_;   // [B x V] their velocities, character space
+  std::vector<std::uint8_t> fresh_;           // [B] placed since the last tick: no velocities yet
+  std::vector<std::uint8_t> held_;            // [B] on a non-looping clip's last frame
+  std::optional<FootLocker> locker_;
+  std::vector<glm::vec3> world_;              // [B x joints] displayed world joint positions
+  std::vector<std::uint8_t> no_feet_flags_;   // [B x 2] zeros, without a locker
+  std::vector<glm::vec3> no_feet_anchors_;    // [B x 2]
 
   // The batch, [B] capacity.
   std::vector<std::uint32_t> due_;       // characters in the batch, ascending
   std::vector<std::uint32_t> continuing_;  // their continuing frames
   std::vector<QueryFrame> due_refs_;
   std::vector<float> queries_;           // [B x dims]
+  std::vector<glm::vec3> past_pos_;      // [B x past offsets] of the batch
+  std::vector<float> past_yaw_;
   std::vector<QueryParams> batch_params_;
   std::vector<Match> matches_;
   std::uint32_t due_count_ = 0;

@@ -36,6 +36,10 @@ struct Clip {
   float cost_bias = 0.0f;           // added to every frame's cost
   std::uint32_t first_frame = 0;    // database frame index of the clip's first frame
   std::uint32_t frame_count = 0;
+  // Metres per unit of the source file, as the import used them (given by
+  // the manifest or guessed); 0 = not recorded (clips made in code, files
+  // before format 4).
+  float metres_per_unit = 0.0f;
 };
 
 // Normalization of one feature dimension: normalized = (raw - offset) / scale.

@@ -16,7 +16,10 @@
 //     (round(max offset_seconds x fps) frames ahead) lies past the clip's last
 //     frame is flagged kFrameEdgeExcluded with EdgeRule::Exclude, and kept as
 //     an ordinary frame with clamped trajectory features with
-//     EdgeRule::Clamp. Looping clips wrap and never get the flag.
+//     EdgeRule::Clamp, or with extrapolated ones with EdgeRule::Extrapolate
+//     (which flags only a clip's last kExtrapolateEndSeconds and frames whose
+//     phase window crosses an edge; see manifest.hpp). Looping clips wrap and
+//     never get the flag.
 //   - Time ranges: frame f of a clip is in [begin, end) seconds when
 //     begin <= f / fps < end; do_not_use sets kFrameDoNotUse,
 //     block_transition sets kFrameBlockTransition; a frame in a tag range

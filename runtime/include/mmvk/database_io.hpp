@@ -15,11 +15,14 @@
 //                              f32 cost bias, u32 first frame, u32 frame count
 //                         u32  frames, then frames x u32 frame flags
 //                         f32  features [frames x dims], row-major, normalized
-//                         u8   1: per-frame modifiers follow (version 3 only, which
-//                              is written only for a database that has them):
+//                         u8   1 when per-frame modifiers follow (version 3 on;
+//                              version 3 is written only for a database that has them):
 //                              u64 tags [frames], f32 cost multiplier [frames],
 //                              f32 cost bias [frames] (the manifest's tag_ranges
 //                              and cost_ranges; without them the clips' values hold)
+//                         u8   1 when the clips' import units follow (version 4
+//                              only, which is written only for a database that
+//                              records them): f32 metres per file unit [clips]
 //                         u8   1 when the animation section follows, else 0 (version 2)
 //                         the animation section (version 2, animation_data.hpp):
 //                              u32 joints, then per joint: str name, i32 parent,
@@ -54,10 +57,11 @@
 namespace mmvk {
 
 // Version 2 adds the optional animation section, version 3 the per-frame
-// tags and cost modifiers (written only for a database that has them, so
-// others stay version 2 files); version 1 and 2 files still load (version 1:
-// features only, Database::animation() null).
-inline constexpr std::uint32_t kDatabaseFormatVersion = 3;
+// tags and cost modifiers, version 4 the clips' import units (each written
+// only for a database that has them, so others stay version 2 or 3 files);
+// version 1 to 3 files still load (version 1: features only,
+// Database::animation() null; before 4: Clip::metres_per_unit 0).
+inline constexpr std::uint32_t kDatabaseFormatVersion = 4;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 
 // The file's bytes.

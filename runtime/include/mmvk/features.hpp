@@ -71,6 +71,12 @@ struct FeatureExtractionOptions {
   std::span<const std::vector<float>> custom;
   // Foot contact detection for FootContact channels.
   FootContactParams contacts;
+  // > 0: a non-looping clip's trajectory offsets that reach past its last
+  // (or before its first) frame are extrapolated at the constant speed and
+  // turning rate of its last (first) this many seconds, instead of clamped,
+  // and do not count as running past the edge (past_end); phase windows
+  // still clamp and count. 0: clamp (the edge rule's default).
+  float extrapolate_seconds = 0.0f;
 };
 
 struct RawFeatures {
@@ -78,7 +84,8 @@ struct RawFeatures {
   std::uint32_t dims = 0;
   std::vector<float> values;            // [frame_count x dims], row-major, raw units
   // [frame_count]: 1 when a trajectory offset or phase window ran past a
-  // non-looping clip's start or end (the name is older than the past trajectory)
+  // non-looping clip's start or end and was clamped (the name is older than
+  // the past trajectory; extrapolated offsets do not count)
   std::vector<std::uint8_t> past_end;
 };
 
@@ -97,11 +104,13 @@ std::uint32_t max_offset_frames(const FeatureSchema& schema, float fps);
 // frames at `fps`: past trajectory offsets and phase windows reach back,
 // future offsets and phase windows ahead. A non-looping clip's frame f runs
 // past an edge when f < before or f + after > last frame.
+// With `trajectory` false, only the phase windows count (the reach that
+// still clamps when trajectories are extrapolated).
 struct EdgeReach {
   std::uint32_t before = 0;
   std::uint32_t after = 0;
 };
-EdgeReach edge_reach(const FeatureSchema& schema, float fps);
+EdgeReach edge_reach(const FeatureSchema& schema, float fps, bool trajectory = true);
 
 // Half-width of a phase window in frames: round(window_seconds * fps), >= 1.
 std::uint32_t window_frames(float window_seconds, float fps);

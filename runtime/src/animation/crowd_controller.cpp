@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "mmvk/playback.hpp"
 #include "mmvk/spring.hpp"
 
 namespace mmvk {
@@ -69,12 +70,19 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   if (!std::isfinite(params.continuing_multiplier) || params.continuing_multiplier < 0.0f) {
     return make_error("crowd controller: continuing_multiplier must be finite and >= 0");
   }
+  if (!std::isfinite(params.same_location_window) || params.same_location_window < 0.0f) {
+    return make_error("crowd controller: same_location_window must be finite and >= 0 (seconds)");
+  }
   if (params.max_batch == 0 || params.max_batch > kMaxBatch) {
     return make_error("crowd controller: max_batch = " + std::to_string(params.max_batch) + " is out of range [1, " +
                       std::to_string(kMaxBatch) + "] (kMaxBatch)");
   }
   Result<QueryAssembler> assembler = QueryAssembler::create(database);
   if (!assembler.ok()) return make_error("crowd controller: " + assembler.message());
+  Result<FootLocker> locker = FootLocker::create(*animation, characters, params.foot_ik);
+  if (!locker.ok() && params.foot_ik.enabled) {
+    return make_error("crowd controller: " + locker.message() + " (foot_ik.enabled = false runs without foot locking)");
+  }
 
   CrowdController c;
   c.database_ = &database;
@@ -87,7 +95,7 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.trajectory_size_ = static_cast<std::uint32_t>(c.assembler_.trajectory_offsets().size());
   const std::size_t n = characters;
   c.frames_.assign(n, 0);
-  c.frame_time_.assign(n, 0.0f);
+  c.fractions_.assign(n, 0.0f);
   c.search_timer_.resize(n);
   for (std::size_t b = 0; b < n; ++b) {
     const float fraction = static_cast<float>(b) * kGolden;
@@ -97,10 +105,14 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.due_flag_.assign(n, 0);
   c.searched_.assign(n, 0);
   c.jumped_.assign(n, 0);
+  c.suppressed_.assign(n, 0);
   c.contacts_.assign(n, animation->contacts[0]);
   c.match_cost_.assign(n, std::numeric_limits<float>::infinity());
   c.root_pos_.assign(n, glm::vec3(0.0f));
   c.root_yaw_.assign(n, 0.0f);
+  c.yaw_rate_.assign(n, 0.0f);
+  const std::span<const float> past = c.assembler_.past_offsets();
+  c.history_ = RootHistory(characters, past.empty() ? 0.0f : *std::max_element(past.begin(), past.end()));
   c.played_velocity_.assign(n, glm::vec3(0.0f));
   c.played_yaw_rate_.assign(n, 0.0f);
   c.sim_.assign(n, SimulationState{});
@@ -113,10 +125,21 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.pred_yaw_.assign(n * c.trajectory_size_, 0.0f);
   c.rotations_.resize(n * c.joints_);
   c.translations_.resize(n * c.joints_);
-  for (std::size_t b = 0; b < n; ++b) {
-    sample_pose(*animation, 0, std::span(c.rotations_).subspan(b * c.joints_, c.joints_),
-                std::span(c.translations_).subspan(b * c.joints_, c.joints_));
-  }
+  c.anim_rotations_.resize(n * c.joints_);
+  c.anim_translations_.resize(n * c.joints_);
+  c.joint_positions_.resize(n * c.joints_);
+  const std::size_t velocity_joints = c.assembler_.velocity_joints().size();
+  c.velocity_world_.assign(n * velocity_joints, glm::vec3(0.0f));
+  c.joint_velocities_.assign(n * velocity_joints, glm::vec3(0.0f));
+  c.fresh_.assign(n, 1);
+  c.held_.assign(n, 0);
+  if (locker.ok()) c.locker_ = std::move(*locker);
+  c.world_.resize(n * c.joints_);
+  c.no_feet_flags_.assign(2 * n, 0);
+  c.no_feet_anchors_.assign(2 * n, glm::vec3(0.0f));
+  c.past_pos_.resize(n * past.size());
+  c.past_yaw_.resize(n * past.size());
+  for (std::uint32_t b = 0; b < characters; ++b) MMVK_TRY(c.place(b, glm::vec3(0.0f), 0.0f, 0));
   c.due_.resize(n);
   c.continuing_.resize(n);
   c.due_refs_.resize(n);
@@ -144,14 +167,21 @@ Status CrowdController::place(std::uint32_t b, const glm::vec3& position, float 
   desired_velocity_[b] = searched_velocity_[b] = glm::vec3(0.0f);
   desired_yaw_[b] = searched_yaw_[b] = root_yaw_[b];
   frames_[b] = frame;
-  frame_time_[b] = 0.0f;
+  fractions_[b] = 0.0f;
+  held_[b] = 0;
   force_[b] = 1;
   played_velocity_[b] = glm::vec3(0.0f);
   played_yaw_rate_[b] = 0.0f;
+  yaw_rate_[b] = 0.0f;
   inertializer_.reset(b);
+  history_.reset(b, ground, root_yaw_[b]);
   contacts_[b] = animation_->contacts[frame];
-  sample_pose(*animation_, frame, std::span(rotations_).subspan(std::size_t{b} * joints_, joints_),
-              std::span(translations_).subspan(std::size_t{b} * joints_, joints_));
+  const std::size_t base = std::size_t{b} * joints_;
+  sample_pose(*animation_, frame, std::span(anim_rotations_).subspan(base, joints_),
+              std::span(anim_translations_).subspan(base, joints_));
+  measure_shown(b, 0.0f, true);
+  if (locker_) locker_->reset(b);
+  display(b, 0.0f);
   return {};
 }
 
@@ -234,124 +264,149 @@ void pose_velocity(const Database& database, const AnimationData& animation, std
   }
 }
 
-// Root velocity (character space, m/s) and yaw rate (rad/s) of the stored
-// animation at `frame`.
-RootDelta root_velocity(const Database& database, const AnimationData& animation, std::uint32_t frame) {
-  const auto [a, b] = difference_frames(database, frame);
-  RootDelta out = root_delta(animation, a, b);
-  out.translation *= database.fps();
-  out.yaw *= database.fps();
-  if (a != frame) {
-    // A backward difference is expressed in the previous frame's space.
-    out.translation = yaw_rotate(out.translation, animation.root_yaws[a] - animation.root_yaws[frame]);
-  }
-  return out;
-}
-
 }  // namespace
 
-void CrowdController::begin(float dt, const CrowdInput& input, ThreadPool& pool) {
+void CrowdController::play(std::uint32_t b, float dt, const CrowdInput& input, float correction) {
   const Database& database = *database_;
   const AnimationData& animation = *animation_;
-  const float fps = database.fps();
   const auto flags = database.frame_flags();
-  const auto frame_clip = database.frame_clip();
-  const auto clips = database.clips();
+  searched_[b] = 0;
+  // 1. simulate.
+  desired_velocity_[b] = input.desired_velocity[b];
+  desired_yaw_[b] = input.desired_yaw.empty() ? yaw_of_velocity(desired_velocity_[b], desired_yaw_[b])
+                                              : wrap_angle(input.desired_yaw[b]);
+  simulate_step(sim_[b], desired_velocity_[b], desired_yaw_[b], params_.spring, dt);
+
+  // 2. play on by dt along the clip.
+  const std::uint32_t previous_flags = flags[nearest_frame(database, {frames_[b], fractions_[b]})];
+  const PlaybackStep step = advance_playback(database, {frames_[b], fractions_[b]}, dt * database.fps());
+  frames_[b] = step.time.frame;
+  fractions_[b] = step.time.fraction;
+  held_[b] = step.reached_end ? 1 : 0;
+  // The root motion of the frame interval now played (the source velocity
+  // of a jump).
+  const RootDelta velocity = root_velocity_at(database, frames_[b]);
+  played_velocity_[b] = velocity.translation;
+  played_yaw_rate_[b] = velocity.yaw;
+
+  // The pose at the new time plus the decaying offsets.
+  const std::size_t base = std::size_t{b} * joints_;
+  const std::span<glm::quat> rotations(anim_rotations_.data() + base, joints_);
+  const std::span<glm::vec3> translations(anim_translations_.data() + base, joints_);
+  sample_pose_at(animation, frames_[b], next_frame(database, frames_[b]), fractions_[b], rotations, translations);
+  const Inertializer::RootOffset offset =
+      inertializer_.update(b, params_.inertialization_half_life, dt, rotations, translations);
+  const float yaw_before = root_yaw_[b];
+  root_pos_[b] += yaw_rotate(step.root_translation + offset.velocity * dt, root_yaw_[b]);
+  root_pos_[b].y = 0.0f;
+  root_yaw_[b] = wrap_angle(root_yaw_[b] + step.root_yaw + offset.yaw_rate * dt);
+  correct_root(b, dt, correction);
+  yaw_rate_[b] = wrap_angle(root_yaw_[b] - yaw_before) / dt;
+  history_.record(b, dt, root_pos_[b], root_yaw_[b]);
+  const std::uint32_t nearest = nearest_frame(database, step.time);
+  contacts_[b] = animation.contacts[nearest];
+  measure_shown(b, dt, fresh_[b] != 0);
+  display(b, dt);
+
+  // 3. decide.
+  search_timer_[b] -= dt;
+  bool regular = false;
+  if (search_timer_[b] <= 0.0f) {
+    regular = true;
+    search_timer_[b] = std::max(search_timer_[b] + params_.search_interval, 0.0f);
+  }
+  const std::uint32_t frame_flags = flags[nearest];
+  const bool forced =
+      force_[b] != 0 || step.reached_end || (frame_flags & kFrameDoNotUse) != 0 ||
+      ((frame_flags & kFrameBlockTransition) != 0 && (previous_flags & kFrameBlockTransition) == 0) ||
+      glm::length(desired_velocity_[b] - searched_velocity_[b]) > params_.force_search_velocity_change ||
+      std::abs(wrap_angle(desired_yaw_[b] - searched_yaw_[b])) > params_.force_search_yaw_change;
+  // A forced search leaves the regular schedule alone: resetting the timer
+  // would bunch characters forced together (all of them on the first tick)
+  // onto the same later ticks.
+  due_flag_[b] = forced ? 2 : regular ? 1 : 0;
+  force_[b] = 0;
+}
+
+void CrowdController::correct_root(std::uint32_t b, float dt, float correction) {
+  glm::vec3 gap = sim_[b].position - root_pos_[b];
+  gap.y = 0.0f;
+  glm::vec3 step = gap * correction;
+  const float step_length = glm::length(step);
+  const float max_step = params_.max_correction_speed * dt;
+  if (step_length > max_step) step *= max_step / step_length;
+  root_pos_[b] += step;
+  gap = sim_[b].position - root_pos_[b];
+  gap.y = 0.0f;
+  const float distance = glm::length(gap);
+  if (distance > params_.max_correction_distance) {
+    root_pos_[b] += gap * (1.0f - params_.max_correction_distance / distance);
+  }
+  float yaw_gap = wrap_angle(sim_[b].yaw - root_yaw_[b]);
+  const float yaw_step = std::clamp(yaw_gap * correction, -params_.max_correction_yaw_rate * dt,
+                                    params_.max_correction_yaw_rate * dt);
+  root_yaw_[b] = wrap_angle(root_yaw_[b] + yaw_step);
+  yaw_gap = wrap_angle(sim_[b].yaw - root_yaw_[b]);
+  if (std::abs(yaw_gap) > params_.max_correction_yaw) {
+    root_yaw_[b] = wrap_angle(sim_[b].yaw - std::copysign(params_.max_correction_yaw, yaw_gap));
+  }
+}
+
+void CrowdController::measure_shown(std::uint32_t b, float dt, bool fresh) {
+  const std::size_t base = std::size_t{b} * joints_;
+  const glm::vec3 origin(0.0f);
+  const float no_yaw = 0.0f;
+  forward_kinematics_batch(animation_->skeleton, std::span(anim_rotations_).subspan(base, joints_),
+                           std::span(anim_translations_).subspan(base, joints_), {&origin, 1}, {&no_yaw, 1},
+                           std::span(joint_positions_).subspan(base, joints_));
+  // Velocities by backward differences of world positions: what the viewer
+  // sees, root motion and corrections included.
+  const std::span<const int> joints = assembler_.velocity_joints();
+  const float c = std::cos(root_yaw_[b]);
+  const float s = std::sin(root_yaw_[b]);
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const glm::vec3 local = joint_positions_[base + static_cast<std::size_t>(joints[k])];
+    const glm::vec3 world = root_pos_[b] + yaw_rotate(local, root_yaw_[b]);
+    glm::vec3& last = velocity_world_[b * joints.size() + k];
+    const glm::vec3 v = fresh || !(dt > 0.0f) ? glm::vec3(0.0f) : (world - last) / dt;
+    joint_velocities_[b * joints.size() + k] = {v.x * c - v.z * s, v.y, v.x * s + v.z * c};
+    last = world;
+  }
+  fresh_[b] = fresh && !(dt > 0.0f) ? 1 : 0;
+}
+
+void CrowdController::display(std::uint32_t b, float dt) {
+  const std::size_t base = std::size_t{b} * joints_;
+  const auto at = [base](auto& v) { return v.begin() + std::ptrdiff_t(base); };
+  std::copy_n(at(anim_rotations_), joints_, at(rotations_));
+  std::copy_n(at(anim_translations_), joints_, at(translations_));
+  const std::span<glm::quat> rotations(rotations_.data() + base, joints_);
+  const std::span<glm::vec3> translations(translations_.data() + base, joints_);
+  const std::span<glm::vec3> world(world_.data() + base, joints_);
+  if (locker_) {
+    locker_->update(b, dt, contacts_[b], root_pos_[b], root_yaw_[b], rotations, translations, world);
+  } else {
+    forward_kinematics_batch(animation_->skeleton, rotations, translations, {&root_pos_[b], 1}, {&root_yaw_[b], 1},
+                             world);
+  }
+}
+
+std::span<const std::uint8_t> CrowdController::foot_locked() const {
+  return locker_ ? locker_->locked() : std::span<const std::uint8_t>(no_feet_flags_);
+}
+
+std::span<const glm::vec3> CrowdController::foot_anchors() const {
+  return locker_ ? locker_->anchors() : std::span<const glm::vec3>(no_feet_anchors_);
+}
+
+std::span<const std::uint8_t> CrowdController::ik_reach_clamped() const {
+  return locker_ ? locker_->reach_clamped() : std::span<const std::uint8_t>(no_feet_flags_);
+}
+
+void CrowdController::begin(float dt, const CrowdInput& input, ThreadPool& pool) {
   const float correction = 1.0f - std::exp2(-dt / params_.correction_half_life);
   for_characters(pool, characters_, [&](std::size_t begin, std::size_t end, unsigned) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const auto b = static_cast<std::uint32_t>(i);
-      searched_[b] = 0;
-      // 1. simulate.
-      desired_velocity_[b] = input.desired_velocity[b];
-      desired_yaw_[b] = input.desired_yaw.empty() ? yaw_of_velocity(desired_velocity_[b], desired_yaw_[b])
-                                                  : wrap_angle(input.desired_yaw[b]);
-      simulate_step(sim_[b], desired_velocity_[b], desired_yaw_[b], params_.spring, dt);
-
-      // 2. play: root motion at the velocity of the frame being left, then
-      // whole frames forward.
-      std::uint32_t frame = frames_[b];
-      const Clip& clip = clips[frame_clip[frame]];
-      const std::uint32_t last = clip.first_frame + clip.frame_count - 1;
-      const bool held = frame == last && !clip.loop;
-      if (held) {
-        played_velocity_[b] = glm::vec3(0.0f);
-        played_yaw_rate_[b] = 0.0f;
-      } else {
-        const RootDelta v = root_velocity(database, animation, frame);
-        played_velocity_[b] = v.translation;
-        played_yaw_rate_[b] = v.yaw;
-      }
-      const std::uint32_t previous_flags = flags[frame];
-      float time = frame_time_[b] + dt * fps;
-      bool at_end = held;
-      while (time >= 1.0f) {
-        time -= 1.0f;
-        if (frame < last) {
-          ++frame;
-        } else if (clip.loop) {
-          frame = clip.first_frame;
-        } else {
-          at_end = true;
-        }
-      }
-      frame_time_[b] = time;
-      frames_[b] = frame;
-      if (frame == last && !clip.loop) at_end = true;
-
-      // The played pose plus the decaying offsets.
-      const std::span<glm::quat> rotations(rotations_.data() + std::size_t{b} * joints_, joints_);
-      const std::span<glm::vec3> translations(translations_.data() + std::size_t{b} * joints_, joints_);
-      sample_pose(animation, frame, rotations, translations);
-      const Inertializer::RootOffset offset =
-          inertializer_.update(b, params_.inertialization_half_life, dt, rotations, translations);
-      root_pos_[b] += yaw_rotate(played_velocity_[b] + offset.velocity, root_yaw_[b]) * dt;
-      root_pos_[b].y = 0.0f;
-      root_yaw_[b] = wrap_angle(root_yaw_[b] + (played_yaw_rate_[b] + offset.yaw_rate) * dt);
-
-      // 7. bounded correction toward the simulated root.
-      glm::vec3 gap = sim_[b].position - root_pos_[b];
-      gap.y = 0.0f;
-      glm::vec3 step = gap * correction;
-      const float step_length = glm::length(step);
-      const float max_step = params_.max_correction_speed * dt;
-      if (step_length > max_step) step *= max_step / step_length;
-      root_pos_[b] += step;
-      gap = sim_[b].position - root_pos_[b];
-      gap.y = 0.0f;
-      const float distance = glm::length(gap);
-      if (distance > params_.max_correction_distance) {
-        root_pos_[b] += gap * (1.0f - params_.max_correction_distance / distance);
-      }
-      float yaw_gap = wrap_angle(sim_[b].yaw - root_yaw_[b]);
-      const float yaw_step = std::clamp(yaw_gap * correction, -params_.max_correction_yaw_rate * dt,
-                                        params_.max_correction_yaw_rate * dt);
-      root_yaw_[b] = wrap_angle(root_yaw_[b] + yaw_step);
-      yaw_gap = wrap_angle(sim_[b].yaw - root_yaw_[b]);
-      if (std::abs(yaw_gap) > params_.max_correction_yaw) {
-        root_yaw_[b] = wrap_angle(sim_[b].yaw - std::copysign(params_.max_correction_yaw, yaw_gap));
-      }
-      contacts_[b] = animation.contacts[frame];
-
-      // 3. decide.
-      search_timer_[b] -= dt;
-      bool regular = false;
-      if (search_timer_[b] <= 0.0f) {
-        regular = true;
-        search_timer_[b] = std::max(search_timer_[b] + params_.search_interval, 0.0f);
-      }
-      const std::uint32_t frame_flags = flags[frame];
-      const bool forced =
-          force_[b] != 0 || at_end || (frame_flags & kFrameDoNotUse) != 0 ||
-          ((frame_flags & kFrameBlockTransition) != 0 && (previous_flags & kFrameBlockTransition) == 0) ||
-          glm::length(desired_velocity_[b] - searched_velocity_[b]) > params_.force_search_velocity_change ||
-          std::abs(wrap_angle(desired_yaw_[b] - searched_yaw_[b])) > params_.force_search_yaw_change;
-      // A forced search leaves the regular schedule alone: resetting the
-      // timer would bunch characters forced together (all of them on the
-      // first tick) onto the same later ticks.
-      due_flag_[b] = forced ? 2 : regular ? 1 : 0;
-      force_[b] = 0;
-    }
+    for (std::size_t i = begin; i < end; ++i) play(static_cast<std::uint32_t>(i), dt, input, correction);
   });
   // Compaction in character order: the batch order is deterministic.
   due_count_ = 0;
@@ -367,6 +422,8 @@ void CrowdController::begin(float dt, const CrowdInput& input, ThreadPool& pool)
 void CrowdController::assemble(ThreadPool& pool) {
   const std::uint32_t dims = database_->dims();
   const std::span<const float> offsets = assembler_.trajectory_offsets();
+  const std::span<const float> past = assembler_.past_offsets();
+  const std::size_t velocity_joints = assembler_.velocity_joints().size();
   const std::size_t t = trajectory_size_;
   for_characters(pool, due_count_, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t i = begin; i < end; ++i) {
@@ -378,25 +435,55 @@ void CrowdController::assemble(ThreadPool& pool) {
       searched_yaw_[b] = desired_yaw_[b];
       searched_[b] = due_flag_[b];  // 1 regular, 2 forced
       due_refs_[i] = QueryFrame{root_pos_[b], root_yaw_[b]};
-      assembler_.assemble(frames_[b], due_refs_[i], positions, yaws,
-                          std::span(queries_).subspan(i * dims, dims));
+      const std::uint32_t nearest = nearest_frame(*database_, {frames_[b], fractions_[b]});
+      const std::span<float> query = std::span(queries_).subspan(i * dims, dims);
+      const std::span<glm::vec3> past_positions(past_pos_.data() + i * past.size(), past.size());
+      const std::span<float> past_yaws(past_yaw_.data() + i * past.size(), past.size());
+      for (std::size_t k = 0; k < past.size(); ++k) history_.at(b, past[k], past_positions[k], past_yaws[k]);
+      ShownPose pose;
+      pose.frame = nearest;
+      pose.joint_positions = std::span<const glm::vec3>(joint_positions_).subspan(std::size_t{b} * joints_, joints_);
+      pose.joint_velocities =
+          std::span<const glm::vec3>(joint_velocities_).subspan(b * velocity_joints, velocity_joints);
+      pose.yaw_rate = yaw_rate_[b];
+      pose.contacts = contacts_[b];
+      pose.past_positions = past_positions;
+      pose.past_yaws = past_yaws;
+      assembler_.assemble_shown(pose, due_refs_[i], positions, yaws, query);
       QueryParams& p = batch_params_[i];
       p = query_params_[b];
-      p.continuing_frame = frames_[b];
+      // A character held on a non-looping clip's last frame has nothing to
+      // play on: that frame gets no continuing bonus, else it wins the
+      // forced search it triggers and the character searches every tick.
+      p.continuing_frame = held_[b] != 0 ? kNoFrame : nearest;
       p.continuing_bias = params_.continuing_bias;
       p.continuing_multiplier = params_.continuing_multiplier;
       p.exclusion_window = params_.exclusion_window;
-      continuing_[i] = frames_[b];
+      continuing_[i] = nearest;
     }
   });
+}
+
+bool CrowdController::same_location(std::uint32_t b, std::uint32_t to) const {
+  const auto frame_clip = database_->frame_clip();
+  const std::uint32_t frame = frames_[b];
+  if (frame_clip[to] != frame_clip[frame]) return false;
+  const Clip& clip = database_->clips()[frame_clip[frame]];
+  // Frames from the character's time to the match, the shorter way round a loop.
+  float distance = float(to) - (float(frame) + fractions_[b]);
+  if (clip.loop) {
+    const auto length = float(clip.frame_count);
+    distance = std::remainder(distance, length);
+  }
+  return std::abs(distance) <= params_.same_location_window * database_->fps();
 }
 
 void CrowdController::jump(std::uint32_t b, std::uint32_t to, unsigned thread) {
   const Database& database = *database_;
   const AnimationData& animation = *animation_;
   JumpScratch& s = scratch_[thread];
-  const std::span<glm::quat> rotations(rotations_.data() + std::size_t{b} * joints_, joints_);
-  const std::span<glm::vec3> translations(translations_.data() + std::size_t{b} * joints_, joints_);
+  const std::span<glm::quat> rotations(anim_rotations_.data() + std::size_t{b} * joints_, joints_);
+  const std::span<glm::vec3> translations(anim_translations_.data() + std::size_t{b} * joints_, joints_);
   // Source: what the character shows now (played pose + offsets), moving at
   // the played velocities plus the offsets' own rates.
   pose_velocity(database, animation, frames_[b], s.source_angular, s.source_velocities);
@@ -411,7 +498,7 @@ void CrowdController::jump(std::uint32_t b, std::uint32_t to, unsigned thread) {
                                  played_velocity_[b] + root.velocity, played_yaw_rate_[b] + root.yaw_rate};
   sample_pose(animation, to, s.rotations, s.translations);
   pose_velocity(database, animation, to, s.angular, s.velocities);
-  const RootDelta to_root = root_velocity(database, animation, to);
+  const RootDelta to_root = root_velocity_at(database, to);
   Inertializer::PoseState destination{s.rotations, s.angular, s.translations, s.velocities, to_root.translation,
                                       to_root.yaw};
   inertializer_.transition(b, source, destination);
@@ -423,7 +510,8 @@ void CrowdController::jump(std::uint32_t b, std::uint32_t to, unsigned thread) {
   played_velocity_[b] = to_root.translation;
   played_yaw_rate_[b] = to_root.yaw;
   frames_[b] = to;
-  contacts_[b] = animation.contacts[to];
+  fractions_[b] = 0.0f;
+  held_[b] = 0;
   jumped_[b] = 1;
 }
 
@@ -436,14 +524,20 @@ void CrowdController::apply(std::span<const Match> matches, std::span<const std:
       const Match& m = matches[i];
       match_cost_[b] = m.cost;
       if (m.frame == kNoFrame || m.frame == continuing[i]) continue;
+      if (same_location(b, m.frame)) {
+        suppressed_[b] = 1;
+        continue;
+      }
       jump(b, m.frame, thread);
     }
   });
   last_.applied = static_cast<std::uint32_t>(characters.size());
   last_.jumps = 0;
+  last_.same_location = 0;
   last_.no_candidate = 0;
   for (std::size_t i = 0; i < characters.size(); ++i) {
     last_.jumps += jumped_[characters[i]];
+    last_.same_location += suppressed_[characters[i]];
     last_.no_candidate += matches[i].frame == kNoFrame ? 1 : 0;
   }
 }
@@ -456,6 +550,7 @@ void add_totals(TickStats& totals, const TickStats& tick) {
   totals.batches += tick.batches;
   totals.applied += tick.applied;
   totals.jumps += tick.jumps;
+  totals.same_location += tick.same_location;
   totals.no_candidate += tick.no_candidate;
 }
 
@@ -466,6 +561,7 @@ Status CrowdController::tick(float dt, const CrowdInput& input, SearchBackend& b
   if (&backend.database() != database_) return make_error("crowd controller: the backend searches another database");
   last_ = TickStats{};
   std::fill(jumped_.begin(), jumped_.end(), std::uint8_t{0});
+  std::fill(suppressed_.begin(), suppressed_.end(), std::uint8_t{0});
   begin(dt, input, pool);
   assemble(pool);
   const std::uint32_t dims = database_->dims();
@@ -492,6 +588,7 @@ Status CrowdController::tick(float dt, const CrowdInput& input, AsyncSearch& sea
   last_ = TickStats{};
   // The previous tick's results first, as if they had arrived at its end.
   std::fill(jumped_.begin(), jumped_.end(), std::uint8_t{0});
+  std::fill(suppressed_.begin(), suppressed_.end(), std::uint8_t{0});
   TickStats applied;
   if (pending_count_ > 0) {
     Status status = search.collect(std::span(matches_).first(pending_count_));
@@ -505,6 +602,7 @@ Status CrowdController::tick(float dt, const CrowdInput& input, AsyncSearch& sea
   begin(dt, input, pool);
   last_.applied = applied.applied;
   last_.jumps = applied.jumps;
+  last_.same_location = applied.same_location;
   last_.no_candidate = applied.no_candidate;
   assemble(pool);
   if (due_count_ > 0) {
@@ -524,8 +622,14 @@ Status CrowdController::tick(float dt, const CrowdInput& input, AsyncSearch& sea
   return {};
 }
 
-void CrowdController::world_positions(std::span<glm::vec3> out, ThreadPool& pool) const {
-  forward_kinematics_batch(animation_->skeleton, rotations_, translations_, root_pos_, root_yaw_, out, &pool);
+void CrowdController::world_positions(std::span<glm::vec3> out, ThreadPool&) const {
+  // Written by display() each tick (the locker computes them anyway).
+  std::copy(world_.begin(), world_.end(), out.begin());
+}
+
+void CrowdController::animated_world_positions(std::span<glm::vec3> out, ThreadPool& pool) const {
+  forward_kinematics_batch(animation_->skeleton, anim_rotations_, anim_translations_, root_pos_, root_yaw_, out,
+                           &pool);
 }
 
 }  // namespace mmvk

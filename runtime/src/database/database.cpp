@@ -87,6 +87,9 @@ Status validate_parts(const DatabaseParts& parts) {
       return make_error(where + ": cost multiplier must be finite and > 0");
     }
     if (!std::isfinite(clip.cost_bias)) return make_error(where + ": cost bias must be finite");
+    if (!(clip.metres_per_unit >= 0.0f) || !std::isfinite(clip.metres_per_unit)) {
+      return make_error(where + ": metres per unit must be finite and >= 0");
+    }
     if ((clip.tags & ~valid_tags) != 0) return make_error(where + " has tag bits beyond the tag names");
     next_frame += clip.frame_count;
   }

@@ -140,6 +140,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   options.source = source;
   options.custom = custom;
   options.contacts = settings.animation.contacts;  // foot_contact channels agree with the animation's contacts
+  if (settings.edge_rule == EdgeRule::Extrapolate) options.extrapolate_seconds = kExtrapolateSeconds;
   Result<RawFeatures> raw = extract_features(motion, *root, settings.schema, options);
   if (!raw.ok()) return raw.error();
   MMVK_TRY(check_plausible(*raw, settings.schema, motion.fps, source + ": clip '" + meta.name + "'"));
@@ -155,10 +156,17 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   out.tags = meta.tags;
   out.fps = motion.fps;
   out.flags.assign(motion.frame_count, 0);
-  if (settings.edge_rule == EdgeRule::Exclude) {
+  // Under Extrapolate, past_end marks only the phase windows that still clamp.
+  if (settings.edge_rule != EdgeRule::Clamp) {
     for (std::uint32_t f = 0; f < motion.frame_count; ++f) {
       if (raw->past_end[f]) out.flags[f] |= kFrameEdgeExcluded;
     }
+  }
+  // Extrapolate keeps the end's frames, but not the last few: a character
+  // sent there would reach the end (and search again) at once.
+  if (settings.edge_rule == EdgeRule::Extrapolate && !meta.loop) {
+    const std::uint32_t keep_out = std::min(offset_frames(kExtrapolateEndSeconds, motion.fps), motion.frame_count);
+    for (std::uint32_t f = motion.frame_count - keep_out; f < motion.frame_count; ++f) out.flags[f] |= kFrameEdgeExcluded;
   }
   flag_ranges(meta.do_not_use, motion.fps, kFrameDoNotUse, out.flags);
   flag_ranges(meta.block_transition, motion.fps, kFrameBlockTransition, out.flags);
@@ -175,6 +183,19 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
 }
 
 bool same_rate(float a, float b) { return std::abs(a - b) <= 1e-3f * std::max(a, b); }
+
+// Frames [first, first + count) of a motion and of its sidecar arrays.
+void keep_frames(Motion& motion, std::vector<std::vector<float>>& custom, std::uint32_t first, std::uint32_t count) {
+  const std::size_t joints = motion.joint_count();
+  auto keep = [&](auto& values, std::size_t per_frame) {
+    values.erase(values.begin() + std::ptrdiff_t((first + count) * per_frame), values.end());
+    values.erase(values.begin(), values.begin() + std::ptrdiff_t(first * per_frame));
+  };
+  keep(motion.local_positions, joints);
+  keep(motion.local_rotations, joints);
+  for (std::vector<float>& values : custom) keep(values, values.size() / motion.frame_count);
+  motion.frame_count = count;
+}
 
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
@@ -321,9 +342,25 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
     }
     motion = std::move(resampled);
   }
+  if (meta.range) {
+    // The part of the file the clip takes, at the build's rate.
+    const std::string field = (meta.field.empty() ? meta.file.string() + ": clip '" + meta.name + "'" : meta.field) +
+                              ".range";
+    Status inside = check_inside(*meta.range, motion->frame_count, motion->fps, field);
+    if (!inside.ok()) return fail(inside.message());
+    std::uint32_t first = motion->frame_count, end = 0;
+    for (std::uint32_t f = 0; f < motion->frame_count; ++f) {
+      if (in_range(f, motion->fps, *meta.range)) first = std::min(first, f), end = f + 1;
+    }
+    keep_frames(*motion, custom, first, end - first);
+  }
   const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation};
   Result<ProcessedClip> processed = process_motion(meta, *motion, custom, false, settings);
   if (!processed.ok()) return fail(processed.message());
+  // The units the import used, recorded so that `mmvk inspect` can show them.
+  const float units = manifest.import.metres_per_unit > 0.0f ? manifest.import.metres_per_unit
+                                                             : guess_metres_per_unit(*bvh);
+  processed->clip.metres_per_unit = units;
   out.clips.push_back(std::move(*processed));
   if (meta.mirror) {
     Result<Motion> mirrored = mirror(*motion, manifest.mirror_bones);
@@ -334,6 +371,7 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
     mirror_sidecars(manifest, custom);
     Result<ProcessedClip> processed_mirror = process_motion(meta, *mirrored, custom, true, settings);
     if (!processed_mirror.ok()) return fail(processed_mirror.message());
+    processed_mirror->clip.metres_per_unit = units;
     out.clips.push_back(std::move(*processed_mirror));
   }
   return out;

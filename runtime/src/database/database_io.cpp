@@ -253,7 +253,10 @@ std::string serialize_database(const Database& database) {
   // Version 3 only when the per-frame section is needed: a database without
   // time ranges stays a version 2 file that older builds read.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
-  file.u32(per_frame ? kDatabaseFormatVersion : 2u);
+  const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
+                                 [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
+  const std::uint32_t version = units ? 4u : per_frame ? 3u : 2u;
+  file.u32(version);
   file.u32(0);
   file.u64(0);
   file.str(schema_to_json(parts.schema));
@@ -280,13 +283,17 @@ std::string serialize_database(const Database& database) {
   file.u32(static_cast<std::uint32_t>(parts.frame_flags.size()));
   for (std::uint32_t flags : parts.frame_flags) file.u32(flags);
   file.f32_array(parts.features);
+  if (version >= 3) file.u8(per_frame ? 1 : 0);
   if (per_frame) {
-    file.u8(1);
     // The complete per-frame values (the Database's, which fill in the clip
     // values for whichever array the parts left empty).
     for (const TagMask tags : database.frame_tags()) file.u64(tags);
     file.f32_array(database.frame_multiplier());
     file.f32_array(database.frame_bias());
+  }
+  if (version >= 4) {
+    file.u8(1);
+    for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
@@ -409,6 +416,14 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
       in.f32_array(parts.frame_multiplier);
       parts.frame_bias.resize(frames);
       in.f32_array(parts.frame_bias);
+    }
+  }
+  if (version >= 4) {
+    std::uint8_t has_units = 0;
+    if (!in.u8(has_units) || has_units > 1) return corrupt("import units presence byte");
+    if (has_units) {
+      if (std::uint64_t{clips} * 4 + 1 > in.left()) return corrupt("import units of " + std::to_string(clips) + " clips");
+      for (Clip& clip : parts.clips) (void)in.f32(clip.metres_per_unit);
     }
   }
   if (version >= 2) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/json_parse.hpp"
+#include "common/name_table.hpp"
 #include "mmvk/file_io.hpp"
 
 namespace mmvk {
@@ -128,8 +129,8 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   }
   if (!object.is_object()) return make_error(where + ": expected an object (or a file name)");
   MMVK_TRY(check_fields(object, where,
-                        {"file", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias", "do_not_use",
-                         "block_transition", "tag_ranges", "cost_ranges"}));
+                        {"file", "range", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias",
+                         "do_not_use", "block_transition", "tag_ranges", "cost_ranges"}));
   ManifestClip clip;
   clip.field = where;
   if (!object.contains("file")) return make_error(where + ".file: missing");
@@ -138,6 +139,7 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (file.empty()) return make_error(where + ".file: empty");
   clip.file = base_dir / file;
   clip.name = clip.file.stem().string();
+  if (object.contains("range")) MMVK_READ(clip.range, read_range(object["range"], where + ".range"));
   if (object.contains("name")) MMVK_READ(clip.name, read_string(object["name"], where + ".name"));
   if (object.contains("tags")) {
     const Json& tags = object["tags"];
@@ -264,7 +266,29 @@ bool is_bvh(const std::filesystem::path& path) {
   return ext == ".bvh";
 }
 
+struct EdgeRuleEntry {
+  EdgeRule rule;
+  std::string_view name;
+};
+constexpr EdgeRuleEntry kEdgeRules[] = {
+    {EdgeRule::Exclude, "exclude"},
+    {EdgeRule::Clamp, "clamp"},
+    {EdgeRule::Extrapolate, "extrapolate"},
+};
+static_assert(detail::indexed_by(std::span<const EdgeRuleEntry>(kEdgeRules), &EdgeRuleEntry::rule));
+
 }  // namespace
+
+std::string_view edge_rule_name(EdgeRule rule) {
+  return detail::name_for(std::span<const EdgeRuleEntry>(kEdgeRules), &EdgeRuleEntry::name, rule);
+}
+
+Result<EdgeRule> parse_edge_rule(std::string_view name) {
+  const std::span<const EdgeRuleEntry> table(kEdgeRules);
+  if (const EdgeRuleEntry* entry = detail::find_named(table, &EdgeRuleEntry::name, name)) return entry->rule;
+  return make_error("expected " + detail::name_list(table, &EdgeRuleEntry::name, '"', true) + ", got \"" +
+                    std::string(name) + "\"");
+}
 
 Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_view source,
                                      const std::filesystem::path& base_dir) {
@@ -344,13 +368,9 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   if (root.contains("edge_rule")) {
     std::string rule;
     MMVK_READ(rule, read_string(root["edge_rule"], at + "edge_rule"));
-    if (rule == "exclude") {
-      manifest.edge_rule = EdgeRule::Exclude;
-    } else if (rule == "clamp") {
-      manifest.edge_rule = EdgeRule::Clamp;
-    } else {
-      return make_error(at + "edge_rule: expected \"exclude\" or \"clamp\", got \"" + rule + "\"");
-    }
+    Result<EdgeRule> parsed = parse_edge_rule(rule);
+    if (!parsed.ok()) return make_error(at + "edge_rule: " + parsed.message());
+    manifest.edge_rule = *parsed;
   }
   bool mirror_all = false;
   if (root.contains("mirror")) MMVK_READ(mirror_all, read_bool(root["mirror"], at + "mirror"));

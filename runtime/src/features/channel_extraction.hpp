@@ -26,13 +26,18 @@ inline glm::vec3 to_local(const glm::vec3& v, const glm::vec3& facing) {
   return {v.x * facing.z - v.z * facing.x, v.y, v.x * facing.x + v.z * facing.z};
 }
 
-// Past and future root poses, looping or clamped. For a looping clip the
-// frame after the last is the last advanced by the clip's final step; every
-// further cycle repeats the rigid motion from frame 0 to that frame, and
-// every cycle before frame 0 undoes it.
+// Past and future root poses, looping, clamped or extrapolated. For a
+// looping clip the frame after the last is the last advanced by the clip's
+// final step; every further cycle repeats the rigid motion from frame 0 to
+// that frame, and every cycle before frame 0 undoes it. A non-looping clip
+// clamps to its first and last frames, unless `extrapolate_frames` > 0: then
+// it goes on past its last frame at the constant speed and turning rate of
+// its last `extrapolate_frames` frames (cut to the clip), and before its
+// first frame at those of its first ones, so that a short take's last second
+// still says where the character was heading.
 class Trajectory {
  public:
-  Trajectory(const CharacterRoot& root, std::uint32_t frames, bool loop);
+  Trajectory(const CharacterRoot& root, std::uint32_t frames, bool loop, std::uint32_t extrapolate_frames = 0);
 
   // Root pose `j` frames from the start (j may run past either end).
   GroundPose at(std::int64_t j) const;
@@ -43,7 +48,12 @@ class Trajectory {
   const CharacterRoot& root_;
   std::uint32_t frames_;
   bool loop_;
+  bool extrapolate_ = false;
   GroundPose after_last_;
+  // Extrapolation: one frame's rigid step, relative to the pose it starts
+  // from, forward past the last frame and backward before the first.
+  GroundPose step_after_;
+  GroundPose step_before_;
 };
 
 // One clip, measured once for all of its channels.

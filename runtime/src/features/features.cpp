@@ -90,11 +90,11 @@ std::uint32_t max_offset_frames(const FeatureSchema& schema, float fps) {
   return result;
 }
 
-EdgeReach edge_reach(const FeatureSchema& schema, float fps) {
+EdgeReach edge_reach(const FeatureSchema& schema, float fps, bool trajectory) {
   EdgeReach reach;
   for (const FeatureChannel& channel : schema.channels) {
     const ChannelField fields = channel_kind_info(channel.kind).fields;
-    if (has_field(fields, ChannelField::Offsets)) {
+    if (trajectory && has_field(fields, ChannelField::Offsets)) {
       for (float t : channel.offsets_seconds) {
         std::uint32_t& side = t < 0.0f ? reach.before : reach.after;
         side = std::max(side, offset_frames(std::abs(t), fps));
@@ -188,7 +188,9 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
 
   // Global positions of every joint, [frames x joints], shared by the channels.
   const std::size_t joints = motion.joint_count();
-  detail::ClipSamples clip{motion, root, detail::Trajectory(root, frames, options.loop),
+  const bool extrapolate = options.extrapolate_seconds > 0.0f && !options.loop;
+  const std::uint32_t extrapolate_frames = extrapolate ? window_frames(options.extrapolate_seconds, motion.fps) : 0;
+  detail::ClipSamples clip{motion, root, detail::Trajectory(root, frames, options.loop, extrapolate_frames),
                            std::vector<glm::vec3>(std::size_t{frames} * joints), options.loop, {}};
   {
     std::vector<glm::vec3> positions(joints);
@@ -216,8 +218,9 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
   out.dims = dims;
   out.values.assign(std::size_t{frames} * dims, 0.0f);
   out.past_end.assign(frames, 0);
-  const EdgeReach reach = edge_reach(schema, motion.fps);
-  const std::string past_owner = past_reach_owner(schema, motion.fps);
+  const EdgeReach reach = edge_reach(schema, motion.fps, !extrapolate);
+  // Extrapolated past offsets leave every frame usable: no reach to check.
+  const std::string past_owner = extrapolate ? std::string() : past_reach_owner(schema, motion.fps);
   if (!options.loop && !past_owner.empty() && std::uint64_t{reach.before} + reach.after >= frames) {
     return make_error(source + ": " + past_owner + " reaches " +
                       std::to_string(reach.before) + " frames back and the schema " + std::to_string(reach.after) +

@@ -1,0 +1,417 @@
+// Foot locking (foot_locker.hpp): per foot a horizontal and a yaw correction
+// that hold a planted contact point on its anchor and decay after release;
+// the hips lowered for out-of-reach targets; two-bone IK on the result.
+#include "mmvk/foot_locker.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "mmvk/character.hpp"
+#include "mmvk/foot_ik.hpp"
+#include "mmvk/spring.hpp"
+
+namespace mmvk {
+
+namespace {
+
+const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
+const glm::quat kIdentity(1.0f, 0.0f, 0.0f, 0.0f);
+
+// A released correction smaller and slower than this (metres or radians, and
+// per second) is set to zero: the leg is then left exactly as animated, and
+// is not solved at all.
+constexpr float kSettled = 1e-5f;
+constexpr float kSettledRate = 1e-4f;
+// A unit foot heading shorter than this horizontally (within 14 degrees of
+// vertical) has no reliable yaw: the yaw correction is held meanwhile, and
+// the lock's heading taken afresh when the foot levels again.
+constexpr float kVerticalHeading = 0.25f;
+
+// Marks a lock whose foot heading is (or was last) vertical: its anchor yaw
+// is set on the next tick with a heading, so the yaw correction carries on.
+constexpr float kNoYaw = std::numeric_limits<float>::quiet_NaN();
+
+constexpr std::uint8_t kPlantedBit[2] = {kContactLeft, kContactRight};
+constexpr std::uint8_t kHeelBit[2] = {kContactLeftHeel, kContactRightHeel};
+constexpr std::uint8_t kToeBit[2] = {kContactLeftToe, kContactRightToe};
+// Contact points: the heel (the ankle joint) or the toe joint.
+constexpr std::uint8_t kHeel = 0;
+constexpr std::uint8_t kToe = 1;
+
+glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
+
+glm::vec3 horizontal(const glm::vec3& v) { return {v.x, 0.0f, v.z}; }
+
+// True when `ancestor` is a strict ancestor of `joint`.
+bool descends(const std::vector<int>& parents, int ancestor, int joint) {
+  for (int j = parents[static_cast<std::size_t>(joint)]; j >= 0; j = parents[static_cast<std::size_t>(j)]) {
+    if (j == ancestor) return true;
+  }
+  return false;
+}
+
+// The yaw of a world direction (radians, 0 along +Z), false when it is
+// (nearly) vertical.
+bool heading_yaw(const glm::vec3& direction, float& yaw) {
+  if (direction.x * direction.x + direction.z * direction.z < kVerticalHeading * kVerticalHeading) return false;
+  yaw = std::atan2(direction.x, direction.z);
+  return true;
+}
+
+// The foot's forward direction in its own frame: toward its toe where the toe
+// is its child, else the direction that faces the character's forward (+Z)
+// on the first frame, else +Z.
+glm::vec3 foot_heading(const AnimationData& animation, const FootLocker::Leg& leg) {
+  const Skeleton& skeleton = animation.skeleton;
+  if (leg.toe >= 0 && skeleton.parents[static_cast<std::size_t>(leg.toe)] == leg.foot) {
+    const glm::vec3 offset = skeleton.rest_offsets[static_cast<std::size_t>(leg.toe)];
+    if (glm::length(offset) > 1e-4f) return glm::normalize(offset);
+  }
+  if (animation.frame_count == 0 || animation.local_rotations.size() < animation.joint_count()) {
+    return glm::vec3(0.0f, 0.0f, 1.0f);
+  }
+  glm::quat global = kIdentity;
+  for (int j = leg.foot; j >= 0; j = skeleton.parents[static_cast<std::size_t>(j)]) {
+    global = animation.local_rotations[static_cast<std::size_t>(j)] * global;
+  }
+  return glm::normalize(glm::inverse(global) * glm::vec3(0.0f, 0.0f, 1.0f));
+}
+
+}  // namespace
+
+Status FootIkParams::validate() const {
+  auto fail = [](const char* field, const char* rule, float value) {
+    return Status(make_error(std::string("foot IK: ") + field + " must be " + rule + ", got " + std::to_string(value)));
+  };
+  if (!(std::isfinite(soft_reach_start) && soft_reach_start > 0.0f && soft_reach_start <= 1.0f)) {
+    return fail("soft_reach_start", "in (0, 1]", soft_reach_start);
+  }
+  const struct {
+    const char* name;
+    float value;
+  } positive[] = {{"unlock_distance", unlock_distance},
+                  {"max_yaw_correction", max_yaw_correction},
+                  {"release_half_life", release_half_life},
+                  {"hip_half_life", hip_half_life}};
+  for (const auto& check : positive) {
+    if (!(std::isfinite(check.value) && check.value > 0.0f)) return fail(check.name, "finite and > 0", check.value);
+  }
+  if (!(std::isfinite(max_hip_drop) && max_hip_drop >= 0.0f)) return fail("max_hip_drop", "finite and >= 0", max_hip_drop);
+  if (!std::isfinite(floor_height)) return fail("floor_height", "finite", floor_height);
+  return {};
+}
+
+Result<FootLocker> FootLocker::create(const AnimationData& animation, std::uint32_t characters,
+                                      const FootIkParams& params) {
+  if (characters == 0) return make_error("foot IK: characters must be at least 1");
+  MMVK_TRY(params.validate());
+  const Skeleton& skeleton = animation.skeleton;
+  auto resolve = [&](const char* role, int& joint) -> Status {
+    Result<int> found = find_bone(skeleton, role);
+    if (!found.ok()) return make_error(std::string("foot IK: ") + found.message());
+    joint = *found;
+    return {};
+  };
+  // Joint `below` must hang under joint `above` (the roles name them).
+  auto under = [&](const char* above_role, int above, const char* below_role, int below) -> Status {
+    if (descends(skeleton.parents, above, below)) return {};
+    return make_error(std::string("foot IK: ") + below_role + " (" + skeleton.names[static_cast<std::size_t>(below)] +
+                      ") is not below " + above_role + " (" + skeleton.names[static_cast<std::size_t>(above)] +
+                      ") in the skeleton");
+  };
+  static constexpr const char* kRoles[2][4] = {{"@left_upper_leg", "@left_lower_leg", "@left_foot", "@left_toe"},
+                                               {"@right_upper_leg", "@right_lower_leg", "@right_foot", "@right_toe"}};
+  FootLocker locker;
+  MMVK_TRY(resolve("@hips", locker.hips_));
+  for (std::size_t side = 0; side < 2; ++side) {
+    Leg& leg = locker.legs_[side];
+    const char* const* roles = kRoles[side];
+    MMVK_TRY(resolve(roles[0], leg.upper));
+    MMVK_TRY(resolve(roles[1], leg.lower));
+    MMVK_TRY(resolve(roles[2], leg.foot));
+    // The toe is optional (DAZ skeletons have none): the ankle is then the
+    // only contact point.
+    Result<int> toe = find_bone(skeleton, roles[3]);
+    leg.toe = toe.ok() ? *toe : -1;
+    MMVK_TRY(under("@hips", locker.hips_, roles[0], leg.upper));
+    MMVK_TRY(under(roles[0], leg.upper, roles[1], leg.lower));
+    MMVK_TRY(under(roles[1], leg.lower, roles[2], leg.foot));
+    if (leg.toe >= 0) MMVK_TRY(under(roles[2], leg.foot, roles[3], leg.toe));
+    locker.heading_[side] = foot_heading(animation, leg);
+  }
+  if (locker.legs_[0].upper == locker.legs_[1].upper || descends(skeleton.parents, locker.legs_[0].upper, locker.legs_[1].upper) ||
+      descends(skeleton.parents, locker.legs_[1].upper, locker.legs_[0].upper)) {
+    return make_error("foot IK: @left_upper_leg and @right_upper_leg must be separate branches of the skeleton");
+  }
+
+  const std::size_t joints = skeleton.size();
+  locker.characters_ = characters;
+  locker.params_ = params;
+  locker.parents_ = skeleton.parents;
+  locker.below_hips_.assign(joints, 0);
+  for (std::size_t j = 0; j < joints; ++j) {
+    const int joint = static_cast<int>(j);
+    locker.below_hips_[j] = joint == locker.hips_ || descends(skeleton.parents, locker.hips_, joint);
+    for (std::size_t side = 0; side < 2; ++side) {
+      const int upper = locker.legs_[side].upper;
+      if (joint == upper || descends(skeleton.parents, upper, joint)) locker.leg_joints_[side].push_back(joint);
+    }
+  }
+  if (joints > kStackJoints) locker.wide_scratch_.resize(std::size_t{characters} * joints);
+  const std::size_t feet = std::size_t{characters} * 2;
+  locker.locked_.assign(feet, 0);
+  locker.clamped_.assign(feet, 0);
+  locker.point_.assign(feet, kHeel);
+  locker.drifted_.assign(feet, 0);
+  locker.anchor_.assign(feet, glm::vec3(0.0f));
+  locker.offset_.assign(feet, glm::vec3(0.0f));
+  locker.offset_rate_.assign(feet, glm::vec3(0.0f));
+  locker.anchor_yaw_.assign(feet, 0.0f);
+  locker.yaw_offset_.assign(feet, 0.0f);
+  locker.yaw_rate_.assign(feet, 0.0f);
+  locker.hip_drop_.assign(characters, 0.0f);
+  locker.hip_drop_rate_.assign(characters, 0.0f);
+  return locker;
+}
+
+Status FootLocker::set_params(const FootIkParams& params) {
+  MMVK_TRY(params.validate());
+  params_ = params;
+  return {};
+}
+
+void FootLocker::clear(std::uint32_t b) {
+  for (std::size_t f = std::size_t{b} * 2; f < std::size_t{b} * 2 + 2; ++f) {
+    locked_[f] = clamped_[f] = drifted_[f] = 0;
+    point_[f] = kHeel;
+    anchor_[f] = offset_[f] = offset_rate_[f] = glm::vec3(0.0f);
+    anchor_yaw_[f] = yaw_offset_[f] = yaw_rate_[f] = 0.0f;
+  }
+  hip_drop_[b] = hip_drop_rate_[b] = 0.0f;
+}
+
+void FootLocker::reset(std::uint32_t b) {
+  assert(b < characters_);
+  clear(b);
+}
+
+void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const glm::vec3& root_position,
+                        float root_yaw, std::span<glm::quat> local_rotations,
+                        std::span<glm::vec3> local_translations, std::span<glm::vec3> world_positions) {
+  const std::size_t joints = parents_.size();
+  assert(b < characters_ && local_rotations.size() >= joints && local_translations.size() >= joints &&
+         world_positions.size() >= joints && dt >= 0.0f);
+  glm::quat stack[kStackJoints];
+  glm::quat* global = joints <= kStackJoints ? stack : wide_scratch_.data() + std::size_t{b} * joints;
+  glm::quat* rotations = local_rotations.data();
+  glm::vec3* translations = local_translations.data();
+  glm::vec3* world = world_positions.data();
+
+  // The animated pose in the world (world = root + R_y(yaw) * fk(pose)),
+  // with global rotations kept for the legs.
+  const glm::quat root = yaw_rotation(root_yaw);
+  for (std::size_t j = 0; j < joints; ++j) {
+    const int parent = parents_[j];
+    if (parent < 0) {
+      global[j] = root * rotations[j];
+      world[j] = root_position + root * translations[j];
+    } else {
+      const std::size_t p = static_cast<std::size_t>(parent);
+      world[j] = world[p] + global[p] * translations[j];
+      global[j] = global[p] * rotations[j];
+    }
+  }
+  if (!params_.enabled) {
+    clear(b);
+    return;
+  }
+
+  // Per foot: the lock's state machine, then its ankle target and rotation.
+  struct Target {
+    glm::vec3 ankle;
+    glm::quat rotation;
+    bool solve;
+  };
+  Target targets[2];
+  float wanted_drop = 0.0f;
+  for (std::size_t side = 0; side < 2; ++side) {
+    const Leg& leg = legs_[side];
+    const std::size_t f = std::size_t{b} * 2 + side;
+    const glm::vec3 ankle = world[leg.foot];
+    const glm::vec3 toe = leg.toe >= 0 ? world[leg.toe] : ankle;
+    const bool planted = (contacts & kPlantedBit[side]) != 0;
+    const bool toe_touches = (contacts & kToeBit[side]) != 0;
+    const bool heel_touches = (contacts & kHeelBit[side]) != 0;
+    // Data without point bits (older files) counts as planted on the toe.
+    const std::uint8_t point = leg.toe >= 0 && (toe_touches || !heel_touches) ? kToe : kHeel;
+    // The foot's heading, only where a lock reads it.
+    float yaw = 0.0f;
+    const bool has_yaw = params_.lock_yaw && (planted || locked_[f] != 0) &&
+                         heading_yaw(global[leg.foot] * heading_[side], yaw);
+
+    glm::vec3& offset = offset_[f];
+    glm::vec3& offset_rate = offset_rate_[f];
+    float& yaw_offset = yaw_offset_[f];
+    float& yaw_rate = yaw_rate_[f];
+    auto at = [&](std::uint8_t contact_point) { return contact_point == kToe ? toe : ankle; };
+    // A new contact point keeps the displayed foot where it is: the offset
+    // takes up the turn of the new point about the old one.
+    auto move_point = [&](std::uint8_t to) {
+      if (to == point_[f]) return false;
+      const glm::vec3 step = at(to) - at(point_[f]);
+      offset += horizontal(yaw_rotation(yaw_offset) * step - step);
+      point_[f] = to;
+      return true;
+    };
+
+    if (!planted) drifted_[f] = 0;
+    if (locked_[f] != 0) {
+      if (!planted) {
+        locked_[f] = 0;
+      } else {
+        // Heel to toe (or back): the anchor moves to the new point as shown.
+        if (move_point(point)) anchor_[f] = at(point_[f]) + offset;
+        if (!has_yaw) {
+          anchor_yaw_[f] = kNoYaw;
+        } else if (std::isnan(anchor_yaw_[f])) {
+          anchor_yaw_[f] = yaw + yaw_offset;
+        }
+        const glm::vec3 next = horizontal(anchor_[f] - at(point_[f]));
+        float next_yaw = has_yaw ? wrap_angle(anchor_yaw_[f] - yaw) : yaw_offset;
+        if (std::abs(next_yaw) > params_.max_yaw_correction) {
+          // The animated foot turned further than the lock holds: it pivots
+          // about its contact point from here, the position still held.
+          next_yaw = std::clamp(next_yaw, -params_.max_yaw_correction, params_.max_yaw_correction);
+          anchor_yaw_[f] = yaw + next_yaw;
+        }
+        if (glm::length(next) > params_.unlock_distance) {
+          locked_[f] = 0;
+          drifted_[f] = 1;
+        } else {
+          if (dt > 0.0f) {
+            offset_rate = (next - offset) / dt;
+            yaw_rate = wrap_angle(next_yaw - yaw_offset) / dt;
+          }
+          offset = next;
+          yaw_offset = next_yaw;
+        }
+      }
+    }
+    if (locked_[f] == 0) {
+      if (planted && drifted_[f] == 0) {
+        // Lock where the foot is shown now: the offset carries on, so does
+        // the display.
+        move_point(point);
+        locked_[f] = 1;
+        anchor_[f] = at(point_[f]) + offset;
+        anchor_yaw_[f] = has_yaw ? yaw + yaw_offset : kNoYaw;
+      } else if (dt > 0.0f) {
+        spring_decay(offset, offset_rate, params_.release_half_life, dt);
+        spring_decay(yaw_offset, yaw_rate, params_.release_half_life, dt);
+        if (glm::length(offset) < kSettled && glm::length(offset_rate) < kSettledRate) {
+          offset = offset_rate = glm::vec3(0.0f);
+        }
+        if (std::abs(yaw_offset) < kSettled && std::abs(yaw_rate) < kSettledRate) yaw_offset = yaw_rate = 0.0f;
+      }
+    }
+
+    // The ankle's target: the animated foot turned by the yaw offset about
+    // its contact point and moved by the offset, at its animated height.
+    Target& target = targets[side];
+    target.ankle = ankle;
+    target.rotation = global[leg.foot];
+    target.solve = false;
+    if (offset != glm::vec3(0.0f) || yaw_offset != 0.0f) {
+      const glm::vec3 contact = at(point_[f]);
+      const glm::quat turn = yaw_rotation(yaw_offset);
+      target.ankle = contact + offset + turn * (ankle - contact);
+      target.rotation = turn * global[leg.foot];
+      target.solve = true;
+    }
+    if (params_.clamp_to_floor) {
+      // The turn is about +Y, so the toe stays at its animated height above the ankle.
+      const float floor = root_position.y + params_.floor_height;
+      const float lowest = std::min(target.ankle.y, target.ankle.y + (toe.y - ankle.y));
+      if (lowest < floor) {
+        target.ankle.y += floor - lowest;
+        target.solve = true;
+      }
+    }
+
+    // The least drop of the hips that brings the target within the leg's
+    // comfortable reach (the solver's soft start): |target - (hip - drop * up)|
+    // = reach, the smaller root; the drop to the target's height when the
+    // target is horizontally further than the reach. An animated target
+    // needs none: the animated extension is within reach by definition.
+    if (!target.solve) continue;
+    const glm::vec3 hip = world[leg.upper];
+    const float length = glm::length(world[leg.lower] - hip) + glm::length(ankle - world[leg.lower]);
+    const float reach = std::min(length, std::max(params_.soft_reach_start * length, glm::length(ankle - hip)));
+    const glm::vec3 to_target = target.ankle - hip;
+    const float across2 = to_target.x * to_target.x + to_target.z * to_target.z;
+    if (across2 + to_target.y * to_target.y > reach * reach) {
+      const float drop = across2 < reach * reach ? -to_target.y - std::sqrt(reach * reach - across2) : -to_target.y;
+      wanted_drop = std::max(wanted_drop, drop);
+    }
+  }
+
+  // The hips follow the wanted drop with a critically damped spring.
+  float& drop = hip_drop_[b];
+  float& drop_rate = hip_drop_rate_[b];
+  const float goal = std::min(wanted_drop, params_.max_hip_drop);
+  if (dt > 0.0f) {
+    float gap = drop - goal;
+    spring_decay(gap, drop_rate, params_.hip_half_life, dt);
+    drop = std::clamp(goal + gap, 0.0f, params_.max_hip_drop);
+    if (goal == 0.0f && drop < kSettled && std::abs(drop_rate) < kSettledRate) drop = drop_rate = 0.0f;
+  }
+  if (drop > 0.0f) {
+    const int parent = parents_[static_cast<std::size_t>(hips_)];
+    const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
+    translations[static_cast<std::size_t>(hips_)] -= glm::inverse(above) * (kUp * drop);
+    for (std::size_t j = 0; j < joints; ++j) {
+      if (below_hips_[j] != 0) world[j].y -= drop;
+    }
+  }
+
+  // Two-bone IK on each leg that has a correction (both when the hips are
+  // lowered: the other foot must stay where it was animated), then the leg's
+  // joints again from the upper leg down.
+  const glm::vec3 forward = root * glm::vec3(0.0f, 0.0f, 1.0f);
+  for (std::size_t side = 0; side < 2; ++side) {
+    const std::size_t f = std::size_t{b} * 2 + side;
+    clamped_[f] = 0;
+    const Target& target = targets[side];
+    if (!target.solve && drop <= 0.0f) continue;
+    const Leg& leg = legs_[side];
+    const TwoBoneIkSolution solution = solve_two_bone_ik(world[leg.upper], world[leg.lower], world[leg.foot],
+                                                         target.ankle, forward, params_.soft_reach_start);
+    clamped_[f] = solution.clamped ? 1 : 0;
+    for (const int joint : leg_joints_[side]) {
+      const std::size_t j = static_cast<std::size_t>(joint);
+      const int parent = parents_[j];
+      const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
+      if (joint == leg.upper) {
+        global[j] = solution.upper * global[j];
+      } else {
+        world[j] = world[static_cast<std::size_t>(parent)] + above * translations[j];
+        if (joint == leg.lower) {
+          global[j] = solution.lower * (above * rotations[j]);
+        } else if (joint == leg.foot) {
+          global[j] = target.rotation;
+        } else {
+          global[j] = above * rotations[j];
+          continue;
+        }
+      }
+      rotations[j] = glm::normalize(glm::inverse(above) * global[j]);
+    }
+  }
+}
+
+}  // namespace mmvk

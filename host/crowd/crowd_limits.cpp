@@ -89,9 +89,12 @@ std::uint64_t tick_count(const CrowdOptions& options) {
 }
 
 // Measured against the peak resident size (/usr/bin/time) on the shipped
-// CMU walks (5,752 frames, fast-box): 100,000 agents for 2 s used 400 MiB
-// (estimate 515), 776 MiB with --html (estimate 1,045); 20,000 agents for
-// 20 s with --html 781 MiB (estimate 1,083). Over, never under.
+// CMU walks (5,752 frames, 31 joints, fast-box, foot IK on): 100,000
+// agents for 2 s used 726 MiB (estimate 863), 1,543 MiB with --html
+// (estimate 2,257); 20,000 agents for 20 s 159 MiB (estimate 227) and
+// 1,614 MiB with --html (estimate 2,831); 1,000 agents for 2 s 23 MiB
+// (estimate 76). Over, never under; the per-joint term is the one to
+// revisit when the controller keeps more per joint.
 std::uint64_t estimate_crowd_bytes(const CrowdOptions& options, const Database& database, std::uint64_t agents,
                                    std::uint64_t goals) {
   const std::uint64_t joints = database.animation() ? database.animation()->joint_count() : 1;
@@ -100,33 +103,43 @@ std::uint64_t estimate_crowd_bytes(const CrowdOptions& options, const Database& 
   const std::uint64_t params = sizeof(QueryParams);
   const std::uint64_t ticks = tick_count(options);
   // The controller: its per-character state, two copies of the query
-  // parameters, the predicted trajectory, the pose (rotation + translation)
-  // and the inertializer's offsets and velocities per joint, the batch.
+  // parameters, the predicted trajectory, the batch, and per joint the
+  // animated and displayed poses, their world positions, the inertializer's
+  // offsets and velocities, the interpolation and foot locking (measured:
+  // about 170 bytes per joint in all).
   const std::uint64_t controller = 200 + sizeof(SimulationState) + sizeof(QueryFrame) + 2 * params + points * 16 +
-                                   joints * (28 + 56) + dims * 4;
+                                   joints * 180 + dims * 4;
   // crowd_run's per-tick arrays, world positions per joint, steering, the
   // scenario's plan and the quality meter's 1 s ring.
   const std::uint64_t host = 160 + joints * 12 + 40 + 160 + std::uint64_t(std::llround(options.rate_hz)) * 8;
   // The search: each slot's queries, parameters and results (two slots on
   // Vulkan, where the host also stages them).
   const std::uint64_t search = 3 * (dims * 4 + params + 16);
-  std::uint64_t bytes = agents * (controller + host + search) + goals * 8 * 3 + ticks * 16;
+  // 64 MiB for the process itself: code, libraries, thread stacks, allocator slack.
+  std::uint64_t bytes = (std::uint64_t{64} << 20) + agents * (controller + host + search) + goals * 8 * 3 + ticks * 16;
   // The database as loaded (features, per-frame arrays, animation) and the
   // backend's copy or upload of the features.
   const std::uint64_t frames = database.frame_count();
   bytes += frames * (dims * 4 * 2 + 32 + joints * 16 + 24);
   if (options.html) {
     // The recording: every sample of every character (root, facing, frame,
-    // desired and matched trajectories), each search as an event, the poses
-    // of the frames played; encoding the page holds the recording, its raw
-    // and deflated payload, the base64 text and the page, at most about
-    // three recordings' worth at once (measured below).
+    // desired and matched trajectories, up to 6 displayed leg joints), each
+    // search and foot change as an event, the poses of the frames played;
+    // encoding the page holds the recording, its raw and deflated payload,
+    // the base64 text and the page, at most about four recordings' worth at
+    // once (measured above).
     const std::uint64_t per_sample = std::max<std::uint64_t>(1, std::uint64_t(std::llround(options.rate_hz / 10.0)));
     const std::uint64_t samples = ticks / per_sample + 1;
     const auto searches = std::uint64_t(std::ceil(options.seconds / options.search_interval_s)) + 2;
+    const auto steps = std::uint64_t(std::ceil(options.seconds * 8.0)) + 2;
     const std::uint64_t recording =
-        agents * (samples * (16 + points * 16) + searches * sizeof(SearchEvent) + 48) + frames * joints * 12;
-    bytes += recording * 3;
+        agents * (samples * (16 + points * 16 + 6 * 12) + searches * sizeof(SearchEvent) + steps * 16 + 48) +
+        frames * joints * 12;
+    bytes += recording * 4;
+  }
+  if (options.trace) {
+    // --trace: the traced characters' world joints and contact bits per tick.
+    bytes += ticks * std::min<std::uint64_t>(options.trace_agents, agents) * (joints * 12 + 2);
   }
   return bytes;
 }

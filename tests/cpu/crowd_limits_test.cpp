@@ -57,13 +57,17 @@ TEST(CrowdLimits, TheMemoryEstimateGrowsWithWhatTheRunKeeps) {
   const CrowdOptions plain = with(10.0, 30.0, 0.1);
   CrowdOptions page = plain;
   page.html = "page.html";
+  // Linear in the agents above the process's fixed share.
   const std::uint64_t small = estimate_crowd_bytes(plain, db, 1000, 8000);
+  const std::uint64_t twice = estimate_crowd_bytes(plain, db, 2000, 16000);
   const std::uint64_t large = estimate_crowd_bytes(plain, db, 100000, 800000);
-  EXPECT_GT(large, 50 * small);
-  EXPECT_GT(estimate_crowd_bytes(page, db, 1000, 8000), small);
+  EXPECT_GT(large - small, 90 * (twice - small));
+  // A page keeps every sample: it grows with the seconds, a run without one does not.
+  const std::uint64_t with_page = estimate_crowd_bytes(page, db, 1000, 8000);
+  EXPECT_GT(with_page, small);
   CrowdOptions long_page = page;
   long_page.seconds = 100.0;
-  EXPECT_GT(estimate_crowd_bytes(long_page, db, 1000, 8000), 5 * estimate_crowd_bytes(page, db, 1000, 8000));
+  EXPECT_GT(estimate_crowd_bytes(long_page, db, 1000, 8000) - small, 5 * (with_page - small));
   // The documented maximum with a page of an hour: far beyond any machine.
   long_page.seconds = 3600.0;
   EXPECT_GT(estimate_crowd_bytes(long_page, db, kMaxAgents, 8ull * kMaxAgents), std::uint64_t{1} << 44);

@@ -112,8 +112,11 @@ Status export_animation(const Database& database, const std::string& source, con
     out["clips"].push_back({{"name", clip.name}, {"first_frame", clip.first_frame}, {"frame_count", clip.frame_count},
                             {"loop", clip.loop}, {"mirrored", clip.mirrored}});
   }
+  // The sidecar's text exists before any file is written; names with
+  // invalid UTF-8 are replaced (U+FFFD), never thrown.
+  const std::string sidecar_text = out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   MMVK_TRY(write_file_atomically(values, bytes));
-  return write_file_atomically(sidecar, out.dump(1) + "\n");
+  return write_file_atomically(sidecar, sidecar_text);
 }
 
 }  // namespace mmvk::cli

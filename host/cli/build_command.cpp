@@ -97,6 +97,17 @@ int run_build(Args args) {
   if (parsed->has("--mirror")) {
     for (ManifestClip& clip : manifest->clips) clip.mirror = true;
   }
+  {
+    // Before the build: the output must not be the manifest, the schema or
+    // a file the build reads.
+    std::error_code ec;
+    const bool folder = std::filesystem::is_directory(parsed->positional[0], ec);
+    std::vector<NamedPath> paths = {{"-o", *output, true},
+                                    {folder ? "the BVH folder" : "the manifest", parsed->positional[0], false}};
+    if (auto schema_path = parsed->value("--schema")) paths.push_back({"--schema", *schema_path, false});
+    for (const std::filesystem::path& file : manifest_input_files(*manifest)) paths.push_back({"the input", file, false});
+    if (Status checked = check_command_paths(paths); !checked) return report_error("build", checked.message(), 1);
+  }
   unsigned threads = 0;
   if (auto text = parsed->value("--threads")) {
     const Result<std::uint32_t> value = parse_u32("--threads", *text, 0, ThreadPool::kMaxThreads);

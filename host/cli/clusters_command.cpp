@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "mmvk/thread_pool.hpp"
 
 namespace mmvk::cli {
@@ -92,6 +93,8 @@ int run_clusters(Args args) {
     params.seed = *seed;
   }
 
+  const NamedPath paths[] = {{"the database", parsed->positional[0], false}, {"-o", *output, true}};
+  if (Status checked = check_command_paths(paths); !checked) return report_error("clusters", checked.message(), 1);
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db) return report_error("clusters", db.message(), 1);
   Result<std::unique_ptr<ThreadPool>> pool_made = ThreadPool::create(threads);

@@ -33,11 +33,11 @@ constexpr const char* kCrowdUsage =
     "  --data NAME|PATH      the motion: a shipped set by name (below), an .mmdb (built with\n"
     "                        animation), a manifest or a folder of BVH (built once and cached\n"
     "                        in $XDG_CACHE_HOME/mmvk or ~/.cache/mmvk). Default: cmu-walks\n"
-    "  --agents N            characters (default 1000; with --scenario, its count)\n"
-    "  --seconds S           simulated time (default 10)\n"
-    "  --rate HZ             simulation ticks per second (default 30; any rate: poses are\n"
+    "  --agents N            characters (default 1000, at most 10,000,000; with --scenario, its count)\n"
+    "  --seconds S           simulated time (default 10; 1 to 10,000,000 ticks)\n"
+    "  --rate HZ             simulation ticks per second (default 30; 1 to 1000: poses are\n"
     "                        interpolated between database frames)\n"
-    "  --search-interval S   seconds between a character's regular searches (default 0.1)\n"
+    "  --search-interval S   seconds between a character's regular searches (default 0.1; 0.001 to 3600)\n"
     "  --backend NAME        the search backend (default vulkan-brute, on the best device)\n"
     "  --device N            the Vulkan device index (default: the best one)\n"
     "  --seed N              the random scenario's seed (default 1)\n"
@@ -57,7 +57,12 @@ constexpr const char* kCrowdUsage =
     "                        joint, [ticks x agents x joints], and FILE.json beside it\n"
     "                        (joint names, parents, tick rate, contacts, foot locks);\n"
     "                        held in memory until the run ends, at most 512 MiB\n"
-    "  --trace-agents M      characters in the trace (default 1)\n";
+    "  --trace-agents M      characters in the trace (default 1)\n"
+    "\n"
+    "Inputs are regular files (a FIFO or device is refused); outputs are checked\n"
+    "before the run, may be a FIFO or device (written in place) but never an input,\n"
+    "and a run that would need more memory than this machine allows is refused\n"
+    "with its estimate (docs/files-and-limits.md).\n";
 
 // One entry per shipped set, its description wrapped under the usage's
 // option descriptions (column 22, at most 88 wide).

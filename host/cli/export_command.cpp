@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/hash.hpp"
 
 namespace mmvk::cli {
 
@@ -27,7 +28,10 @@ constexpr const char* kExportUsage =
     "\n"
     "--animation anim.f32 writes the animation section the same way (float32\n"
     "[frames x columns] and anim.f32.json naming the columns, the skeleton and\n"
-    "the clips); either --features or --animation may be given alone.\n";
+    "the clips); either --features or --animation may be given alone.\n"
+    "\n"
+    "A device or FIFO output (--features /dev/stdout) is written in place; its\n"
+    "sidecar must then be named with --sidecar (--animation needs a file).\n";
 
 nlohmann::json sidecar(const Database& db, const std::string& source, const std::string& features_path) {
   const FeatureSchema& schema = db.schema();
@@ -38,7 +42,7 @@ nlohmann::json sidecar(const Database& db, const std::string& source, const std:
   out["frames"] = db.frame_count();
   out["dims"] = db.dims();
   out["fps"] = db.fps();
-  out["content_hash"] = db.content_hash();
+  out["content_hash"] = hash_hex(db.content_hash());
   out["channels"] = nlohmann::json::array();
   std::vector<std::uint32_t> groups;
   std::vector<float> weights;
@@ -104,6 +108,28 @@ int run_export(Args args) {
     std::fputs(kExportUsage, stderr);
     return 2;
   }
+  const std::string sidecar_path = features ? parsed->value("--sidecar").value_or(*features + ".json") : std::string();
+  // Before any work: an output that is the database, or another output,
+  // would destroy it.
+  std::vector<NamedPath> paths = {{"the database", parsed->positional[0], false}};
+  if (features) {
+    paths.push_back({"--features", *features, true});
+    paths.push_back({parsed->value("--sidecar") ? "--sidecar" : "the sidecar (--features + .json)", sidecar_path, true});
+  }
+  if (animation) {
+    paths.push_back({"--animation", *animation, true});
+    paths.push_back({"the animation sidecar (--animation + .json)", *animation + ".json", true});
+  }
+  // A default sidecar beside a device or FIFO (--features /dev/null) would
+  // be a new file in /dev: it must be named.
+  if (features && !parsed->value("--sidecar") && is_stream_path(*features)) {
+    return report_error("export", "--features " + *features + " is a device or FIFO: name the JSON sidecar with --sidecar", 1);
+  }
+  if (animation && is_stream_path(*animation)) {
+    return report_error("export", "--animation " + *animation + " is a device or FIFO: its sidecar would be " +
+                                      *animation + ".json beside it; write to a file", 1);
+  }
+  if (Status checked = check_command_paths(paths); !checked) return report_error("export", checked.message(), 1);
   Result<Database> db = load_database(parsed->positional[0]);
   if (!db.ok()) {
     std::fprintf(stderr, "mmvk export: %s\n", db.message().c_str());
@@ -117,11 +143,13 @@ int run_export(Args args) {
     std::printf("wrote %s (%u frames, float32) and %s.json\n", animation->c_str(), db->frame_count(), animation->c_str());
     if (!features) return 0;
   }
-  const std::string sidecar_path = parsed->value("--sidecar").value_or(*features + ".json");
+  // The sidecar's text exists before any file is written; names with
+  // invalid UTF-8 are replaced (U+FFFD), never thrown.
+  const std::string sidecar_text =
+      sidecar(*db, parsed->positional[0], *features).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+      "\n";
   Status written = write_f32_rows(*features, db->features());
-  if (written.ok()) {
-    written = write_file_atomically(sidecar_path, sidecar(*db, parsed->positional[0], *features).dump(1) + "\n");
-  }
+  if (written.ok()) written = write_file_atomically(sidecar_path, sidecar_text);
   if (!written.ok()) {
     std::fprintf(stderr, "mmvk export: %s\n", written.message().c_str());
     return 1;

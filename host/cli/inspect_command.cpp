@@ -8,6 +8,7 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/hash.hpp"
 #include "mmvk/normalization.hpp"
 #include "animation_report.hpp"
 #include "units_report.hpp"
@@ -115,7 +116,7 @@ int run_inspect(Args args) {
     out["frames"] = db.frame_count();
     out["dims"] = db.dims();
     out["fps"] = db.fps();
-    out["content_hash"] = db.content_hash();
+    out["content_hash"] = hash_hex(db.content_hash());
     out["flags"] = {{"do_not_use", do_not_use}, {"block_transition", block}, {"edge_excluded", edge},
                     {"candidates", candidates}};
     out["tags"] = nlohmann::json::array();
@@ -154,7 +155,7 @@ int run_inspect(Args args) {
   std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n", printable(path).c_str(),
               thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()), db.clips().size(), mirrored,
               looping, db.dims(), double(db.fps()));
-  std::printf("content hash: %016" PRIx64 "\n", db.content_hash());
+  std::printf("content hash: %s\n", hash_hex(db.content_hash()).c_str());
   print_animation(db);
   print_units(db);
   std::printf("frame flags: %s do_not_use, %s block_transition, %s edge_excluded; %s candidate frames\n",

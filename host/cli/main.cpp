@@ -2,6 +2,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <new>
 #include <string_view>
 #include <vector>
 
@@ -20,7 +21,11 @@ constexpr const char* kUsage =
     "  crowd [--agents N] [--html out.html] ...     a motion-matched crowd, its figures and a viewer page\n"
     "  clusters db.mmdb -o table.mmkc               train and save the cluster tables (query --clusters)\n"
     "\n"
-    "Run `mmvk <command> --help` for a command's options.\n";
+    "Run `mmvk <command> --help` for a command's options.\n"
+    "\n"
+    "Inputs are regular files (only query --queries may also be a pipe). A regular\n"
+    "output is replaced atomically; a device or FIFO is written in place; an output\n"
+    "that is an input or another output is refused (docs/files-and-limits.md).\n";
 
 int dispatch(std::string_view command, mmvk::cli::Args rest, const char* program) {
   if (command == "build") return mmvk::cli::run_build(rest);
@@ -59,5 +64,16 @@ int main(int argc, char** argv) {
     return check_stdout("help", 0);
   }
   const std::string_view command = args[0];
-  return check_stdout(command, dispatch(command, mmvk::cli::Args(args.data() + 1, args.size() - 1), argv[0]));
+  int exit_code = 1;
+  try {
+    exit_code = dispatch(command, mmvk::cli::Args(args.data() + 1, args.size() - 1), argv[0]);
+  } catch (const std::bad_alloc&) {
+    // The last resort behind the commands' own bounds (the crowd's memory
+    // estimate, the size caps): a clean exit instead of an abort. Outputs are
+    // written last and atomically, so none is left half-written.
+    std::fprintf(stderr, "mmvk %.*s: out of memory (see docs/files-and-limits.md for the limits)\n",
+                 int(command.size()), command.data());
+    exit_code = 1;
+  }
+  return check_stdout(command, exit_code);
 }

@@ -41,7 +41,8 @@ constexpr const char* kQueryUsage =
     "Reads B queries as raw little-endian float32 [B x dims] (dims and their order\n"
     "as in `mmvk export`'s sidecar). Values are raw features, normalized here with\n"
     "the database's offsets and scales, or already normalized with --normalized.\n"
-    "(--features is a synonym of --queries.)\n"
+    "(--features is a synonym of --queries.) The queries may come from a pipe\n"
+    "(--queries /dev/stdin); every other input must be a regular file.\n"
     "--pose-targets: one pose-matching query instead, from end-effector targets\n"
     "  {\"targets\": [{\"bone\": \"@left_foot\", \"position\": [x, y, z], \"velocity\": [x, y, z]}]}\n"
     "  (character space, metres and m/s; see docs/search.md): only the targeted\n"
@@ -169,7 +170,9 @@ Status make_backend(BackendHolder& holder, const Database& db, const std::string
 Result<QueryParams> query_params(const Database& db, const ParsedArgs& args) {
   QueryParams params;
   if (const auto text = args.value("--continuing")) {
-    MMVK_ASSIGN_OR_RETURN(params.continuing_frame, parse_u32("--continuing", *text));
+    // A frame of the database: 4294967295 (kNoFrame inside the library) is
+    // no way to say "none"; leave the option out for that.
+    MMVK_ASSIGN_OR_RETURN(params.continuing_frame, parse_u32("--continuing", *text, 0, db.frame_count() - 1));
   }
   if (const auto text = args.value("--continuing-bias")) {
     MMVK_ASSIGN_OR_RETURN(params.continuing_bias, parse_float("--continuing-bias", *text));
@@ -245,8 +248,14 @@ int run_query(Args args) {
     if (!value) return report_error("query", value.message(), 2);
     threads = *value;
   }
-  if (const auto out = parsed->value("--out")) {
-    if (Status writable = check_writable(*out); !writable) return fail(writable.message());
+  {
+    // Before any work: --out must be writable and no input.
+    std::vector<NamedPath> paths = {{"the database", parsed->positional[0], false}};
+    if (queries_path) paths.push_back({parsed->value("--queries") ? "--queries" : "--features", *queries_path, false});
+    if (pose_path) paths.push_back({"--pose-targets", *pose_path, false});
+    if (const auto table = parsed->value("--clusters")) paths.push_back({"--clusters", *table, false});
+    if (const auto out = parsed->value("--out")) paths.push_back({"--out", *out, true});
+    if (Status checked = check_command_paths(paths); !checked) return fail(checked.message());
   }
   // A mistyped backend is reported before the database loads (seconds for
   // a large one), in the words the registry would use.
@@ -281,7 +290,9 @@ int run_query(Args args) {
     }
   }
   Result<std::vector<float>> features =
-      pose ? Result<std::vector<float>>(pose->features) : read_f32_rows(*queries_path, db->dims());
+      pose ? Result<std::vector<float>>(pose->features)
+           : read_f32_rows(*queries_path, db->dims(), std::nullopt,
+                           ReadOptions{std::uint64_t{kMaxBatch} * db->dims() * 4, /*allow_stream=*/true});
   if (!features) return fail(features.message());
   const std::size_t count = features->size() / db->dims();
   if (!pose && !parsed->has("--normalized")) {

@@ -13,6 +13,8 @@
 
 #include "clip_quality.hpp"
 #include "crowd_backend.hpp"
+#include "crowd_limits.hpp"
+#include "crowd_paths.hpp"
 #include "crowd_recorder.hpp"
 #include "default_data.hpp"
 #include "mmvk/hash.hpp"
@@ -51,33 +53,11 @@ Status check_options(const CrowdOptions& o) {
   if (!(o.search_interval_s > 0.0) || !std::isfinite(o.search_interval_s)) {
     return make_error("--search-interval must be a positive number (seconds)");
   }
-  if (o.seconds * o.rate_hz > 1.0e7) return make_error("--seconds x --rate is over 10 million ticks");
   if (o.continuing_bias && !std::isfinite(*o.continuing_bias)) return make_error("--continuing-bias must be finite");
   if (o.continuing_multiplier && !(std::isfinite(*o.continuing_multiplier) && *o.continuing_multiplier >= 0.0f)) {
     return make_error("--continuing-multiplier must be finite and >= 0");
   }
-  return {};
-}
-
-// The trace's files must not be another output of the run (nor its input):
-// the last one written would silently win.
-Status check_trace_paths(const CrowdOptions& o) {
-  if (!o.trace) return {};
-  const std::filesystem::path files[2] = {*o.trace, trace_sidecar_path(*o.trace)};
-  const std::pair<const char*, const std::optional<std::filesystem::path>*> others[] = {
-      {"--summary", &o.summary}, {"--html", &o.html}, {"--data", &o.data}, {"--scenario", &o.scenario}};
-  for (const auto& file : files) {
-    std::error_code ec;
-    const auto mine = std::filesystem::weakly_canonical(file, ec);
-    for (const auto& [option, other] : others) {
-      if (ec || !*other) continue;
-      std::error_code other_ec;
-      const auto theirs = std::filesystem::weakly_canonical(**other, other_ec);
-      if (!other_ec && mine == theirs) return make_error("--trace: " + file.string() + " is also " + option + "'s file");
-    }
-    if (Status writable = check_writable(file); !writable) return make_error("--trace: " + writable.message());
-  }
-  return {};
+  return check_time_options(o);
 }
 
 Result<OpenedDatabase> open_crowd_database(const DataChoice& data, const CrowdOptions& options, std::FILE* log) {
@@ -161,9 +141,10 @@ std::uint32_t acceleration_step(double rate_hz, double fps) {
 
 Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   MMVK_TRY(check_options(options));
-  // Before the database, which may take a while to build.
-  MMVK_TRY(check_trace_paths(options));
   MMVK_ASSIGN_OR_RETURN(const DataChoice data, choose_data(options.data, options.executable));
+  // Before the database, which may take a while to build: every output
+  // writable, none of them an input or another output (crowd_paths.hpp).
+  MMVK_TRY(check_crowd_paths(options, data.source));
   MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
   const Database& db = opened.database;
   const std::string& db_name = data.label;
@@ -172,7 +153,9 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   }
   Result<GaitSpeeds> speeds = measure_gait_speeds(db);
   if (!speeds) return make_error(db_name + ": " + speeds.message());
+  MMVK_TRY(check_crowd_memory(options, db, nullptr));
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options, speeds->has_run));
+  MMVK_TRY(check_crowd_memory(options, db, &scenario));
   MMVK_TRY(resolve_gaits(scenario, *speeds));
   const auto agents = std::uint32_t(scenario.agents.size());
 

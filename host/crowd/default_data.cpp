@@ -1,12 +1,13 @@
 #include "default_data.hpp"
 
-#include <fstream>
-#include <sstream>
+#include <cstdio>
 #include <system_error>
 
+#include "cache_entry.hpp"
 #include "mmvk/hash.hpp"
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/file_io.hpp"
 #include "mmvk/manifest.hpp"
 
 namespace mmvk::crowd {
@@ -16,28 +17,20 @@ namespace {
 // Bumped when the way the host builds databases changes (not the data).
 constexpr std::uint32_t kRecipeVersion = 1;
 
-bool read_whole_file(const std::filesystem::path& path, std::string& out) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return false;
-  std::stringstream text;
-  text << file.rdbuf();
-  out = text.str();
-  return bool(file) || file.eof();
-}
-
 // The digest of everything a build reads: the manifest (or folder listing)
 // and the bytes of every clip.
 Result<std::uint64_t> source_digest(const std::filesystem::path& source, const Manifest& manifest) {
   Hasher hash;
   hash.add_u32(kRecipeVersion);
   hash.add_u32(kDatabaseFormatVersion);
-  std::string bytes;
+  // The one reader: regular files only, so a clip that is a FIFO fails
+  // instead of blocking the digest.
   if (!std::filesystem::is_directory(source)) {
-    if (!read_whole_file(source, bytes)) return make_error(source.string() + ": cannot read");
+    MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(source, ReadOptions{kMaxJsonBytes, false}));
     hash.add_text(bytes);
   }
   for (const ManifestClip& clip : manifest.clips) {
-    if (!read_whole_file(clip.file, bytes)) return make_error(clip.file.string() + ": cannot read");
+    MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(clip.file));
     hash.add_text(clip.file.filename().string());
     hash.add_text(bytes);
   }
@@ -117,8 +110,9 @@ Result<OpenedDatabase> open_database(const std::filesystem::path& source, const 
     cached = cache_dir / ("crowd-" + label + "-" + hex(digest) + ".mmdb");
     if (std::filesystem::exists(cached, ec)) {
       Result<Database> loaded = load_database(cached);
-      if (loaded) return OpenedDatabase{std::move(loaded.value()), cached, false};
-      say("the cached database " + cached.string() + " is unreadable (" + loaded.message() + "); rebuilding it");
+      const Status valid = loaded ? validate_cache_entry(*loaded, manifest) : Status(loaded.error());
+      if (valid) return OpenedDatabase{std::move(loaded.value()), cached, false};
+      say("the cached database " + cached.string() + " is not usable (" + valid.message() + "); rebuilding it");
     }
   }
   say("building the database from " + source.string() + " (" + std::to_string(manifest.clips.size()) +
@@ -126,7 +120,8 @@ Result<OpenedDatabase> open_database(const std::filesystem::path& source, const 
   MMVK_ASSIGN_OR_RETURN(Database database, build_database(manifest));
   if (!cached.empty()) {
     std::filesystem::create_directories(cache_dir, ec);
-    if (Status saved = save_database(database, cached); !saved) {
+    // A cache entry: whatever stands at its name is replaced, never written through.
+    if (Status saved = write_file_atomically(cached, serialize_database(database), OutputPolicy::CacheEntry); !saved) {
       say("could not cache the database (" + saved.message() + "); it will be built again next time");
       cached.clear();
     } else {

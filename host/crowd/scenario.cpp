@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "crowd_limits.hpp"
+#include "mmvk/file_io.hpp"
+#include "mmvk/json_check.hpp"
 #include "random.hpp"
 
 namespace mmvk::crowd {
@@ -129,6 +130,9 @@ Scenario make_random_scenario(const RandomScenarioOptions& options) {
 
 Result<Scenario> parse_scenario_json(std::string_view json_text, std::string_view source) {
   const std::string name(source.empty() ? std::string_view("scenario") : source);
+  // Duplicate keys, NUL bytes and trailing bytes are errors, as in every
+  // mmvk JSON input.
+  MMVK_TRY(check_json_text(json_text, name));
   const Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
   if (root.is_discarded()) return make_error(name + ": not valid JSON");
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"agents\"");
@@ -138,6 +142,10 @@ Result<Scenario> parse_scenario_json(std::string_view json_text, std::string_vie
   if (!root.contains("agents")) return make_error(name + ": agents: missing");
   const Json& agents = root["agents"];
   if (!agents.is_array() || agents.empty()) return make_error(name + ": agents: expected a non-empty array");
+  if (agents.size() > kMaxAgents) {
+    return make_error(name + ": agents: " + std::to_string(agents.size()) + " agents, over the limit of " +
+                      std::to_string(kMaxAgents));
+  }
   float extent = 0.0f;
   for (std::size_t a = 0; a < agents.size(); ++a) {
     MMVK_ASSIGN_OR_RETURN(AgentPlan plan, parse_agent(agents[a], name + ": agents[" + std::to_string(a) + "]"));
@@ -154,11 +162,11 @@ Result<Scenario> parse_scenario_json(std::string_view json_text, std::string_vie
 }
 
 Result<Scenario> load_scenario(const std::filesystem::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return make_error(path.string() + ": cannot open the scenario file");
-  std::stringstream text;
-  text << file.rdbuf();
-  return parse_scenario_json(text.str(), path.string());
+  // A regular file of at most kMaxJsonBytes: --scenario /dev/zero or a FIFO
+  // fails at once.
+  Result<std::string> text = read_file(path, ReadOptions{kMaxJsonBytes, false});
+  if (!text) return make_error("--scenario: " + text.message());
+  return parse_scenario_json(*text, path.string());
 }
 
 }  // namespace mmvk::crowd

@@ -14,7 +14,9 @@
 //       "exclude_tags": ["run"] }        // optional: and none of these
 //   ]
 // }
-// Unknown fields are errors; every error names the file and the field:
+// Unknown fields, duplicate keys and bytes after the JSON are errors; the
+// file is at most 64 MiB (kMaxJsonBytes) and kMaxAgents agents
+// (crowd_limits.hpp). Every error names the file and the field:
 // "crowd.json: agents[2].goals[1]: expected [x, z] numbers".
 #pragma once
 

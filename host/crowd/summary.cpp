@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
 #include <nlohmann/json.hpp>
+
+#include "mmvk/file_io.hpp"
+#include "mmvk/hash.hpp"
 
 namespace mmvk::crowd {
 
@@ -12,12 +14,6 @@ namespace {
 
 // JSON has no NaN: a figure that could not be measured is null.
 nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr); }
-
-std::string hex(std::uint64_t value) {
-  char text[19];
-  std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(value));
-  return text;
-}
 
 // The figures both the crowd and the clips have, under the same keys.
 void add_motion(nlohmann::ordered_json& j, const MotionFigures& m) {
@@ -72,7 +68,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["transitions_per_agent_s"] = number(s.transitions_per_agent_s);
   j["goals_reached"] = s.goals_reached;
   // A string: a 64-bit value is not exact in every JSON reader's doubles.
-  j["chosen_frames_hash"] = hex(s.chosen_frames_hash);
+  j["chosen_frames_hash"] = hash_hex(s.chosen_frames_hash);
   j["notes"] = s.notes;
   if (!s.html.empty()) {
     j["html"] = s.html;
@@ -101,11 +97,9 @@ std::string describe_motion(const CrowdSummary& s) {
 }
 
 Status write_summary(const CrowdSummary& summary, const std::filesystem::path& path) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) return make_error(path.string() + ": cannot write the summary");
-  file << summary_to_json(summary);
-  file.close();
-  if (!file) return make_error(path.string() + ": writing the summary failed");
+  if (Status written = write_file_atomically(path, summary_to_json(summary)); !written) {
+    return make_error("--summary: " + written.message());
+  }
   return {};
 }
 

@@ -288,7 +288,7 @@ const std::map<std::string, Expected>& corpus_expectations() {
       {"negative_frame_time.bvh", {18, "Frame Time: must be positive"}},
       {"negative_frames.bvh", {17, "Frames: must be a non-negative integer, got '-3'"}},
       {"no_channels.bvh", {13, "declares no CHANNELS"}},
-      {"no_hierarchy_keyword.bvh", {1, "expected HIERARCHY, got 'ROOT'"}},
+      {"no_hierarchy_keyword.bvh", {1, "not a BVH file: expected HIERARCHY"}},
       {"non_numeric_value.bvh", {20, "non-numeric token 'zero'"}},
       {"second_root.bvh", {16, "second ROOT"}},
       {"short_offset.bvh", {8, "OFFSET of JOINT Leg needs 3 numbers; got 'CHANNELS' on line 9"}},

@@ -109,7 +109,7 @@ TEST_F(CrowdCli, ControlsAndTraceErrorsNameTheOption) {
   expect_failure(run + "--continuing-multiplier -1", "--continuing-multiplier must be >= 0");
   const std::string trace = (dir_ / "t.f32").string();
   expect_failure(run + "--trace " + trace + " --trace-agents 5", "--trace-agents 5 must be in [1, 3]");
-  expect_failure(run + "--trace " + trace + " --summary " + trace, "is also --summary's file");
+  expect_failure(run + "--trace " + trace + " --summary " + trace, "name the same file");
   // An unwritable trace is refused before the database is built.
   const auto unwritable = run_command(mmvk_ + " crowd " + run + "--trace /nonexistent/folder/t.f32");
   EXPECT_EQ(unwritable.exit_code, 1) << unwritable.output;

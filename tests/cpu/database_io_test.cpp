@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <csignal>
 #include <cstring>
 #include <fstream>
 #include <random>
 
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "mmvk/hash.hpp"
@@ -218,16 +221,27 @@ TEST(DatabaseIo, FailedWriteLeavesTheOldFileIntact) {
   ASSERT_TRUE(save_database(db, path).ok());
   std::ifstream before_in(path, std::ios::binary);
   const std::string before((std::istreambuf_iterator<char>(before_in)), std::istreambuf_iterator<char>());
-  // Occupy the temp file's name with a folder so the write fails.
-  std::filesystem::path temp = path;
-  temp += ".tmp-" + std::to_string(::getpid());
-  std::filesystem::create_directory(temp);
   DatabaseParts parts = db.parts();
   parts.fps = 60.0f;
   Result<Database> other = Database::create(std::move(parts));
   ASSERT_TRUE(other.ok());
-  Status saved = save_database(*other, path);
-  EXPECT_FALSE(saved.ok());
+  // The write fails half-way: a child process may write files of at most
+  // 1000 bytes (EFBIG instead of SIGXFSZ), which holds even for root.
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{1000, 1000};
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(10);
+    const Status saved = save_database(*other, path);
+    ::_exit(saved.ok() ? 0 : (saved.message().find("db.mmdb") != std::string::npos ? 3 : 11));
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << "the save should have failed, naming the file";
+  // Only the old file is left: the temp file was removed.
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
   std::ifstream after_in(path, std::ios::binary);
   const std::string after((std::istreambuf_iterator<char>(after_in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(before, after);

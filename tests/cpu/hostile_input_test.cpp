@@ -17,7 +17,9 @@
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/hash.hpp"
+#include "mmvk/json_check.hpp"
 #include "mmvk/manifest.hpp"
+#include "mmvk/pose_query.hpp"
 #include "mmvk/motion.hpp"
 #include "mmvk/reference_search.hpp"
 #include "mmvk/thread_pool.hpp"
@@ -184,6 +186,51 @@ TEST(HostileJson, EqualKeysInDifferentObjectsAreFine) {
   const Result<Manifest> manifest = parse_manifest_json(
       R"({"clips": [{"file": "a.bvh", "loop": true}, {"file": "b.bvh", "loop": false}]})", "m.json", ".");
   EXPECT_TRUE(manifest.ok()) << manifest.message();
+}
+
+// Issue 23: bytes after the JSON, NULs among them, are errors in every JSON
+// input; nlohmann's parser alone stops at a NUL and would accept the rest.
+TEST(HostileJson, TrailingBytesAndNulsAreRejectedEverywhere) {
+  const std::string manifest = R"({"clips": [{"file": "a.bvh"}]})";
+  const std::string schema = R"({"channels": [{"name": "a", "kind": "bone_position", "bone": "Hips"}]})";
+  const std::string targets = R"({"targets": [{"bone": "Hips", "position": [0, 0, 0]}]})";
+  ASSERT_TRUE(parse_manifest_json(manifest, "m.json", ".").ok());
+  ASSERT_TRUE(parse_schema_json(schema, "s.json").ok());
+  ASSERT_TRUE(parse_pose_targets_json(targets, "t.json").ok());
+  for (const std::string& tail : {std::string(1, '\0'), std::string("\0garbage", 8), std::string(" {}"), std::string("x")}) {
+    const Result<Manifest> m = parse_manifest_json(manifest + tail, "m.json", ".");
+    ASSERT_FALSE(m.ok()) << tail.size();
+    EXPECT_TRUE(contains(m.message(), "m.json")) << m.message();
+    EXPECT_FALSE(parse_schema_json(schema + tail, "s.json").ok()) << tail.size();
+    EXPECT_FALSE(parse_pose_targets_json(targets + tail, "t.json").ok()) << tail.size();
+    EXPECT_FALSE(check_json_text(targets + tail, "x.json").ok()) << tail.size();
+  }
+  const Status nul = check_json_text(std::string("{}") + std::string(2, '\0'), "x.json");
+  ASSERT_FALSE(nul.ok());
+  EXPECT_TRUE(contains(nul.message(), "x.json: a NUL byte at offset 2")) << nul.message();
+  EXPECT_TRUE(check_json_text("  {\"a\": [1, {\"a\": 2}]}\n", "x.json").ok());
+  const Status dup = check_json_text(R"({"a": 1, "b": {"c": 1, "c": 2}})", "x.json");
+  ASSERT_FALSE(dup.ok());
+  EXPECT_TRUE(contains(dup.message(), "duplicate key \"c\"")) << dup.message();
+}
+
+// Issue 23: a field a channel kind would ignore is an error, like an unknown one.
+TEST(HostileJson, ABoneOnAChannelThatReadsNoneIsRejected) {
+  const Result<FeatureSchema> schema =
+      parse_schema_json(R"({"channels": [{"name": "turn", "kind": "root_angular_velocity", "bone": "Hips"}]})", "s.json");
+  ASSERT_FALSE(schema.ok());
+  EXPECT_TRUE(contains(schema.message(), "s.json: channels[0].bone: a root_angular_velocity channel reads no bone"))
+      << schema.message();
+  EXPECT_TRUE(parse_schema_json(R"({"channels": [{"name": "turn", "kind": "root_angular_velocity"}]})", "s.json").ok());
+}
+
+// Issue 23: a file that is not BVH is rejected without echoing it.
+TEST(HostileBvh, ANonBvhFileIsNotEchoed) {
+  const Result<BvhFile> file = parse_bvh("root:$6$salt$secrethash:19000:0:99999:7:::\n", "shadow");
+  ASSERT_FALSE(file.ok());
+  EXPECT_TRUE(contains(file.message(), "shadow:1: not a BVH file")) << file.message();
+  EXPECT_FALSE(contains(file.message(), "root")) << file.message();
+  EXPECT_FALSE(contains(file.message(), "secret")) << file.message();
 }
 
 TEST(HostileFrameRate, TinyManifestFpsIsABadFrameRate) {

@@ -4,8 +4,9 @@
 // OUT_DIR/<target>/ gets: bvh (a generated walk, plus the malformed-BVH test
 // corpus when given), mmdb and mmdb_repair (a database built from the walk),
 // json (a manifest and the default schema, each behind its selector byte),
-// cluster_table (a table trained on fixed_database.hpp's), query (query rows).
-#include <cmath>
+// cluster_table (a table trained on fixed_database.hpp's), query (query rows),
+// scenario (a crowd scenario using every field) and pose_targets (targets on
+// the walk database's bones).
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,32 +19,11 @@
 #include "mmvk/database_io.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "fixed_database.hpp"
+#include "walk_database.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-// A 40-frame, 30 fps walk of a 5-joint skeleton whose names resolve to the
-// default schema's bone roles (hips, upper legs, feet).
-std::string walk_bvh() {
-  std::string text =
-      "HIERARCHY\nROOT Hips\n{\n OFFSET 0 100 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
-      " JOINT UpperLeg_L\n {\n  OFFSET 10 -5 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
-      "  JOINT Foot_L\n  {\n   OFFSET 0 -90 0\n   CHANNELS 3 Zrotation Xrotation Yrotation\n"
-      "   End Site\n   {\n    OFFSET 0 -5 10\n   }\n  }\n }\n"
-      " JOINT UpperLeg_R\n {\n  OFFSET -10 -5 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
-      "  JOINT Foot_R\n  {\n   OFFSET 0 -90 0\n   CHANNELS 3 Zrotation Xrotation Yrotation\n"
-      "   End Site\n   {\n    OFFSET 0 -5 10\n   }\n  }\n }\n}\n"
-      "MOTION\nFrames: 40\nFrame Time: 0.0333333\n";
-  char line[256];
-  for (int f = 0; f < 40; ++f) {
-    const double swing = 25.0 * std::sin(f * 0.3);
-    std::snprintf(line, sizeof(line), "0 100 %.2f 0 0 %.2f 0 %.2f 0 0 0 0 0 %.2f 0 0 0 0\n", f * 4.0, f * 1.5, swing,
-                  -swing);
-    text += line;
-  }
-  return text;
-}
 
 bool write(const fs::path& path, const std::string& bytes) {
   fs::create_directories(path.parent_path());
@@ -65,7 +45,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1];
-  const std::string bvh = walk_bvh();
+  const std::string bvh = mmvk::fuzz::walk_bvh();
   bool ok = write(out / "bvh" / "walk.bvh", bvh);
   if (argc > 2) {
     for (const fs::directory_entry& entry : fs::directory_iterator(argv[2])) {
@@ -73,18 +53,7 @@ int main(int argc, char** argv) {
     }
   }
 
-  mmvk::Result<mmvk::BvhFile> file = mmvk::parse_bvh(bvh, "walk.bvh");
-  if (!file.ok()) return std::fprintf(stderr, "%s\n", file.message().c_str()), 1;
-  mmvk::Result<mmvk::Motion> motion = mmvk::motion_from_bvh(*file, {});
-  if (!motion.ok()) return std::fprintf(stderr, "%s\n", motion.message().c_str()), 1;
-  std::vector<mmvk::MotionClip> clips(1);
-  clips[0].meta.file = "walk.bvh";
-  clips[0].meta.name = "walk";
-  clips[0].meta.tags = {"walk"};
-  clips[0].motion = std::move(*motion);
-  mmvk::MotionBuildSettings settings;
-  settings.edge_rule = mmvk::EdgeRule::Clamp;
-  mmvk::Result<mmvk::Database> db = mmvk::build_database_from_motions(clips, settings);
+  mmvk::Result<mmvk::Database> db = mmvk::fuzz::build_walk_database();
   if (!db.ok()) return std::fprintf(stderr, "%s\n", db.message().c_str()), 1;
   const std::string mmdb = mmvk::serialize_database(*db);
   ok = ok && write(out / "mmdb" / "walk.mmdb", mmdb);
@@ -105,6 +74,14 @@ int main(int argc, char** argv) {
   const fs::path table_path = out / "cluster_table" / "walk.mmkc";
   fs::create_directories(table_path.parent_path());
   ok = ok && mmvk::save_cluster_table(*table, table_path).ok();
+
+  ok = ok && write(out / "scenario" / "scenario.json",
+                   "{\"world_size_m\": 40, \"agents\": [{\"start\": [0, 0], \"goals\": [[4, 0], [4, 4]], "
+                   "\"speed\": \"run\", \"require_tags\": [\"walk\"], \"exclude_tags\": [\"turn\"]}, "
+                   "{\"start\": [1, -2.5], \"goals\": [[-3, 1]], \"speed\": 1.2}]}");
+  ok = ok && write(out / "pose_targets" / "targets.json",
+                   "{\"targets\": [{\"bone\": \"@left_foot\", \"position\": [0.1, 0.05, 0.2], "
+                   "\"velocity\": [0, 0, 1.2]}, {\"bone\": \"@right_foot\", \"position\": [-0.1, 0, -0.1]}]}");
 
   const std::span<const float> rows = db->features().first(3 * std::size_t{db->dims()});
   ok = ok && write(out / "query" / "rows.f32", std::string(reinterpret_cast<const char*>(rows.data()), rows.size_bytes()));

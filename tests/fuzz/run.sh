@@ -39,3 +39,5 @@ run fuzz_json json tests/fuzz/json.dict
 run fuzz_cluster_table cluster_table
 run fuzz_query_rows query
 run fuzz_search_diff search_diff
+run fuzz_scenario_json scenario tests/fuzz/json.dict
+run fuzz_pose_targets pose_targets tests/fuzz/json.dict

@@ -189,6 +189,30 @@ TEST_F(ViewerChromium, CorruptDataIsReportedAsAnError) {
   EXPECT_NE(status.find("data-state=\"error\""), std::string::npos) << status;
 }
 
+// Issue 23: a tiny zoom (from the URL; the wheel goes through the same
+// clamp) looped for ever drawing the grid, and thousands of goals per agent
+// stalled every frame. The page must still report ready, with the view
+// clamped and only visible goal segments drawn.
+TEST_F(ViewerChromium, TinyZoomAndThousandsOfGoalsStayResponsive) {
+  SyntheticRecordingParams params;
+  params.agents = 100;
+  params.seconds = 10.0f;
+  Recording r = make_synthetic_recording(params);
+  for (std::size_t a = 0; a < r.goals.size(); ++a) {
+    r.goals[a].clear();
+    for (int g = 0; g < 5000; ++g) {
+      r.goals[a].push_back({float((g * 7 + int(a)) % 200) - 100.0f, float((g * 13 + int(a) * 3) % 200) - 100.0f});
+    }
+  }
+  const auto size = write_viewer_html(*dir_ / "goals.html", r);
+  ASSERT_TRUE(size.ok()) << size.message();
+  for (const char* zoom : {"1e-300", "1e-9", "1e300", "0.5"}) {
+    const std::string status = status_of(run_chromium(*dir_ / "goals.html", "--dump-dom", std::string("zoom") + zoom,
+                                                      std::string("?t=4&agent=3&paused=1&zoom=") + zoom));
+    EXPECT_NE(status.find("data-state=\"ready\""), std::string::npos) << "zoom=" << zoom << ": " << status;
+  }
+}
+
 struct Rgb {
   int r, g, b;
 };

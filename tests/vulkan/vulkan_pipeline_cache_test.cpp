@@ -11,6 +11,7 @@
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/backend_suite.hpp"
+#include "support/device_nodes.hpp"
 #include "support/test_data.hpp"
 #include "vulkan_test_env.hpp"
 
@@ -230,6 +231,32 @@ TEST(PipelineCacheFile, GarbageFileIsIgnoredWithANote) {
   // The next save replaces it with a good file.
   ASSERT_TRUE(vulkan::save_pipeline_cache_file(*context, dir).ok());
   EXPECT_EQ(vulkan::load_pipeline_cache_file(*context, dir), "");
+  std::filesystem::remove_all(dir);
+}
+
+// Issue 23: a pipeline cache file that is a symlink to an endless device or
+// a FIFO is refused at once (not read up to 4 GiB, not blocked on), and the
+// next save replaces the link with a regular file, never writing through it.
+// The device is a private node made with mknod (skipped where refused).
+TEST(PipelineCacheFile, NonRegularFilesAreIgnoredAndReplaced) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const std::filesystem::path dir = fresh_directory("non-regular");
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = vulkan::pipeline_cache_file(*context, dir);
+  ASSERT_TRUE(make_fifo(dir / "fifo"));
+  std::vector<std::pair<std::filesystem::path, std::string>> targets = {{dir / "fifo", "FIFO"}};
+  if (make_device_node(dir / "zero", MemoryDevice::Zero)) targets.push_back({dir / "zero", "character device"});
+  for (const auto& [target, kind] : targets) {
+    std::filesystem::remove(file);
+    std::filesystem::create_symlink(target, file);
+    const std::string note = vulkan::load_pipeline_cache_file(*context, dir);
+    EXPECT_NE(note.find(kind), std::string::npos) << note;
+    EXPECT_NE(note.find("starts empty"), std::string::npos) << note;
+    ASSERT_TRUE(vulkan::save_pipeline_cache_file(*context, dir).ok());
+    EXPECT_EQ(file_type(file), "regular");
+    EXPECT_NE(file_type(target), "regular");
+    EXPECT_EQ(vulkan::load_pipeline_cache_file(*context, dir), "");
+  }
   std::filesystem::remove_all(dir);
 }
 

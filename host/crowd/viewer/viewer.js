@@ -121,11 +121,17 @@
     if (meta.has_matched) [d.matX, d.matZ] = trajectory(readers.matched);
     r = readers.goals;
     d.goals = [];
+    d.goalBox = [];  // per agent [min x, min z, max x, max z] of its goals, to skip paths out of view
     for (let a = 0; a < N; a++) {
-      const count = r.u(), g = new Float32Array(2 * count);
+      const count = r.u(), g = new Float32Array(2 * count), box = [Infinity, Infinity, -Infinity, -Infinity];
       let x = 0, z = 0;
-      for (let i = 0; i < count; i++) { x += r.z(); z += r.z(); g[2 * i] = x / 100; g[2 * i + 1] = z / 100; }
+      for (let i = 0; i < count; i++) {
+        x += r.z(); z += r.z(); g[2 * i] = x / 100; g[2 * i + 1] = z / 100;
+        box[0] = Math.min(box[0], g[2 * i]); box[1] = Math.min(box[1], g[2 * i + 1]);
+        box[2] = Math.max(box[2], g[2 * i]); box[3] = Math.max(box[3], g[2 * i + 1]);
+      }
       d.goals.push(g);
+      d.goalBox.push(box);
     }
     r.finish();
     r = readers.searches;
@@ -310,12 +316,38 @@
 
   const crowdCanvas = document.getElementById('crowd');
 
+  // Zoom bounds, pixels per metre: a tiny zoom (from the URL or the wheel)
+  // made the grid loop run for ever, and neither end shows anything useful.
+  const kMinScale = 1e-3, kMaxScale = 1e4;
+  const clampScale = (s) => Math.min(kMaxScale, Math.max(kMinScale, Number.isFinite(s) ? s : 1));
+
   function fitView(w, h) {
     const [x0, z0, x1, z1] = D.bounds;
-    const scale = Math.min(w / Math.max(x1 - x0 + 4, 1), h / Math.max(z1 - z0 + 4, 1));
+    const scale = clampScale(Math.min(w / Math.max(x1 - x0 + 4, 1), h / Math.max(z1 - z0 + 4, 1)));
     state.view = { cx: (x0 + x1) / 2, cz: (z0 + z1) / 2, scale };
   }
   const toScreen = (v, w, h, x, z) => [w / 2 + (x - v.cx) * v.scale, h / 2 + (z - v.cz) * v.scale];
+
+  // One agent's goal path into the current path, only its segments that
+  // cross the view [xa, xb] x [za, zb] (world metres), and at most about
+  // one point per pixel: thousands of goals per agent stay cheap to draw.
+  function addVisiblePath(ctx, g, v, w, h, xa, xb, za, zb) {
+    let lastX = NaN, lastY = NaN;  // the last point added, on screen; NaN: the pen is up
+    for (let i = 2; i < g.length; i += 2) {
+      const x0 = g[i - 2], z0 = g[i - 1], x1 = g[i], z1 = g[i + 1];
+      if ((x0 < xa && x1 < xa) || (x0 > xb && x1 > xb) || (z0 < za && z1 < za) || (z0 > zb && z1 > zb)) {
+        lastX = NaN;
+        continue;
+      }
+      const [sx, sy] = toScreen(v, w, h, x1, z1);
+      if (Number.isNaN(lastX)) {
+        const [px, py] = toScreen(v, w, h, x0, z0);
+        ctx.moveTo(px, py); lastX = px; lastY = py;
+      }
+      if (Math.abs(sx - lastX) + Math.abs(sy - lastY) < 1 && i + 2 < g.length) continue;
+      ctx.lineTo(sx, sy); lastX = sx; lastY = sy;
+    }
+  }
 
   function drawCrowd() {
     const { ctx, w, h } = prepare(crowdCanvas);
@@ -332,22 +364,24 @@
       const p = sampleAt(state.selected, state.t);
       v.cx = p.x; v.cz = p.z;
     }
-    // Ground grid: 1 m lines when zoomed in, else 10 m.
-    const step = v.scale > 12 ? 1 : 10;
+    // Ground grid: 1 m lines when zoomed in, else 10 m, coarser by tens
+    // while more than 200 lines would cross the view.
+    v.scale = clampScale(v.scale);
+    const xa = v.cx - w / 2 / v.scale, xb = v.cx + w / 2 / v.scale, za = v.cz - h / 2 / v.scale, zb = v.cz + h / 2 / v.scale;
+    let step = v.scale > 12 ? 1 : 10;
+    while (Math.max(xb - xa, zb - za) / step > 200) step *= 10;
     ctx.strokeStyle = '#242a33'; ctx.lineWidth = 1;
     ctx.beginPath();
-    const xa = v.cx - w / 2 / v.scale, xb = v.cx + w / 2 / v.scale, za = v.cz - h / 2 / v.scale, zb = v.cz + h / 2 / v.scale;
     for (let x = Math.ceil(xa / step) * step; x <= xb; x += step) { const sx = toScreen(v, w, h, x, 0)[0]; ctx.moveTo(sx, 0); ctx.lineTo(sx, h); }
     for (let z = Math.ceil(za / step) * step; z <= zb; z += step) { const sy = toScreen(v, w, h, 0, z)[1]; ctx.moveTo(0, sy); ctx.lineTo(w, sy); }
     ctx.stroke();
     // Goal paths of everyone, faint, in one path.
     ctx.strokeStyle = 'rgba(160,170,190,0.16)'; ctx.lineWidth = 1;
     ctx.beginPath();
-    for (const g of D.goals) {
-      for (let i = 0; i < g.length; i += 2) {
-        const [sx, sy] = toScreen(v, w, h, g[i], g[i + 1]);
-        if (i === 0) ctx.moveTo(sx, sy); else ctx.lineTo(sx, sy);
-      }
+    for (let a = 0; a < D.N; a++) {
+      const b = D.goalBox[a];
+      if (b[2] < xa || b[0] > xb || b[3] < za || b[1] > zb) continue;
+      addVisiblePath(ctx, D.goals[a], v, w, h, xa, xb, za, zb);
     }
     ctx.stroke();
     // The characters: a disc (0.3 m, at least 2.5 px) and a facing tick.
@@ -434,7 +468,7 @@
     const g = D.goals[a], goalPts = [];
     for (let i = 0; i < g.length; i += 2) goalPts.push(toScreen(v, w, h, g[i], g[i + 1]));
     polyline(ctx, goalPts, 'rgba(255,255,255,0.55)', 1.5, [4, 4]);
-    dots(ctx, goalPts, '#fff', 3);
+    dots(ctx, goalPts.filter(([x, y]) => x >= -4 && y >= -4 && x <= w + 4 && y <= h + 4), '#fff', 3);
     // Achieved path: 2 s behind (grey) and the samples ahead (cyan).
     const p = sampleAt(a, state.t), past = [], ahead = [];
     for (let s = Math.max(0, p.s0 - Math.round(2 * D.rate)); s <= p.s0; s++) past.push(toScreen(v, w, h, D.rootX[a * D.S + s], D.rootZ[a * D.S + s]));
@@ -743,7 +777,7 @@
       e.preventDefault();
       const v = state.view, w = crowdCanvas.clientWidth, h = crowdCanvas.clientHeight;
       const wx = v.cx + (e.offsetX - w / 2) / v.scale, wz = v.cz + (e.offsetY - h / 2) / v.scale;
-      v.scale *= Math.exp(-e.deltaY * 0.0015);
+      v.scale = clampScale(v.scale * Math.exp(-e.deltaY * 0.0015));
       v.cx = wx - (e.offsetX - w / 2) / v.scale; v.cz = wz - (e.offsetY - h / 2) / v.scale;
       state.dirty = true;
     }, { passive: false });
@@ -781,7 +815,7 @@
   // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE&follow=1
   function applyQuery() {
     const q = new URLSearchParams(window.location.search);
-    if (q.has('zoom')) state.zoom = parseFloat(q.get('zoom')) || 0;
+    if (q.has('zoom')) state.zoom = parseFloat(q.get('zoom')) > 0 ? clampScale(parseFloat(q.get('zoom'))) : 0;
     state.follow = q.get('follow') === '1';
     document.getElementById('follow').checked = state.follow;
     if (q.has('t')) setTime(parseFloat(q.get('t')) || 0);

@@ -2,15 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <string_view>
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+#include "mmvk/file_io.hpp"
 #include "mmvk_viewer_assets.hpp"  // generated from viewer.html and viewer.js
 #include "viewer/recording_check.hpp"
 #include "viewer/viewer_payload.hpp"
@@ -65,18 +59,6 @@ Result<std::string> fill_template(std::string_view page, const std::array<std::p
   return out;
 }
 
-Status write_all(int fd, const std::string& text, const std::string& temp) {
-  std::size_t written = 0;
-  while (written < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return make_error("viewer: cannot write " + temp + ": " + std::strerror(errno));
-    written += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0) return make_error("viewer: cannot flush " + temp + ": " + std::strerror(errno));
-  return {};
-}
-
 }  // namespace
 
 Result<ViewerPage> render_viewer_html(const Recording& recording) {
@@ -97,23 +79,8 @@ Result<ViewerPage> render_viewer_html(const Recording& recording) {
 
 Result<std::size_t> write_viewer_html(const std::filesystem::path& path, const Recording& recording) {
   MMVK_ASSIGN_OR_RETURN(ViewerPage page, render_viewer_html(recording));
-  // The temporary file sits beside the target so the rename stays on one
-  // file system and is atomic.
-  std::string temp = path.string() + ".XXXXXX";
-  const int fd = ::mkstemp(temp.data());
-  if (fd < 0) return make_error("viewer: cannot create a temporary file beside " + path.string() + ": " + std::strerror(errno));
-  Status status = write_all(fd, page.html, temp);
-  // mkstemp creates 0600; a page is for people to open, so make it readable.
-  if (status.ok() && ::fchmod(fd, 0644) != 0) {
-    status = make_error("viewer: cannot set permissions of " + temp + ": " + std::strerror(errno));
-  }
-  if (::close(fd) != 0 && status.ok()) status = make_error("viewer: cannot close " + temp + ": " + std::strerror(errno));
-  if (status.ok() && std::rename(temp.c_str(), path.c_str()) != 0) {
-    status = make_error("viewer: cannot rename " + temp + " to " + path.string() + ": " + std::strerror(errno));
-  }
-  if (!status.ok()) {
-    ::unlink(temp.c_str());
-    return status;
+  if (Status written = write_file_atomically(path, page.html); !written) {
+    return make_error("viewer: " + written.message());
   }
   return page.html.size();
 }

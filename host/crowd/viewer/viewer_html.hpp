@@ -24,9 +24,10 @@ struct ViewerPage {
 // fault is named; see validate_recording) or a compression failure.
 Result<ViewerPage> render_viewer_html(const Recording& recording);
 
-// Renders the page and writes it to `path` atomically: a temporary file in
-// the same folder, flushed to disk, then renamed over `path`, so a reader
-// never sees half a page. Errors name the path and the failing step.
+// Renders the page and writes it to `path` with mmvk's one writer
+// (write_file_atomically): a regular file is replaced atomically, so a
+// reader never sees half a page; a FIFO or device is written in place.
+// Errors name the path and the failing step.
 // Returns the size of the written file in bytes.
 Result<std::size_t> write_viewer_html(const std::filesystem::path& path, const Recording& recording);
 

@@ -6,7 +6,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <span>
+#include <string>
 #include <string_view>
 
 namespace mmvk {
@@ -41,5 +43,13 @@ class Hasher {
  private:
   std::uint64_t state_ = 0xcbf29ce484222325ull;
 };
+
+// How every mmvk tool prints a digest: "0x" and 16 hex digits (a string in
+// JSON too, where a 64-bit integer is not exact in every reader's doubles).
+inline std::string hash_hex(std::uint64_t digest) {
+  char text[19];
+  std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(digest));
+  return text;
+}
 
 }  // namespace mmvk

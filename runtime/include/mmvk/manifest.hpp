@@ -163,4 +163,9 @@ Result<Manifest> manifest_from_directory(const std::filesystem::path& dir);
 // A manifest file or a folder of BVH, whichever `path` is.
 Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path);
 
+// Every file a build of `manifest` reads besides the manifest itself: each
+// clip's BVH and its custom channels' sidecars (features.hpp), in clip order,
+// for hosts that refuse an output that is one of them (manifest_files.cpp).
+std::vector<std::filesystem::path> manifest_input_files(const Manifest& manifest);
+
 }  // namespace mmvk

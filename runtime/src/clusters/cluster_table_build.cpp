@@ -7,6 +7,7 @@
 #include <string>
 
 #include "clusters/cluster_table_build.hpp"
+#include "mmvk/hash.hpp"
 
 namespace mmvk::detail {
 
@@ -108,8 +109,8 @@ Status validate_cluster_table(const ClusterTable& t, const Database& database) {
   const std::uint32_t dims = database.dims();
   const FeatureSchema& schema = database.schema();
   if (t.database_hash != database.content_hash()) {
-    return make_error("cluster table: built from another database (database hash " + std::to_string(t.database_hash) +
-                      ", this database's is " + std::to_string(database.content_hash()) + ")");
+    return make_error("cluster table: built from another database (database hash " + hash_hex(t.database_hash) +
+                      ", this database's is " + hash_hex(database.content_hash()) + ")");
   }
   if (t.dims != dims) {
     return make_error("cluster table: " + std::to_string(t.dims) + " dims, the database has " + std::to_string(dims));

@@ -1,104 +1,91 @@
 #include "mmvk/file_io.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 
 namespace mmvk {
 
 namespace {
-std::string describe_errno(const std::filesystem::path& path, const char* what) {
-  return path.string() + ": " + what + ": " + std::strerror(errno);
+
+namespace fs = std::filesystem;
+
+std::string describe_errno(const fs::path& path, const char* what, int error = errno) {
+  return path.string() + ": " + what + ": " + std::strerror(error);
 }
+
+const char* file_kind(mode_t mode) {
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+Error too_large(const fs::path& path, std::uint64_t bytes, bool at_least, std::uint64_t limit) {
+  const std::string name = limit == kMaxFileBytes ? " (kMaxFileBytes) for one mmvk input file" : " bytes for this input";
+  return make_error(path.string() + ": " + (at_least ? "more than " : "") + std::to_string(bytes) +
+                    " bytes, over the limit of " + std::to_string(limit) + name);
+}
+
+// Closes the descriptor on every path out of read_file.
+struct Descriptor {
+  int fd = -1;
+  ~Descriptor() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
 }  // namespace
 
-Result<std::string> read_file(const std::filesystem::path& path) {
-  // An ifstream opens a directory and reads it as empty, which every loader
-  // would then report as an empty or truncated file.
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) return make_error(path.string() + ": is a directory, expected a file");
-  // A regular file's size is known up front; anything else (a pipe, a
-  // device such as /dev/zero) is bounded while it is read.
-  const std::uintmax_t size = std::filesystem::file_size(path, error);
-  const auto too_large = [&](std::uintmax_t bytes, const char* qualifier) {
-    return make_error(path.string() + ": " + qualifier + std::to_string(bytes) + " bytes, over the limit of " +
-                      std::to_string(kMaxFileBytes) + " (kMaxFileBytes) for one mmvk input file");
-  };
-  if (!error && size > kMaxFileBytes) return too_large(size, "");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(path.string() + ": cannot open for reading");
+Result<std::string> read_file(const fs::path& path, const ReadOptions& options) {
+  // Checked before the file is opened: opening a device can have effects
+  // of its own (a tape rewinds, a watchdog arms), and a FIFO opened for
+  // reading blocks until someone writes.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return make_error(path.string() + ": no such file");
+    return make_error(describe_errno(path, "cannot open for reading"));
+  }
+  if (S_ISDIR(st.st_mode)) return make_error(path.string() + ": is a directory, expected a file");
+  if (!S_ISREG(st.st_mode) && !options.allow_stream) {
+    return make_error(path.string() + ": is " + file_kind(st.st_mode) + ", not a regular file (read from files only)");
+  }
+  if (S_ISREG(st.st_mode) && std::uint64_t(st.st_size) > options.max_bytes) {
+    return too_large(path, std::uint64_t(st.st_size), false, options.max_bytes);
+  }
+  // O_NONBLOCK: a FIFO replaced in between cannot block the open either.
+  Descriptor file{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)};
+  if (file.fd < 0) return make_error(describe_errno(path, "cannot open for reading"));
+  struct stat opened {};
+  if (::fstat(file.fd, &opened) != 0) return make_error(describe_errno(path, "cannot read"));
+  if (S_ISDIR(opened.st_mode) || (!S_ISREG(opened.st_mode) && !options.allow_stream)) {
+    return make_error(path.string() + ": changed while it was opened; not read");
+  }
+  // Reads block from here on: a stream's writer is waited for (a FIFO that
+  // no one had open at the open() reads as empty instead).
+  if (!S_ISREG(opened.st_mode)) ::fcntl(file.fd, F_SETFL, ::fcntl(file.fd, F_GETFL) & ~O_NONBLOCK);
   std::string contents;
-  if (!error) contents.reserve(static_cast<std::size_t>(size));
+  if (S_ISREG(opened.st_mode)) contents.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(
+                                   std::uint64_t(opened.st_size), options.max_bytes)));
   std::array<char, 1 << 16> chunk;
-  while (in) {
-    in.read(chunk.data(), chunk.size());
-    const std::size_t got = static_cast<std::size_t>(in.gcount());
-    if (contents.size() + got > kMaxFileBytes) return too_large(contents.size() + got, "more than ");
-    contents.append(chunk.data(), got);
-  }
-  if (in.bad()) return make_error(path.string() + ": read error");
-  return contents;
-}
-
-Status check_writable(const std::filesystem::path& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) return make_error(path.string() + ": is a directory, expected a file");
-  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(folder, error)) {
-    return make_error(path.string() + ": cannot write there: folder " + folder.string() + " does not exist");
-  }
-  if (::access(folder.c_str(), W_OK) != 0) return make_error(describe_errno(folder, "cannot write in this folder"));
-  return {};
-}
-
-Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
-  // The temp file lives beside the target so rename() stays on one file system.
-  std::filesystem::path temp = path;
-  temp += ".tmp-" + std::to_string(::getpid());
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return make_error(describe_errno(temp, "cannot create"));
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      Error error = make_error(describe_errno(temp, "write failed"));
-      ::close(fd);
-      ::unlink(temp.c_str());
-      return error;
+  for (;;) {
+    const ssize_t got = ::read(file.fd, chunk.data(), chunk.size());
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) return make_error(describe_errno(path, "read error"));
+    if (got == 0) break;
+    if (contents.size() + std::size_t(got) > options.max_bytes) {
+      return too_large(path, contents.size() + std::size_t(got), true, options.max_bytes);
     }
-    written += static_cast<std::size_t>(n);
+    contents.append(chunk.data(), std::size_t(got));
   }
-  if (::fsync(fd) != 0) {
-    Error error = make_error(describe_errno(temp, "fsync failed"));
-    ::close(fd);
-    ::unlink(temp.c_str());
-    return error;
-  }
-  if (::close(fd) != 0) {
-    Error error = make_error(describe_errno(temp, "close failed"));
-    ::unlink(temp.c_str());
-    return error;
-  }
-  if (::rename(temp.c_str(), path.c_str()) != 0) {
-    Error error = make_error(describe_errno(path, "cannot replace"));
-    ::unlink(temp.c_str());
-    return error;
-  }
-  // Make the rename itself durable.
-  std::filesystem::path dir = path.parent_path();
-  if (dir.empty()) dir = ".";
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
-  return {};
+  return contents;
 }
 
 void append_f32_le(std::string& bytes, std::span<const float> values) {
@@ -131,9 +118,9 @@ void decode_f32_le(std::string_view bytes, std::span<float> values) {
 }
 
 Result<std::vector<float>> read_f32_rows(const std::filesystem::path& path, std::uint32_t cols,
-                                         std::optional<std::uint64_t> expected_rows) {
+                                         std::optional<std::uint64_t> expected_rows, const ReadOptions& options) {
   if (cols == 0) return make_error(path.string() + ": a float32 row file needs at least one value per row");
-  MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(path));
+  MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(path, options));
   const std::size_t row_bytes = std::size_t{cols} * 4;
   if (expected_rows && bytes.size() != *expected_rows * row_bytes) {
     return make_error(path.string() + ": " + std::to_string(bytes.size()) + " bytes, expected " +

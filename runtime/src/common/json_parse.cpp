@@ -1,5 +1,7 @@
 #include "common/json_parse.hpp"
 
+#include "mmvk/json_check.hpp"
+
 #include <cmath>
 #include <set>
 #include <vector>
@@ -8,6 +10,12 @@ namespace mmvk::detail {
 
 Result<nlohmann::json> parse_json_text(std::string_view text, const std::string& source) {
   using Json = nlohmann::json;
+  // nlohmann's lexer reads a NUL byte as the end of the input, which would
+  // accept anything after one; JSON text holds none (control characters in
+  // strings are escaped).
+  if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    return make_error(source + ": a NUL byte at offset " + std::to_string(nul) + " (not JSON text)");
+  }
   // The keys seen so far in each object being parsed, innermost last.
   std::vector<std::set<std::string>> open_objects;
   std::string duplicate;
@@ -36,3 +44,11 @@ Result<float> json_float(const nlohmann::json& value, const std::string& where) 
 }
 
 }  // namespace mmvk::detail
+
+namespace mmvk {
+
+Status check_json_text(std::string_view text, std::string_view source) {
+  return detail::parse_json_text(text, std::string(source)).status();
+}
+
+}  // namespace mmvk

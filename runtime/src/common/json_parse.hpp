@@ -13,7 +13,8 @@
 
 namespace mmvk::detail {
 
-// Parses `text`; errors name `source`: "not valid JSON", or a duplicate key.
+// Parses `text`; errors name `source`: "not valid JSON" (bytes after the
+// value included), a NUL byte, or a duplicate key (mmvk/json_check.hpp).
 Result<nlohmann::json> parse_json_text(std::string_view text, const std::string& source);
 
 // A JSON number as a finite float; errors name `where` ("expected a number",

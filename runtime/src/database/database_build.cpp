@@ -12,6 +12,7 @@
 #include "mmvk/features.hpp"
 #include "mmvk/normalization.hpp"
 #include "database/animation_build.hpp"
+#include "database/cost_overflow.hpp"
 
 namespace mmvk {
 
@@ -439,7 +440,10 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     for (ProcessedClip& processed : clip.clips) clips.push_back(std::move(processed));
     clip.clips.clear();
   }
-  return assemble(clips, manifest.schema, fps, manifest.contacts, options.animation, manifest.mirror_bones, source);
+  MMVK_ASSIGN_OR_RETURN(Database database,
+                        assemble(clips, manifest.schema, fps, manifest.contacts, options.animation, manifest.mirror_bones, source));
+  MMVK_TRY(detail::check_cost_overflow(database, source));
+  return database;
 }
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings) {
@@ -457,8 +461,10 @@ Result<Database> build_database_from_motions(std::span<const MotionClip> clips, 
     if (!one.ok()) return one.error();
     processed.push_back(std::move(*one));
   }
-  return assemble(processed, settings.schema, fps, settings.contacts, settings.animation, {},
-                  "build_database_from_motions");
+  MMVK_ASSIGN_OR_RETURN(Database database, assemble(processed, settings.schema, fps, settings.contacts,
+                                                    settings.animation, {}, "build_database_from_motions"));
+  MMVK_TRY(detail::check_cost_overflow(database, "build_database_from_motions"));
+  return database;
 }
 
 }  // namespace mmvk

@@ -339,7 +339,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
       if (!loaded.ok()) return make_error(at + "schema: " + loaded.message());
       manifest.schema = std::move(*loaded);
     } else if (schema.is_object()) {
-      Result<FeatureSchema> parsed = parse_schema_json(schema.dump(), name + ": schema");
+      Result<FeatureSchema> parsed = parse_schema_json(schema.dump(-1, ' ', false, Json::error_handler_t::replace), name + ": schema");
       if (!parsed.ok()) return parsed.error();
       manifest.schema = std::move(*parsed);
     } else {
@@ -426,7 +426,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
 #undef MMVK_READ
 
 Result<Manifest> load_manifest(const std::filesystem::path& path) {
-  Result<std::string> text = read_file(path);
+  Result<std::string> text = read_file(path, ReadOptions{kMaxJsonBytes, false});
   if (!text.ok()) return text.error();
   return parse_manifest_json(*text, path.string(), path.parent_path());
 }

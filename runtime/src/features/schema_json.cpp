@@ -37,6 +37,10 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
   }
   channel.kind = info->kind;
   if (object.contains("bone")) {
+    // Unknown fields are errors, and so is a field the kind would ignore.
+    if (!has_field(info->fields, ChannelField::Bone)) {
+      return make_error(where + ".bone: a " + kind + " channel reads no bone");
+    }
     if (!object["bone"].is_string()) return make_error(where + ".bone: expected a string");
     channel.bone = object["bone"].get<std::string>();
   }
@@ -148,7 +152,7 @@ Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_
 }
 
 Result<FeatureSchema> load_schema(const std::filesystem::path& path) {
-  Result<std::string> text = read_file(path);
+  Result<std::string> text = read_file(path, ReadOptions{kMaxJsonBytes, false});
   if (!text.ok()) return text.error();
   return parse_schema_json(*text, path.string());
 }
@@ -174,7 +178,7 @@ std::string schema_to_json(const FeatureSchema& schema) {
   }
   Json root;
   root["channels"] = std::move(channels);
-  return root.dump(2);
+  return root.dump(2, ' ', false, Json::error_handler_t::replace);  // names from a file: never throw on bad UTF-8
 }
 
 }  // namespace mmvk

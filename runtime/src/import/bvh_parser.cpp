@@ -173,7 +173,11 @@ class Parser {
     int line = 0;
     std::string_view token = cursor_.next_token(&line);
     if (token.empty()) return fail(line, "file is empty (expected HIERARCHY)");
-    if (!iequals(token, "HIERARCHY")) return fail(line, "expected HIERARCHY, got " + quote(token));
+    // Nothing of a file is echoed before it is known to be BVH: a manifest
+    // may name any file the user can read (/etc/shadow, run as root).
+    if (!iequals(token, "HIERARCHY")) {
+      return fail(line, "not a BVH file: expected HIERARCHY at its start (its content is not shown)");
+    }
     token = cursor_.next_token(&line);
     if (!iequals(token, "ROOT")) {
       return fail(line, "expected ROOT after HIERARCHY, got " + (token.empty() ? "end of file" : quote(token)));

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/json_parse.hpp"
+#include "search/cost_bound.hpp"
 #include "mmvk/channel_kinds.hpp"
 #include "mmvk/character.hpp"
 #include "mmvk/file_io.hpp"
@@ -124,7 +125,7 @@ Result<std::vector<PoseTarget>> parse_pose_targets_json(std::string_view json_te
 }
 
 Result<std::vector<PoseTarget>> load_pose_targets(const std::filesystem::path& path) {
-  MMVK_ASSIGN_OR_RETURN(const std::string text, read_file(path));
+  MMVK_ASSIGN_OR_RETURN(const std::string text, read_file(path, ReadOptions{kMaxJsonBytes, false}));
   return parse_pose_targets_json(text, path.string());
 }
 
@@ -139,6 +140,7 @@ Result<PoseQuery> build_pose_query(const Database& database, std::span<const Pos
   for (std::uint32_t d = 0; d < database.dims(); ++d) raw[d] = database.normalization()[d].offset;
   PoseQuery query;
   std::set<std::size_t> used;
+  std::vector<std::string> fields;  // per query.channels entry, for messages
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const PoseTarget& target = targets[i];
     const std::string where = name + ": targets[" + std::to_string(i) + "]";
@@ -159,6 +161,7 @@ Result<PoseQuery> build_pose_query(const Database& database, std::span<const Pos
       const std::uint32_t first = schema.offset(c);
       for (int k = 0; k < 3; ++k) raw[first + static_cast<std::uint32_t>(k)] = (*value)[k];
       query.channels.push_back(c);
+      fields.push_back(where + field);
     }
   }
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
@@ -166,6 +169,17 @@ Result<PoseQuery> build_pose_query(const Database& database, std::span<const Pos
   }
   query.features.resize(database.dims());
   database.normalize(raw, query.features);
+  // A target far outside the data would make every cost overflow; the
+  // search would say so without naming the target. The same bound as the
+  // search's, summed target by target to name the one that tips it over.
+  double total = 0.0;
+  for (std::size_t i = 0; i < query.channels.size(); ++i) {
+    const std::size_t c = query.channels[i];
+    total += double(query.params.channel_weights[c]) * detail::channel_distance_bound(database, query.features, c);
+    if (!(double(database.max_multiplier()) * total + double(database.max_abs_bias()) <= detail::kMaxCostBound)) {
+      return make_error(fields[i] + ": too far from anything in the database (its costs would overflow float)");
+    }
+  }
   return query;
 }
 

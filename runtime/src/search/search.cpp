@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "search/cost_bound.hpp"
+
 namespace mmvk {
 
 namespace {
@@ -13,18 +15,9 @@ namespace {
 // + |bias|, times the continuing multiplier when above 1, + |continuing bias|.
 double cost_bound(const Database& database, std::span<const float> query, const QueryParams& params,
                   double max_multiplier, double max_abs_bias) {
-  const FeatureSchema& schema = database.schema();
-  const std::span<const float> max_abs = database.max_abs_features();
   double total = 0.0;
-  std::uint32_t d = 0;
-  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
-    const std::uint32_t end = d + schema.channels[c].dims();
-    double channel = 0.0;
-    for (; d < end; ++d) {
-      const double diff = std::fabs(double(query[d])) + double(max_abs[d]);
-      channel += diff * diff;
-    }
-    total += double(params.channel_weights[c]) * channel;
+  for (std::size_t c = 0; c < database.schema().channels.size(); ++c) {
+    total += double(params.channel_weights[c]) * detail::channel_distance_bound(database, query, c);
   }
   const double base = max_multiplier * total + max_abs_bias;
   return base * std::max(1.0, double(params.continuing_multiplier)) + std::fabs(double(params.continuing_bias));
@@ -86,7 +79,7 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
   // garbage. Half of FLT_MAX leaves room for the float rounding of the sums.
   const double max_multiplier = database.max_multiplier();
   const double max_abs_bias = database.max_abs_bias();
-  const double limit = 0.5 * double(std::numeric_limits<float>::max());
+  const double limit = detail::kMaxCostBound;
   const QueryParams defaults;
   for (std::size_t q = 0; q < batch.size; ++q) {
     const QueryParams& p = batch.params.empty() ? defaults : batch.params[q];

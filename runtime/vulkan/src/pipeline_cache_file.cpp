@@ -16,6 +16,8 @@ constexpr char kMagic[8] = {'M', 'M', 'V', 'K', 'P', 'C', 'F', '1'};
 constexpr std::uint32_t kVersion = 1;
 // magic, version, reserved, blob size, checksum
 constexpr std::size_t kFrameBytes = sizeof(kMagic) + 4 + 4 + 8 + 8;
+// Drivers' caches of mmvk's few kernels are a few MB; more is not ours.
+constexpr std::uint64_t kMaxPipelineCacheBytes = std::uint64_t{256} << 20;
 
 void append_le(std::string& out, std::uint64_t value, std::size_t bytes) {
   for (std::size_t b = 0; b < bytes; ++b) out.push_back(static_cast<char>((value >> (8 * b)) & 0xFF));
@@ -77,7 +79,9 @@ std::string load_pipeline_cache_file(Context& context, const std::filesystem::pa
   const std::filesystem::path path = pipeline_cache_file(context, directory);
   std::error_code error;
   if (!std::filesystem::exists(path, error)) return {};  // the first run on this device
-  Result<std::string> bytes = read_file(path);
+  // A regular file only: a symlink to /dev/zero or a FIFO planted in the
+  // cache folder fails at once instead of being read or blocking.
+  Result<std::string> bytes = read_file(path, ReadOptions{kMaxPipelineCacheBytes, false});
   if (!bytes) return bytes.message() + "; the pipeline cache starts empty";
   Result<std::vector<std::byte>> blob = decode_pipeline_cache_file(*bytes);
   if (!blob) return path.string() + ": " + blob.message() + "; ignored, the pipeline cache starts empty";
@@ -91,7 +95,10 @@ Status save_pipeline_cache_file(const Context& context, const std::filesystem::p
   std::error_code error;
   std::filesystem::create_directories(directory, error);
   if (error) return make_error(directory.string() + ": cannot create the cache directory: " + error.message());
-  return write_file_atomically(pipeline_cache_file(context, directory), encode_pipeline_cache_file(blob));
+  // A cache entry: whatever stands at its name (a symlink, a device node) is
+  // replaced, never written through.
+  return write_file_atomically(pipeline_cache_file(context, directory), encode_pipeline_cache_file(blob),
+                               OutputPolicy::CacheEntry);
 }
 
 }  // namespace mmvk::vulkan

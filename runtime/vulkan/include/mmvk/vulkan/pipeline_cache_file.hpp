@@ -36,13 +36,15 @@ Result<std::vector<std::byte>> decode_pipeline_cache_file(std::string_view bytes
 
 // Merges the device's file in `directory` into the Context's cache.
 // Returns "" when it was used or does not exist yet, otherwise a note for
-// the user saying why it was ignored (unreadable, damaged, another driver
-// build); never fails, the cache stays usable either way.
+// the user saying why it was ignored (not a regular file, over 256 MiB,
+// unreadable, damaged, another driver build); never fails, the cache stays
+// usable either way.
 std::string load_pipeline_cache_file(Context& context, const std::filesystem::path& directory);
 
 // Writes the Context's current cache to its file in `directory` (created
 // with its parents if missing), atomically: a crash mid-write leaves the
-// previous file. Errors name the path.
+// previous file, and whatever stood at the file's name (a symlink, a device
+// node) is replaced, never written through. Errors name the path.
 Status save_pipeline_cache_file(const Context& context, const std::filesystem::path& directory);
 
 }  // namespace mmvk::vulkan

@@ -1,0 +1,38 @@
+#include "crowd_paths.hpp"
+
+#include <system_error>
+
+#include "mmvk/manifest.hpp"
+#include "trace.hpp"
+
+namespace mmvk::crowd {
+
+std::vector<NamedPath> crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source) {
+  std::vector<NamedPath> paths;
+  const std::string data = options.data ? "--data" : "the default data";
+  paths.push_back({data, data_source, false});
+  // A manifest or a folder: the files its build reads are inputs too. A
+  // manifest that does not load is reported by the run itself.
+  std::error_code ec;
+  if (data_source.extension() != ".mmdb" && std::filesystem::exists(data_source, ec)) {
+    if (Result<Manifest> manifest = load_manifest_or_directory(data_source); manifest) {
+      for (const std::filesystem::path& file : manifest_input_files(*manifest)) {
+        paths.push_back({"a clip of " + data, file, false});
+      }
+    }
+  }
+  if (options.scenario) paths.push_back({"--scenario", *options.scenario, false});
+  if (options.summary) paths.push_back({"--summary", *options.summary, true});
+  if (options.html) paths.push_back({"--html", *options.html, true});
+  if (options.trace) {
+    paths.push_back({"--trace", *options.trace, true});
+    paths.push_back({"the trace's sidecar (--trace + .json)", trace_sidecar_path(*options.trace), true});
+  }
+  return paths;
+}
+
+Status check_crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source) {
+  return check_command_paths(crowd_paths(options, data_source));
+}
+
+}  // namespace mmvk::crowd

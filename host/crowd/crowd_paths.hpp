@@ -1,0 +1,23 @@
+// The crowd's paths, checked before the database is opened or a tick runs:
+// every output (--summary, --html, --trace and its sidecar) writable, and
+// none of them the same file as an input (the data, the BVH and sidecars
+// its manifest or folder names, --scenario) or as another output. Before this check the crowd found a bad
+// output path only after the simulation, and `--html c.mmdb --data c.mmdb`
+// replaced the database with the page.
+#pragma once
+
+#include <vector>
+
+#include "crowd_options.hpp"
+#include "mmvk/file_io.hpp"
+#include "mmvk/status.hpp"
+
+namespace mmvk::crowd {
+
+// The run's paths as check_command_paths takes them, named by option.
+// `data_source`: the .mmdb, manifest or folder the run reads (choose_data's
+// source: --data, a shipped set's manifest or the default one).
+std::vector<NamedPath> crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source);
+Status check_crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source);
+
+}  // namespace mmvk::crowd

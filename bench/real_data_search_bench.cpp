@@ -90,7 +90,7 @@ Fixture* fixture(DataSet set) {
     if (clusters != nullptr) params.clusters = static_cast<std::uint32_t>(std::strtoul(clusters, nullptr, 10));
     const std::string suffix = params.clusters == 0 ? "" : "-c" + std::to_string(params.clusters);
     const std::filesystem::path cache =
-        std::filesystem::path(MMVK_BENCH_WORK_DIR) / (std::string(data_set_name(set)) + suffix + ".mmkc");
+        bench_work_dir() / (std::string(data_set_name(set)) + suffix + ".mmkc");
     Result<ClusterTable> table = load_cluster_table(cache);
     if (!table || !validate_cluster_table(*table, *f->db).ok()) {
       table = train_cluster_table(*f->db, params, f->pool);

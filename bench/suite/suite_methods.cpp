@@ -197,6 +197,7 @@ struct SuiteMethodFactory::Shared {
     if (method.build_s == 0.0) method.build_s = seconds_since(start);
     method.exact = peer->exact();
     method.index_bytes = double(peer->index_bytes());
+    method.settings = peer->settings();
     method.backend = std::move(peer);
     return method;
   }

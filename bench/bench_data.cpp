@@ -28,7 +28,6 @@ fs::path data_dir() {
   return from_env && *from_env ? fs::path(from_env) : fs::path(MMVK_DEFAULT_DATA_DIR);
 }
 
-fs::path work_dir() { return MMVK_BENCH_WORK_DIR; }
 
 // Unpacks the Bandai volume archives into the build tree once (never into the
 // shared data folder); a marker file records a completed unpack.
@@ -60,7 +59,7 @@ Result<Manifest> manifest_for(DataSet set) {
   const fs::path locomotion = data_dir() / "bandai-namco-nc" / "locomotion-normal";
   Result<Manifest> manifest = manifest_from_directory(locomotion);
   if (!manifest || set == DataSet::Locomotion) return manifest;
-  const fs::path volume = work_dir() / "volume";
+  const fs::path volume = bench_work_dir() / "volume";
   if (!unpack_volume(volume)) return make_error("bench: the volume archives could not be unpacked");
   for (const char* dataset : {"Bandai-Namco-Research-Motiondataset-1", "Bandai-Namco-Research-Motiondataset-2"}) {
     Result<Manifest> part = manifest_from_directory(volume / dataset / "data");
@@ -89,7 +88,7 @@ struct Variant {
 };
 
 std::unique_ptr<Database> load_or_build(DataSet set, const Variant& variant) {
-  const fs::path cache = work_dir() / (variant.cache_name + ".mmdb");
+  const fs::path cache = bench_work_dir() / (variant.cache_name + ".mmdb");
   if (fs::exists(cache)) {
     Result<Database> loaded = load_database(cache);
     // A cache from before the animation section (format 1) is rebuilt: the
@@ -118,7 +117,7 @@ std::unique_ptr<Database> load_or_build(DataSet set, const Variant& variant) {
     std::fprintf(stderr, "bench: %s\n", built.message().c_str());
     return nullptr;
   }
-  fs::create_directories(work_dir());
+  fs::create_directories(bench_work_dir());
   if (Status saved = save_database(*built, cache); !saved) {
     std::fprintf(stderr, "bench: cannot cache the database: %s\n", saved.message().c_str());
   }
@@ -126,6 +125,11 @@ std::unique_ptr<Database> load_or_build(DataSet set, const Variant& variant) {
 }
 
 }  // namespace
+
+fs::path bench_work_dir() {
+  const char* from_env = std::getenv("MMVK_BENCH_WORK_DIR");
+  return from_env && *from_env ? fs::path(from_env) : fs::path(MMVK_BENCH_WORK_DIR);
+}
 
 std::string_view data_set_name(DataSet set) {
   switch (set) {

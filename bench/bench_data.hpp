@@ -26,6 +26,11 @@ enum class DataSet { Locomotion, Volume, VolumeMirrored, Volume104k };
 
 std::string_view data_set_name(DataSet set);
 
+// Where unpacked archives and cached databases and tables live:
+// MMVK_BENCH_WORK_DIR from the environment when set (a build carried to
+// another machine, bench/gpu_check.sh), else build/bench-data.
+std::filesystem::path bench_work_dir();
+
 // The database for `set`, built (or loaded from the cache) on first use.
 // Returns nullptr after printing why when the data is missing or the build
 // fails; the benchmark then reports an error instead of a number.

@@ -12,7 +12,9 @@
 // ([tile][dim][16], what any SIMD loop over rows wants), queries split over
 // the threads, and for each block of rows that fits in L2 every query of the
 // thread walks it, four tiles at a time (four independent sums hide the add
-// latency). Widest of AVX-512F / AVX2 / SSE2 that the CPU runs.
+// latency). plain-loop: the widest of AVX-512F / AVX2 / SSE2 that the CPU
+// runs; plain-loop-avx2: the 256-bit loop, the yardstick of the AVX2
+// kernels (fast-brute-avx2) on a CPU that also has AVX-512F.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -92,19 +94,28 @@ float min_avx512(const float* x, std::size_t d, std::size_t a, std::size_t b, co
 #pragma GCC pop_options
 #endif
 
-std::pair<MinFn, const char*> pick() {
+// The loop of one instruction set: `avx2_only` holds the 256-bit loop
+// (the plain-loop-avx2 rows, beside fast-brute-avx2), else the widest the
+// CPU runs. {nullptr, reason} when the CPU lacks the set.
+std::pair<MinFn, const char*> pick(bool avx2_only) {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f")) return {min_avx512, "avx512f"};
+  if (!avx2_only && __builtin_cpu_supports("avx512f")) return {min_avx512, "avx512f"};
   if (__builtin_cpu_supports("avx2")) return {min_avx2, "avx2"};
 #endif
+  if (avx2_only) return {nullptr, "no AVX2 on this CPU"};
   return {min_sse2, "sse2"};
 }
 
-void plain_loop(benchmark::State& state, DataSet set, QueryStream stream) {
+void plain_loop(benchmark::State& state, DataSet set, QueryStream stream, bool avx2_only) {
   const Database* db = database(set);
   if (db == nullptr) {
     state.SkipWithError("database unavailable (see stderr)");
+    return;
+  }
+  const auto [fn, isa] = pick(avx2_only);
+  if (fn == nullptr) {
+    state.SkipWithError(isa);
     return;
   }
   const std::size_t batch = static_cast<std::size_t>(state.range(0));
@@ -118,7 +129,6 @@ void plain_loop(benchmark::State& state, DataSet set, QueryStream stream) {
     for (std::size_t d = 0; d < dims; ++d) x[((f / kRows) * dims + d) * kRows + f % kRows] = row[d];
   }
   const std::vector<float> queries = make_queries(*db, stream, batch);
-  const auto [fn, isa] = pick();
   ThreadPool pool;  // all cores, as the fixture of the fast-brute rows
   std::vector<float> best(batch);
   const double cpu_start = process_cpu_seconds();
@@ -145,10 +155,12 @@ void plain_loop(benchmark::State& state, DataSet set, QueryStream stream) {
 const bool registered = [] {
   for (DataSet set : {DataSet::Locomotion, DataSet::Volume, DataSet::VolumeMirrored}) {
     for (QueryStream stream : {QueryStream::Transition}) {
-      const std::string name =
-          "real/" + std::string(data_set_name(set)) + "/" + std::string(query_stream_name(stream)) + "/plain-loop";
-      auto* b = benchmark::RegisterBenchmark(name.c_str(), plain_loop, set, stream);
-      b->ArgName("B")->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
+      for (const bool avx2_only : {false, true}) {
+        const std::string name = "real/" + std::string(data_set_name(set)) + "/" + std::string(query_stream_name(stream)) +
+                                 (avx2_only ? "/plain-loop-avx2" : "/plain-loop");
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), plain_loop, set, stream, avx2_only);
+        b->ArgName("B")->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond)->UseRealTime();
+      }
     }
   }
   return true;

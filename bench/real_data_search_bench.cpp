@@ -39,12 +39,18 @@ struct Variant {
   // clusters-per-query: issue 10's additions off (no grouping by cluster,
   // no span boxes, no split single query), for before/after in one run.
   bool per_query = false;
+  // The instruction set of the tile kernels: the *-avx2 rows hold the
+  // 256-bit kernels to the 256-bit plain loop (plain-loop-avx2) on a CPU
+  // that also has AVX-512F.
+  CpuKernels kernels = CpuKernels::Widest;
 };
 
 const std::vector<Variant>& variants() {
   static const std::vector<Variant> all = [] {
     std::vector<Variant> v = {{"reference", "reference"}, {"fast-brute", "fast-brute"}, {"fast-box", "fast-box"},
-                              {"clusters", "clusters"}, {"clusters-per-query", "clusters", 0, true}};
+                              {"clusters", "clusters"}, {"clusters-per-query", "clusters", 0, true},
+                              {"fast-brute-avx2", "fast-brute", 0, false, CpuKernels::Avx2},
+                              {"clusters-avx2", "clusters", 0, false, CpuKernels::Avx2}};
     for (const std::uint32_t nprobe : {1u, 4u, 8u, 16u, 32u, 64u}) {
       v.push_back({"clusters-nprobe" + std::to_string(nprobe), "clusters-nprobe", nprobe});
     }
@@ -84,7 +90,7 @@ Fixture* fixture(DataSet set) {
     if (clusters != nullptr) params.clusters = static_cast<std::uint32_t>(std::strtoul(clusters, nullptr, 10));
     const std::string suffix = params.clusters == 0 ? "" : "-c" + std::to_string(params.clusters);
     const std::filesystem::path cache =
-        std::filesystem::path(MMVK_BENCH_WORK_DIR) / (std::string(data_set_name(set)) + suffix + ".mmkc");
+        bench_work_dir() / (std::string(data_set_name(set)) + suffix + ".mmkc");
     Result<ClusterTable> table = load_cluster_table(cache);
     if (!table || !validate_cluster_table(*table, *f->db).ok()) {
       table = train_cluster_table(*f->db, params, f->pool);
@@ -99,6 +105,8 @@ Fixture* fixture(DataSet set) {
       for (const Variant& variant : variants()) {
         BackendSpec spec{.name = variant.backend, .pool = &f->pool, .clusters = &f->table};
         spec.nprobe = variant.nprobe;
+        spec.fast.kernels = variant.kernels;
+        spec.cluster.kernels = variant.kernels;
         // Tuning switches (MMVK_BENCH_PROBE_BY_BOUND=1, MMVK_BENCH_NO_SEED=1).
         spec.cluster.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
         spec.cluster.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;

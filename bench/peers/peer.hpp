@@ -37,6 +37,9 @@ class PeerBackend : public SearchBackend {
   // True when the peer returns the reference's frames (box-scan); FAISS flat
   // is exact up to float near-ties and says false.
   virtual bool exact() const = 0;
+  // The settings the peer chose for this machine and how (a sweep's
+  // figures), for the suite's record; empty when it has none to choose.
+  virtual std::string settings() const { return {}; }
 
  protected:
   // `database` must outlive the peer.

@@ -224,6 +224,7 @@ void run_cell(benchmark::State& state, DataSet set, SuiteSchema schema, QueryStr
   state.counters["kernel_us_per_query"] = kernel_s * 1e6 / queries;
   state.counters["N"] = db.frame_count();
   state.counters["dims"] = db.dims();
+  if (!method->settings.empty()) state.SetLabel(method->settings);
 }
 
 // Registered dataset, schema, method, stream, batch: the order the cells

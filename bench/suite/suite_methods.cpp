@@ -7,6 +7,7 @@
 #include <optional>
 #include <utility>
 
+#include "bench_data.hpp"
 #include "mmvk/backends.hpp"
 #include "peer.hpp"
 #include "box_scan.hpp"
@@ -111,7 +112,7 @@ struct SuiteMethodFactory::Shared {
   double pca_s = 0.0;
 #endif
 
-  fs::path cache(const std::string& extension) const { return fs::path(MMVK_BENCH_WORK_DIR) / (stem + extension); }
+  fs::path cache(const std::string& extension) const { return bench_work_dir() / (stem + extension); }
 
   // k-means with the defaults (round(sqrt N) clusters), cached with the
   // seconds its training took beside it.
@@ -196,6 +197,7 @@ struct SuiteMethodFactory::Shared {
     if (method.build_s == 0.0) method.build_s = seconds_since(start);
     method.exact = peer->exact();
     method.index_bytes = double(peer->index_bytes());
+    method.settings = peer->settings();
     method.backend = std::move(peer);
     return method;
   }

@@ -41,6 +41,9 @@ struct SuiteMethod {
   double index_bytes = 0.0;   // host bytes beyond the database's feature matrix
   double device_bytes = 0.0;  // VulkanSearch::device_bytes(): database, tables, slots' scratch
   vulkan::VulkanSearch* vulkan = nullptr;  // for kernel timestamps
+  // A peer's settings for this machine and the sweep that chose them
+  // (PeerBackend::settings), the cell's label.
+  std::string settings;
 };
 
 // What the methods of one database share, made on first use by the

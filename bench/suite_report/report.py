@@ -60,6 +60,10 @@ def _machine_lines(machine, data):
     policies = sorted({c["omp_wait_policy"] for c in data.contexts if c.get("omp_wait_policy")})
     if policies:
         lines.append(f"- OpenMP (FAISS, OpenBLAS): `OMP_WAIT_POLICY={', '.join(policies)}`.")
+    blas = sorted({c["blas"] for c in data.contexts if c.get("blas")})
+    if blas:
+        lines.append(f"- BLAS under FAISS: {'; '.join(blas)} (FAISS's threads and BLAS block: each FAISS cell's "
+                     "label in the JSON, chosen by a sweep; bench/peers/README.md).")
     load = ", ".join(f"{x:.1f}" for x in m.load_avg) if m.load_avg else "?"
     lines.append(f"- Load average at the start of the first file: {load}; Google Benchmark's date: {m.date or '?'}.")
     return lines

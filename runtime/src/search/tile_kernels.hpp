@@ -69,9 +69,11 @@ struct Kernels {
   void (*box_bounds)(const BoxArrays& boxes, std::size_t first_pack, std::size_t pack_count, const float* query,
                      const float* weights, float* out);
   const char* name;  // "avx512f", "avx2" or "generic"
-  // Queries per brute-force pass whose sums fit the registers: 4 with
+  // Queries per brute-force pass, which share each row load: 4 with
   // AVX-512's 32 registers of one tile each (1.2x faster than 2 on the
-  // Bandai volume set), 2 where a tile takes 2 or 4 of 16 registers.
+  // Bandai volume set) and with AVX2 (a tile is 2 of 16 registers; 4
+  // queries ran 1.18x faster than 2 on Bandai-sized rows), 2 with SSE2 (a
+  // tile is 4 registers).
   std::uint32_t brute_queries;
 };
 

@@ -32,9 +32,7 @@
 #include "steering.hpp"
 #include "trace.hpp"
 
-#if defined(MMVK_CROWD_HAS_VIEWER)
 #include "viewer/viewer_html.hpp"
-#endif
 
 namespace mmvk::crowd {
 
@@ -352,14 +350,10 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
     s.trace = options.trace->string();
   }
   if (options.html) {
-#if defined(MMVK_CROWD_HAS_VIEWER)
     Recording recording = recorder->finish(pool);
     MMVK_ASSIGN_OR_RETURN(const std::size_t bytes, write_viewer_html(*options.html, recording));
     s.html = options.html->string();
     s.html_bytes = bytes;
-#else
-    return make_error("--html: this mmvk was built without the crowd viewer");
-#endif
   }
   return s;
 }

@@ -6,11 +6,12 @@
 #include <cassert>
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
 #include "mmvk/channel_kinds.hpp"
 #include "mmvk/character.hpp"
+#include "mmvk/features.hpp"
 #include "mmvk/foot_contacts.hpp"
-
-#include <glm/geometric.hpp>
 
 namespace mmvk {
 
@@ -102,8 +103,10 @@ Status QueryAssembler::plan_shown(const Database& database) {
     switch (info.shown) {
       case ShownSource::Trajectory:
         for (std::size_t i = 0; i < channel.offsets_seconds.size(); ++i) {
-          const float ago = -channel.offsets_seconds[i];
-          if (ago <= 0.0f) continue;
+          if (channel.offsets_seconds[i] >= 0.0f) continue;
+          // The build sampled the past at whole frames: so does the query.
+          const float ago =
+              -float(signed_offset_frames(channel.offsets_seconds[i], database.fps())) / database.fps();
           auto found = std::find(past_offsets_.begin(), past_offsets_.end(), ago);
           if (found == past_offsets_.end()) found = past_offsets_.insert(past_offsets_.end(), ago);
           past_slots_.push_back({first + 2 * static_cast<std::uint32_t>(i),

@@ -204,6 +204,43 @@ TEST(QueryAssembly, TrajectoryInCharacterSpaceAndPoseFromTheFrame) {
   }
 }
 
+TEST(QueryAssembly, ShownPoseWritesEveryDimensionPastOffsetsIncluded) {
+  FeatureSchema schema = default_schema();
+  for (FeatureChannel& channel : schema.channels) {
+    // -0.01 s is sampled a whole frame back at 30 fps, as the build does.
+    if (channel.kind == ChannelKind::TrajectoryPosition) channel.offsets_seconds = {-0.5f, -0.01f, 0.5f, 1.0f};
+  }
+  const Database db = make_database(true, schema);
+  Result<QueryAssembler> assembler = QueryAssembler::create(db);
+  ASSERT_TRUE(assembler.ok()) << assembler.message();
+  ASSERT_EQ(assembler->past_offsets().size(), 2u);
+  EXPECT_FLOAT_EQ(assembler->past_offsets()[0], 0.5f);
+  EXPECT_FLOAT_EQ(assembler->past_offsets()[1], 1.0f / 30.0f);
+  const std::size_t joints = db.animation()->joint_count();
+  std::vector<glm::vec3> joint_positions(joints, glm::vec3(0.1f));
+  std::vector<glm::vec3> velocities(assembler->velocity_joints().size(), glm::vec3(0.5f));
+  const glm::vec3 past[2] = {{2.0f, 0.0f, 2.5f}, {2.0f, 0.0f, 3.0f}};
+  const float past_yaws[2] = {0.0f, 0.0f};
+  const glm::vec3 future[3] = {{2.0f, 0.0f, 3.5f}, {2.0f, 0.0f, 4.0f}, {2.0f, 0.0f, 4.0f}};
+  const float future_yaws[3] = {0.0f, 0.0f, 0.0f};
+  ShownPose shown;
+  shown.frame = 7;
+  shown.joint_positions = joint_positions;
+  shown.joint_velocities = velocities;
+  shown.past_positions = past;
+  shown.past_yaws = past_yaws;
+  std::vector<float> query(db.dims(), std::nanf(""));
+  assembler->assemble_shown(shown, QueryFrame{glm::vec3(2.0f, 0.0f, 3.0f), 0.0f}, future, future_yaws, query);
+  const FeatureSchema& s = db.schema();
+  for (std::uint32_t d = 0; d < db.dims(); ++d) EXPECT_TRUE(std::isfinite(query[d])) << s.dim_name(d);
+  // The past 0.5 s point lies 0.5 m behind the root (character space -z).
+  for (std::size_t c = 0; c < s.channels.size(); ++c) {
+    if (s.channels[c].kind != ChannelKind::TrajectoryPosition) continue;
+    const std::uint32_t z = s.offset(c) + 1;
+    EXPECT_NEAR(query[z] * db.normalization()[z].scale + db.normalization()[z].offset, -0.5f, 1e-5f);
+  }
+}
+
 TEST(QueryAssembly, NamesTheMissingTrajectoryChannel) {
   FeatureSchema schema = default_schema();
   std::erase_if(schema.channels, [](const FeatureChannel& c) { return c.kind == ChannelKind::TrajectoryPosition; });

@@ -97,7 +97,6 @@ class ClusterSearch final : public SearchBackend {
   const ClusterSearchCounters& counters() const { return counters_; }
 
   const ClusterSearchOptions& options() const { return options_; }
-  void set_nprobe(std::uint32_t nprobe) { options_.nprobe = nprobe; }
   std::uint32_t cluster_count() const;
   // The instruction set the kernels use: "avx512f", "avx2" or "generic".
   std::string_view kernel_name() const;

@@ -43,21 +43,16 @@ constexpr std::size_t kStreamQueries = 1024;
 const char* const kStreams[] = {"continue", "transition", "random"};
 constexpr std::uint32_t kBatchSizes[] = {1, 64, 1024};
 
-// The rows: registry backends (mmvk/backends.hpp) by name with the nprobe
-// and, to measure which bound helps, the bounds of the exact walk.
+// The rows: registry backends (mmvk/backends.hpp) by name with the nprobe.
 struct Variant {
   const char* label;
   const char* backend;
   std::uint32_t nprobe = 0;
-  bool box_bound = true;
-  bool radius_bound = false;
 };
 constexpr Variant kVariants[] = {
     {"fast-brute", "fast-brute"},
     {"fast-box", "fast-box"},
     {"clusters", "clusters"},
-    {"clusters+radius", "clusters", 0, true, true},
-    {"clusters-radius", "clusters", 0, false, true},
     {"clusters-nprobe1", "clusters-nprobe", 1},
     {"clusters-nprobe4", "clusters-nprobe", 4},
     {"clusters-nprobe16", "clusters-nprobe", 16},
@@ -182,8 +177,6 @@ Setup& setup_for(const std::string& label, const std::function<const Database*()
   for (const Variant& variant : kVariants) {
     BackendSpec spec{.name = variant.backend, .pool = &s.pool, .clusters = &s.table};
     spec.nprobe = variant.nprobe;
-    spec.cluster.box_bound = variant.box_bound;
-    spec.cluster.radius_bound = variant.radius_bound;
     auto backend = registry.make(spec, *s.db);
     if (!backend.ok()) {
       std::fprintf(stderr, "cluster_bench: %s\n", backend.message().c_str());

@@ -1,7 +1,7 @@
-// The calibration loop for the brute-force target of issue 10: a plain
-// vectorized loop doing the same arithmetic as an exact cost (a subtract, a
-// multiply and an add per row·dim, no FMA, since costs must stay bit-identical
-// with the reference), over the same rows, queries and threads as the
+// The calibration loop that brute force is held to: a plain vectorized
+// loop doing the same arithmetic as an exact cost (a subtract, a multiply
+// and an add per row·dim, no FMA, since costs must stay bit-identical with
+// the reference), over the same rows, queries and threads as the
 // `real/<set>/<stream>/fast-brute` rows. It keeps only the minimum (no
 // channel weights, multipliers, biases or flags: those cost per row, not per
 // row·dim), so it is what the arithmetic alone costs on this machine.

@@ -36,8 +36,8 @@ struct Variant {
   std::string label;
   std::string backend;
   std::uint32_t nprobe = 0;
-  // clusters-per-query: issue 10's additions off (no grouping by cluster,
-  // no span boxes, no split single query), for before/after in one run.
+  // clusters-per-query: the grouped walk and the span boxes off (the
+  // one-query walk the grouping replaced), for before/after in one run.
   bool per_query = false;
   // The instruction set of the tile kernels: the *-avx2 rows hold the
   // 256-bit kernels to the 256-bit plain loop (plain-loop-avx2) on a CPU
@@ -107,14 +107,11 @@ Fixture* fixture(DataSet set) {
         spec.nprobe = variant.nprobe;
         spec.fast.kernels = variant.kernels;
         spec.cluster.kernels = variant.kernels;
-        // Tuning switches (MMVK_BENCH_PROBE_BY_BOUND=1, MMVK_BENCH_NO_SEED=1).
-        spec.cluster.probe_by_bound = std::getenv("MMVK_BENCH_PROBE_BY_BOUND") != nullptr;
+        // Tuning switch (MMVK_BENCH_NO_SEED=1).
         spec.cluster.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
-        if (std::getenv("MMVK_BENCH_SPLIT") != nullptr) spec.cluster.split_single = std::getenv("MMVK_BENCH_SPLIT")[0] == '1';
         if (variant.per_query) {
           spec.cluster.batch_by_cluster = false;
           spec.cluster.span_bound = false;
-          spec.cluster.split_single = false;
         }
         Result<std::unique_ptr<SearchBackend>> made = registry.make(spec, *f->db);
         if (made) {

@@ -1,7 +1,7 @@
 // mmvk_faiss_plain: FAISS's IndexFlatL2 the way its own examples use it,
 // outside the suite's machinery, to check the suite's faiss-flat figures
-// (issue 21: they must agree within 20%) and to sweep the settings that
-// decide FAISS flat's speed on a machine:
+// (the two must agree within 20%) and to sweep the settings that decide
+// FAISS flat's speed on a machine:
 //   - OpenMP threads (omp_set_num_threads: 1 ... all cores),
 //   - FAISS's BLAS block over the database (distance_compute_blas_database_bs,
 //     default 1024 rows): each block is one sgemm and one OpenMP reduction,

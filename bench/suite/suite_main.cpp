@@ -9,16 +9,16 @@
 //   doing the work need: measured here, faiss-flat at B = 1024 on
 //   locomotion took about 5x longer than with OMP_WAIT_POLICY=passive,
 //   while mmvk's own thread pool, which sleeps on a condition variable, was
-//   unaffected. On an idle machine `active` can be faster (issue 21:
+//   unaffected. On an idle machine `active` can be faster (2 cores:
 //   302 against 475 us/query at 417k, B = 1024, 2 threads); set it to
 //   measure that.
 // - OPENBLAS_CORETYPE=SkylakeX unless the caller set a core type, when the
 //   CPU has the AVX-512 subsets those kernels use and OpenBLAS picked its
 //   AVX2 kernels (Haswell or Zen) for it: Debian's OpenBLAS 0.3.21 does not
-//   know AMD's AVX-512 CPUs. Measured on the AMD EPYC of issue 21 (417k
-//   frames, B = 1024, one thread): faiss-flat 622 -> 459 us/query. (The
-//   shared machine of issue 21 sets OPENBLAS_CORETYPE=Haswell for every
-//   process; the suite keeps a caller's choice.)
+//   know AMD's AVX-512 CPUs. Measured on a 2-core AMD EPYC (417k
+//   frames, B = 1024, one thread): faiss-flat 622 -> 459 us/query. (A
+//   machine may set OPENBLAS_CORETYPE=Haswell for every process, as the
+//   shared test machine does; the suite keeps a caller's choice.)
 //
 // FAISS's process-wide search settings (threads, BLAS block) are chosen per
 // peer by a sweep at creation (bench/peers/faiss_peers.cpp) and recorded in

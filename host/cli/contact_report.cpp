@@ -13,8 +13,8 @@ namespace mmvk::cli {
 
 namespace {
 
-// Above this horizontal speed a flagged point visibly slides (the issue that
-// asked for these labels counted heel strikes and toe-offs this way).
+// Above this horizontal speed a flagged point visibly slides (heel strikes
+// and toe-offs are counted this way).
 constexpr double kFastMetresPerSecond = 0.1;
 
 // One point of one foot while one of its bits is set.

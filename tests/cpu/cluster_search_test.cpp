@@ -117,17 +117,13 @@ struct Variant {
 const Variant kExactVariants[] = {
     {"exact", {}},
     {"nprobe=all", {.nprobe = 1000000}},
-    {"box + radius", {.nprobe = 0, .box_bound = true, .radius_bound = true}},
-    {"radius only", {.nprobe = 0, .box_bound = false, .radius_bound = true}},
-    {"no tile bound", {.nprobe = 0, .box_bound = true, .radius_bound = true, .tile_bound = false}},
-    {"no bounds", {.nprobe = 0, .box_bound = false, .radius_bound = false, .tile_bound = false}},
+    {"no tile bound", {.nprobe = 0, .box_bound = true, .tile_bound = false}},
+    {"no bounds", {.nprobe = 0, .box_bound = false, .tile_bound = false}},
     {"no nearest seed", {.nprobe = 0, .seed_nearest = false}},
-    {"nprobe=all by bound", {.nprobe = 1000000, .probe_by_bound = true}},
     // The SSE2 kernels the tile module falls back to (the same ones FastSearch
-    // forces with baseline_kernels).
-    {"baseline kernels", {.baseline_kernels = true}},
-    {"baseline kernels, box + radius",
-     {.nprobe = 0, .box_bound = true, .radius_bound = true, .seed_nearest = false, .baseline_kernels = true}},
+    // runs with kernels = Generic).
+    {"generic kernels", {.kernels = CpuKernels::Generic}},
+    {"generic kernels, no nearest seed", {.nprobe = 0, .seed_nearest = false, .kernels = CpuKernels::Generic}},
 };
 
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
@@ -230,25 +226,22 @@ TEST(ClusterSearch, NprobeResultsAreRealCandidatesWithTrueCosts) {
   ReferenceSearch reference(db);
   std::vector<Match> exact(count);
   ASSERT_TRUE(reference.search({features, params, count}, 1, exact).ok());
-  for (bool by_bound : {false, true}) {
-    std::size_t previous_hits = 0;
-    for (std::uint32_t nprobe : {1u, 4u, 16u}) {
-      auto backend = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .probe_by_bound = by_bound});
-      ASSERT_TRUE(backend.ok());
-      std::vector<Match> out(count);
-      ASSERT_TRUE((*backend)->search({features, params, count}, 1, out).ok());
-      std::size_t hits = 0;
-      for (std::size_t i = 0; i < count; ++i) {
-        hits += out[i].frame == exact[i].frame;
-        if (out[i].frame == kNoFrame) continue;
-        EXPECT_TRUE(is_candidate(db, out[i].frame, params[i]));
-        EXPECT_EQ(out[i].cost, frame_cost(db, out[i].frame, {features.data() + i * db.dims(), db.dims()}, params[i]));
-        EXPECT_FALSE(match_less(out[i], exact[i])) << "nprobe cannot beat exact";
-      }
-      EXPECT_GE(hits, previous_hits) << "more probes, no fewer exact hits (nprobe " << nprobe << ", by bound "
-                                     << by_bound << ")";
-      previous_hits = hits;
+  std::size_t previous_hits = 0;
+  for (std::uint32_t nprobe : {1u, 4u, 16u}) {
+    auto backend = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
+    ASSERT_TRUE(backend.ok());
+    std::vector<Match> out(count);
+    ASSERT_TRUE((*backend)->search({features, params, count}, 1, out).ok());
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+      hits += out[i].frame == exact[i].frame;
+      if (out[i].frame == kNoFrame) continue;
+      EXPECT_TRUE(is_candidate(db, out[i].frame, params[i]));
+      EXPECT_EQ(out[i].cost, frame_cost(db, out[i].frame, {features.data() + i * db.dims(), db.dims()}, params[i]));
+      EXPECT_FALSE(match_less(out[i], exact[i])) << "nprobe cannot beat exact";
     }
+    EXPECT_GE(hits, previous_hits) << "more probes, no fewer exact hits (nprobe " << nprobe << ")";
+    previous_hits = hits;
   }
 }
 
@@ -277,9 +270,10 @@ TEST(ClusterSearch, PicksTheSameKernelsAsFastSearch) {
   const ClusterTable table = make_table(db, 10);
   ThreadPool pool(1);
   for (bool baseline : {false, true}) {
-    auto clusters = ClusterSearch::create(db, table, pool, {.baseline_kernels = baseline});
+    const CpuKernels kernels = baseline ? CpuKernels::Generic : CpuKernels::Widest;
+    auto clusters = ClusterSearch::create(db, table, pool, {.kernels = kernels});
     ASSERT_TRUE(clusters.ok());
-    auto fast = FastSearch::create(db, pool, {.baseline_kernels = baseline});
+    auto fast = FastSearch::create(db, pool, {.kernels = kernels});
     ASSERT_TRUE(fast.ok());
     EXPECT_EQ((*clusters)->kernel_name(), (*fast)->kernel_name());
     std::string expected = "generic";
@@ -327,12 +321,12 @@ TEST(ClusterSearch, BadInputIsAnError) {
   EXPECT_NE(mismatched.message().find("another database"), std::string::npos) << mismatched.message();
 }
 
-// Issue 10's exact paths against the reference, under every constraint and
-// bias: the grouped batch (sub-batches of 512 queries per thread, so 1100
-// queries on 2 threads cross a sub-batch boundary), the span boxes (few
-// clusters, so clusters hold many 16-tile spans), the query split over the
-// threads (B < threads), and each alone.
-TEST(ClusterSearch, GroupedSpannedAndSplitPathsMatchTheReference) {
+// The exact paths against the reference, under every constraint and bias:
+// the grouped batch (sub-batches of 512 queries per thread, so 1100 queries
+// on 2 threads cross a sub-batch boundary), the span boxes (few clusters, so
+// clusters hold many 16-tile spans), batches smaller than the pool, and each
+// path alone.
+TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
   test::ClusteredDataSpec spec;
   spec.frames = 6000;
   const Database db = make_database(spec);
@@ -343,20 +337,18 @@ TEST(ClusterSearch, GroupedSpannedAndSplitPathsMatchTheReference) {
   const std::vector<QueryParams>& params = queries.params;
   const Variant variants[] = {
       {"all on", {}},
-      {"grouped only", {.span_bound = false, .split_single = false}},
-      {"spans only", {.span_bound = true, .batch_by_cluster = false, .split_single = false}},
-      {"all off", {.span_bound = false, .batch_by_cluster = false, .split_single = false}},
+      {"grouped only", {.span_bound = false}},
+      {"spans only", {.span_bound = true, .batch_by_cluster = false}},
+      {"all off", {.span_bound = false, .batch_by_cluster = false}},
       {"all on, no seed", {.seed_nearest = false}},
-      {"all on, box + radius", {.radius_bound = true}},
-      {"split", {.split_single = true}},
   };
   for (const std::uint32_t clusters : {3u, 40u}) {
     const ClusterTable table = make_table(db, clusters);
     for (const unsigned threads : {1u, 2u, 3u}) {
       ThreadPool pool(threads);
       for (const std::uint32_t k : {1u, 4u}) {
-        // The whole batch (grouped path), then the first 3 queries one at a
-        // time and 2 at a time (fewer queries than threads: split).
+        // The whole batch (grouped path), then the first 36 queries one at a
+        // time and 2 at a time (fewer queries than threads).
         std::vector<Match> expected(count * k);
         ASSERT_TRUE(reference.search({features, params, count}, k, expected).ok());
         for (const Variant& variant : variants) {

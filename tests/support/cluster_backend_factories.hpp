@@ -13,7 +13,7 @@
 namespace mmvk::test {
 
 // NProbe 0: exact ("clusters"); else "clusters-nprobe" with that nprobe.
-template <std::uint32_t NProbe, bool Box = true, bool Radius = false>
+template <std::uint32_t NProbe, bool Box = true>
 struct ClusterFactory {
   // The cache owns the pool the backends run on and the tables.
   ClusterTableCache tables;
@@ -23,7 +23,6 @@ struct ClusterFactory {
     MMVK_ASSIGN_OR_RETURN(spec.clusters, tables.table_for(db));
     spec.nprobe = NProbe;
     spec.cluster.box_bound = Box;
-    spec.cluster.radius_bound = Radius;
     return cpu_backends().make(spec, db);
   }
 };

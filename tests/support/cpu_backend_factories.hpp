@@ -16,13 +16,14 @@ struct ReferenceFactory {
   }
 };
 
-template <bool Prune, unsigned Threads, bool Baseline = false>
+// Generic: the x86-64 baseline kernels instead of the widest this CPU runs.
+template <bool Prune, unsigned Threads, bool Generic = false>
 struct FastFactory {
   ThreadPool pool{Threads};
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
     BackendSpec spec{.name = Prune ? "fast-box" : "fast-brute", .pool = &pool};
     spec.fast.rows_per_block = 512;  // several cache blocks even on small test data
-    spec.fast.baseline_kernels = Baseline;
+    spec.fast.kernels = Generic ? CpuKernels::Generic : CpuKernels::Widest;
     return cpu_backends().make(spec, db);
   }
 };

@@ -7,17 +7,13 @@
 // reference's frames with bit-identical costs: rows are evaluated in the
 // reference's accumulation order (see search.hpp).
 //
-// The lower bound of cluster c is the max of two bounds, each a true lower
-// bound of multiplier_i * total_i for every member i, to which min_bias is
-// added (float addition is monotone, so the bias step keeps it a bound):
-//  - box: min_multiplier * sum_ch w_ch * sum_d gap_d^2, gap_d = distance of
-//    q_d to [box_min_d, box_max_d], accumulated in the reference's order in
-//    float; every rounding step is monotone, so it never exceeds the cost of
-//    a member computed the same way;
-//  - radius: min_multiplier * sum_ch w_ch * max(0, |q_ch - centroid_ch| -
-//    radius_ch)^2 (the triangle inequality per channel), computed in double
-//    and shrunk by a relative margin that covers the float rounding of the
-//    real cost evaluation (proof in cluster_search.cpp).
+// The lower bound of cluster c is its box bound, a true lower bound of
+// multiplier_i * total_i for every member i, to which min_bias is added
+// (float addition is monotone, so the bias step keeps it a bound):
+// min_multiplier * sum_ch w_ch * sum_d gap_d^2, gap_d = distance of q_d to
+// [box_min_d, box_max_d], accumulated in the reference's order in float;
+// every rounding step is monotone, so it never exceeds the cost of a member
+// computed the same way.
 // The continuing frame (whose cost may carry a negative continuing_bias) is
 // evaluated first as a seed and skipped during the cluster walk, so the
 // cluster bounds never need to account for continuing_bias.
@@ -56,10 +52,6 @@ namespace mmvk {
 struct ClusterSearchOptions {
   std::uint32_t nprobe = 0;  // 0 = exact; else clusters searched per query
   bool box_bound = true;     // use the per-dimension box bound
-  // Use the per-channel radius (triangle) bound as well. Off by default: on
-  // the Bandai locomotion features it visited no fewer clusters than the box
-  // bound alone and doubled the time per query (see bench/cluster_bench.cpp).
-  bool radius_bound = false;
   // Within a visited cluster, skip 16-row tiles whose own box bound (the
   // same box bound over the tile's members) is above the k-th best.
   bool tile_bound = true;
@@ -70,32 +62,11 @@ struct ClusterSearchOptions {
   // Exact mode: visit the cluster of the nearest centroid first, then the
   // rest in lower-bound order (the seed tightens the k-th best early).
   bool seed_nearest = true;
-  // nprobe mode: visit the clusters in the exact mode's order (seed, then
-  // lower bound) and stop after nprobe visits, instead of the nprobe
-  // nearest centroids: a capped exact walk. On the Bandai volume set (417k
-  // frames, 646 clusters, transition queries) it reached recall@1 0.99 at
-  // nprobe 32 with ~80% of the exact mode's work; the nearest centroids
-  // needed nprobe 64 and ~90%. Neither is much cheaper than exact there:
-  // the tile bounds make exact mode's proof of the answer cheap, and most
-  // of its work is finding the answer (see the bench results in git log).
-  bool probe_by_bound = false;
-  // Exact mode, B >= threads: each thread takes its queries in sub-batches
-  // and visits their clusters grouped by cluster, so the rows of a cluster
-  // are loaded once for all the sub-batch's queries that visit it (see
-  // cluster_search.cpp). Off: the one-query walk, query by query.
+  // Each thread takes its queries in sub-batches and visits their clusters
+  // (in nprobe mode, the probed ones) grouped by cluster, so the rows of a
+  // cluster are loaded once for all the sub-batch's queries that visit it
+  // (see cluster_search.cpp). Off: the one-query walk, query by query.
   bool batch_by_cluster = true;
-  // Exact mode, B < threads: each query is split over the pool's threads
-  // (tiles of the seed cluster and candidate clusters dealt out in turn,
-  // one shared k-th best for pruning). Off by default: on the 2-vCPU test
-  // machine (Bandai volume, 417k frames) B = 1 calls back to back ran 1.7x
-  // faster split, with the pool's workers still spinning, but calls 1 ms
-  // apart (a game's one query per tick) 1.2x slower, each paying for
-  // waking a sleeping worker (bench/RESULTS.md, issue 10). Worth it for
-  // bursts of single queries on otherwise idle cores.
-  bool split_single = false;
-  // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
-  // AVX-512F (as FastSearchOptions::baseline_kernels; the same kernels).
-  bool baseline_kernels = false;
   // As FastSearchOptions::kernels.
   CpuKernels kernels = CpuKernels::Widest;
 };
@@ -126,7 +97,6 @@ class ClusterSearch final : public SearchBackend {
   const ClusterSearchCounters& counters() const { return counters_; }
 
   const ClusterSearchOptions& options() const { return options_; }
-  void set_nprobe(std::uint32_t nprobe) { options_.nprobe = nprobe; }
   std::uint32_t cluster_count() const;
   // The instruction set the kernels use: "avx512f", "avx2" or "generic".
   std::string_view kernel_name() const;

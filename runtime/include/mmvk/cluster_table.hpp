@@ -66,6 +66,8 @@ struct ClusterTable {
   // distance between the member's and the centroid's values of that channel
   // (rounded up to the next float), for the per-channel triangle bound
   // cost >= min_mult * sum_c w_c * max(0, |q_c - centroid_c| - radius_c)^2 + min_bias.
+  // No backend uses that bound (it never beat the box bound); the field is
+  // kept so that tables on disk keep their layout.
   std::vector<float> channel_radius;
 };
 

@@ -36,10 +36,9 @@ struct FastSearchOptions {
   // a thread walks one block before the next, so the block stays in L2.
   // Rounded up to whole groups.
   std::uint32_t rows_per_block = 2048;
-  // Use the x86-64 baseline (SSE2) kernels even when the CPU has AVX2 or
-  // AVX-512F; tests use it to check every kernel against the reference.
-  bool baseline_kernels = false;
-  // Which kernels to run (baseline_kernels = true overrides it to Generic).
+  // Which kernels to run: Widest picks the widest set this CPU runs;
+  // Generic the x86-64 baseline (SSE2) ones, which tests use to hold every
+  // kernel to the reference. create() refuses a set the CPU lacks.
   CpuKernels kernels = CpuKernels::Widest;
 };
 

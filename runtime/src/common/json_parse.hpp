@@ -1,6 +1,6 @@
 // JSON parsing for manifests and schemas: nlohmann::json keeps the last of
 // two equal keys in an object without a word, so a manifest with "fps" twice
-// would silently use one of them. parse_json_object_text rejects that, naming
+// would silently use one of them. parse_json_text rejects that, naming
 // the key. Also the reading of a JSON number into a float that both share.
 #pragma once
 

@@ -119,7 +119,7 @@ std::uint32_t read_u32_at(std::string_view bytes, std::size_t at) {
 
 // Quantized16 rotations: each component of the unit quaternion (sign made
 // w >= 0) times 32767, rounded; renormalized on load. The worst-case angle
-// error is about 4e-3 degree (tests/cpu/animation_io_test.cpp measures it).
+// error is about 4e-3 degree (tests/data/animation_data_test.cpp measures it).
 std::int16_t quantize(float c) { return static_cast<std::int16_t>(std::lround(std::clamp(c, -1.0f, 1.0f) * 32767.0f)); }
 
 // The contact setup of a version 5 animation section: the joints and the

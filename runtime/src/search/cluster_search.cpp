@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -54,9 +53,8 @@ struct Scratch {
   std::vector<float> tile_bound;                 // [tiles of the largest cluster, padded to 16]
   std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
   std::vector<std::uint32_t> passing;            // [tiles of the largest cluster]
-  std::vector<double> radius_sum, radius_total;  // [clusters]
   std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
-  // Batched exact mode and the split single query.
+  // The grouped walk (batch_by_cluster).
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
   std::vector<std::uint32_t> seed, cursor, candidate_end;      // [kSubBatch]
   std::vector<ClusterBound> candidates;                        // each query's, sorted, one after another
@@ -72,7 +70,6 @@ struct Scratch {
 struct ClusterSearch::Layout {
   ClusterTable table;
   std::uint32_t dims = 0;
-  std::uint32_t channels = 0;
   detail::Kernels kernels{};
   std::vector<std::uint32_t> tile_offsets;   // [clusters + 1]
   // The members of each cluster, in frame order, fill its tiles; the last
@@ -96,14 +93,11 @@ struct ClusterSearch::Layout {
   // Box c: [centroid, centroid], multiplier 1, bias 0, so its bound is the
   // channel-weighted squared centroid distance.
   detail::BoxPacks centroids;
-  std::vector<float> radius_t;               // [channels x clusters]
   // [clusters]: 1 when empty or all members excluded by flags (bytes, not
   // vector<bool>, so the per-query eligibility loop vectorizes).
   std::vector<std::uint8_t> never_candidate;
   std::uint32_t candidate_clusters = 0;      // clusters with never_candidate 0
-  double radius_margin = 0.0;
   std::vector<Scratch> scratch;              // [pool threads]
-  std::vector<Match> partial;                // [threads x k]: a split query's lists
 };
 
 Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& database, const ClusterTable& table,
@@ -113,8 +107,7 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   Layout& l = *layout;
   l.table = table;
   l.dims = database.dims();
-  l.channels = static_cast<std::uint32_t>(database.schema().channels.size());
-  if (!detail::select_kernels(options.kernels, options.baseline_kernels, l.kernels)) {
+  if (!detail::select_kernels(options.kernels, l.kernels)) {
     return make_error("cluster search: this CPU cannot run the requested kernels (ClusterSearchOptions::kernels)");
   }
   const std::uint32_t k = table.cluster_count;
@@ -176,31 +169,14 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
       l.span_boxes.set(std::size_t{l.span_box_pack[c]} * kLanes + span, box);
     }
   }
-  // Radius-bound margin. For a member row x, the real cost evaluation
-  // computes s_ch = fl-sum of fl(fl(x_d - q_d)^2) over n_ch dims: each term
-  // is >= its real value times (1-u)^2 (u = 2^-24, round to nearest), and
-  // summing n_ch non-negative terms loses at most a factor (1-u)^n_ch. The
-  // weighting, the C channel additions and the multiplier lose at most
-  // (1-u)^(C+2). So fl(multiplier * total) >= multiplier * sum_ch w_ch S_ch *
-  // (1-u)^(D+C+4), S_ch the real squared channel distance, and
-  // (1-u)^m >= 1 - m*u. The double evaluation of the bound adds < 1e-12
-  // relative error, and its conversion to float is rounded down. Hence a
-  // factor 1 - 2*(D+C+8)*u keeps the bound at or below every member's cost
-  // (with room to spare). Underflow breaks relative error bounds, so radius
-  // bounds below 1e-30 are dropped to 0.
-  l.radius_margin = 2.0 * (l.dims + l.channels + 8) * 0x1.0p-24;
   const std::size_t cluster_packs = packs_of(k);
   l.cluster_boxes = detail::BoxPacks(cluster_packs, l.dims);
   l.centroids = detail::BoxPacks(cluster_packs, l.dims);
-  l.radius_t.resize(std::size_t{k} * l.channels);
   for (std::uint32_t c = 0; c < k; ++c) {
     const std::size_t at = std::size_t{c} * l.dims;
     l.cluster_boxes.set(c, table.box_min.data() + at, table.box_max.data() + at, table.min_multiplier[c],
                         table.min_bias[c]);
     l.centroids.set(c, table.centroids.data() + at, table.centroids.data() + at, 1.0f, 0.0f);
-    for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
-      l.radius_t[std::size_t{ch} * k + c] = table.channel_radius[std::size_t{c} * l.channels + ch];
-    }
   }
   l.scratch.resize(pool.thread_count());
   for (Scratch& s : l.scratch) {
@@ -211,8 +187,6 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.span_bound.resize(packs_of(packs_of(l.max_cluster_tiles)) * kLanes);
     s.passing.resize(l.max_cluster_tiles);
     s.staging.resize(k);
-    s.radius_sum.resize(k);
-    s.radius_total.resize(k);
     s.batch_bound.resize(kSubBatch * cluster_packs * kLanes);
     s.seed.resize(kSubBatch);
     s.cursor.resize(kSubBatch);
@@ -232,68 +206,12 @@ std::string_view ClusterSearch::kernel_name() const { return layout_->kernels.na
 
 namespace {
 
-// Radius bounds of every cluster with the bias, raised into out[] (see the
-// margin proof in create()). Adding the bias after the max is the max of the
-// biased bounds: float addition is monotone.
-void radius_bounds(const ClusterSearch::Layout& l, const float* q, const float* w, Scratch& s, float* out) {
-  const ClusterTable& t = l.table;
-  const std::size_t n = t.cluster_count;
-  double* sum = s.radius_sum.data();
-  double* total = s.radius_total.data();
-  std::fill_n(total, n, 0.0);
-  std::uint32_t d = 0;
-  for (std::uint32_t ch = 0; ch < l.channels; ++ch) {
-    const std::uint32_t end = l.rows.channel_end[ch];
-    const double weight = w[ch];
-    if (weight == 0.0) {
-      d = end;
-      continue;
-    }
-    std::fill_n(sum, n, 0.0);
-    for (; d < end; ++d) {
-      const double qd = q[d];
-      for (std::size_t i = 0; i < n; ++i) {
-        const double diff = qd - double(t.centroids[i * l.dims + d]);
-        sum[i] += diff * diff;
-      }
-    }
-    const float* radius = l.radius_t.data() + std::size_t{ch} * n;
-    for (std::size_t i = 0; i < n; ++i) {
-      // 1 - 1e-12 absorbs the double rounding of the distance itself, which
-      // a cancellation against the radius could otherwise magnify.
-      const double gap = std::sqrt(sum[i]) * (1.0 - 1e-12) - double(radius[i]);
-      total[i] += gap > 0.0 ? weight * gap * gap : 0.0;
-    }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const double bound = double(t.min_multiplier[i]) * total[i] * (1.0 - l.radius_margin);
-    if (!(bound >= 1e-30)) continue;
-    float down = static_cast<float>(bound);
-    if (double(down) > bound) down = std::nextafter(down, 0.0f);
-    out[i] = std::max(out[i], down + t.min_bias[i]);
-  }
-}
-
 // One query as the walks see it.
 struct QueryView {
   const float* q;
   const float* w;
   const QueryParams* params;
   std::span<Match> best;  // sorted, k entries
-};
-
-// A k-th best shared by the threads that split one query (single-query
-// path): any k rows found by any thread bound the final k-th best from
-// above, so a tile bound strictly above the smallest thread-local k-th best
-// can be skipped by every thread.
-struct SharedThreshold {
-  std::atomic<float> value{std::numeric_limits<float>::infinity()};
-  float load() const { return value.load(std::memory_order_relaxed); }
-  void lower_to(float v) {
-    float cur = load();
-    while (v < cur && !value.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
-    }
-  }
 };
 
 // What every walk needs besides the query.
@@ -306,16 +224,10 @@ struct WalkContext {
   detail::BoxArrays span_boxes;
 };
 
-float threshold_of(const QueryView& v, const SharedThreshold* shared) {
-  const float own = v.best.back().cost;
-  return shared == nullptr ? own : std::min(own, shared->load());
-}
-
-// Evaluates the tiles i = part, part + parts, ... of cluster c whose own
-// bound is at most the k-th best (strictly greater is skipped: a member
-// costing exactly the k-th best could still win on a lower frame id).
-void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c, std::uint32_t part = 0,
-                   std::uint32_t parts = 1, SharedThreshold* shared = nullptr) {
+// Evaluates the tiles of cluster c whose own bound is at most the k-th best
+// (strictly greater is skipped: a member costing exactly the k-th best could
+// still win on a lower frame id).
+void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c) {
   const ClusterSearch::Layout& l = x.l;
   ++s.counters.clusters_visited;
   const std::uint32_t first_tile = l.tile_offsets[c];
@@ -330,7 +242,7 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
     // above the k-th best are never computed (+inf: skipped below).
     const std::size_t spans = packs_of(tiles);
     l.kernels.box_bounds(x.span_boxes, l.span_box_pack[c], packs_of(spans), v.q, v.w, s.span_bound.data());
-    const float threshold = threshold_of(v, shared);
+    const float threshold = v.best.back().cost;
     for (std::size_t span = 0; span < spans;) {
       if (s.span_bound[span] > threshold) {
         std::fill_n(s.tile_bound.data() + span * kLanes, kLanes, std::numeric_limits<float>::infinity());
@@ -350,27 +262,26 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
   std::array<std::uint32_t, kTileChunk> chunk{};
   std::uint32_t chunk_size = 0;
   const auto flush = [&] {
-    const detail::KernelQuery kernel_query{v.q, v.w, threshold_of(v, shared)};
+    const detail::KernelQuery kernel_query{v.q, v.w, v.best.back().cost};
     const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, chunk.data(), chunk_size, s.hits.data());
     chunk_size = 0;
     for (std::size_t h = 0; h < hits; ++h) {
       detail::offer_tile_row(x.db, *v.params, v.best, Match{l.frame[s.hits[h].slot], s.hits[h].cost});
     }
-    if (shared != nullptr && hits != 0) shared->lower_to(v.best.back().cost);
   };
   // The tiles whose bound passes the k-th best from before the walk,
   // compacted without a branch (most tiles fail, in no pattern a predictor
   // learns); each is checked again below as the k-th best tightens.
   std::uint32_t* passing = s.passing.data();
   std::uint32_t passing_count = 0;
-  const float threshold_before = threshold_of(v, shared);
-  for (std::uint32_t i = part; i < tiles; i += parts) {
+  const float threshold_before = v.best.back().cost;
+  for (std::uint32_t i = 0; i < tiles; ++i) {
     passing[passing_count] = i;
     passing_count += !x.options.tile_bound || !(s.tile_bound[i] > threshold_before) ? 1u : 0u;
   }
   for (std::uint32_t j = 0; j < passing_count; ++j) {
     const std::uint32_t i = passing[j];
-    if (x.options.tile_bound && s.tile_bound[i] > threshold_of(v, shared)) continue;
+    if (x.options.tile_bound && s.tile_bound[i] > v.best.back().cost) continue;
     const std::uint32_t tile = first_tile + i;
     s.rows += l.tile_rows[tile];
     chunk[chunk_size++] = tile;
@@ -468,7 +379,6 @@ std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v,
   } else {
     std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
   }
-  if (x.options.radius_bound) radius_bounds(l, v.q, v.w, s, bound);
   const std::uint32_t eligible = mark_ineligible(l, *v.params, bound);
   const bool probing = x.options.nprobe != 0 && x.options.nprobe < eligible;
   if (!probing && (!x.options.seed_nearest || eligible < 2)) return kNoCluster;
@@ -522,10 +432,9 @@ void walk_one(const WalkContext& x, Scratch& s, const QueryView& v) {
   // Nearest-centroid seed (exact mode) or probe order (nprobe mode):
   // channel-weighted squared centroid distances, a box bound of the
   // zero-size boxes [centroid, centroid] with unit multipliers.
-  const bool by_centroid = probing && !options.probe_by_bound;
-  const bool seeding = !by_centroid && options.seed_nearest && s.order.size() > 1;
+  const bool seeding = !probing && options.seed_nearest && s.order.size() > 1;
   const std::size_t cluster_packs = packs_of(t.cluster_count);
-  if (by_centroid || seeding) {
+  if (probing || seeding) {
     l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
   }
   float* bound = s.bound.data();
@@ -535,11 +444,10 @@ void walk_one(const WalkContext& x, Scratch& s, const QueryView& v) {
     } else {
       std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
     }
-    if (options.radius_bound) radius_bounds(l, v.q, v.w, s, bound);
     for (ClusterBound& b : s.order) b.bound = bound[b.cluster];
   }
 
-  if (by_centroid) {
+  if (probing) {
     // The nprobe nearest centroids, nearest first (the most likely home
     // of the answer, so the k-th best tightens early); a probed cluster
     // whose lower bound is above the k-th best is skipped, which never
@@ -562,29 +470,24 @@ void walk_one(const WalkContext& x, Scratch& s, const QueryView& v) {
   // tighten the k-th best early, then every cluster in lower-bound order
   // until the next bound is above the k-th best.
   std::uint32_t seeded = kNoCluster;
-  std::uint32_t budget = probing ? options.nprobe : t.cluster_count;
   if (seeding) {
     const ClusterBound* nearest = &s.order.front();
     for (const ClusterBound& b : s.order) {
       if (s.distance[b.cluster] < s.distance[nearest->cluster]) nearest = &b;
     }
     seeded = nearest->cluster;
-    if (nearest->bound <= best[k - 1].cost) {
-      visit_cluster(x, s, v, seeded);
-      --budget;
-    }
+    if (nearest->bound <= best[k - 1].cost) visit_cluster(x, s, v, seeded);
   }
   // A min-heap: usually only a few clusters are visited, so popping them
   // in order beats sorting all of them.
   const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
   std::make_heap(s.order.begin(), s.order.end(), heap_order);
-  for (auto heap_end = s.order.end(); heap_end != s.order.begin() && budget > 0; --heap_end) {
+  for (auto heap_end = s.order.end(); heap_end != s.order.begin(); --heap_end) {
     std::pop_heap(s.order.begin(), heap_end, heap_order);
     const ClusterBound& b = *(heap_end - 1);
     if (b.bound > best[k - 1].cost) break;
     if (b.cluster == seeded) continue;
     visit_cluster(x, s, v, b.cluster);
-    --budget;
   }
 }
 
@@ -662,30 +565,6 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
   }
 }
 
-// One query split over `parts` threads: each computes the bounds (cheap),
-// takes every parts-th tile of the seed cluster and every parts-th
-// candidate cluster into a list of its own, pruning against the smallest
-// k-th best any of them has found; the lists are merged at the end.
-void walk_split(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t part, std::uint32_t parts,
-                SharedThreshold& shared) {
-  const std::uint32_t clusters = x.l.table.cluster_count;
-  std::fill(v.best.begin(), v.best.end(), Match{});
-  if (part == 0) {
-    start_query(x, s, v);
-    shared.lower_to(v.best.back().cost);
-  }
-  float* bound = s.batch_bound.data();
-  const std::uint32_t seed = exact_bounds(x, s, v, bound);
-  if (seed != kNoCluster && bound[seed] <= threshold_of(v, &shared)) visit_cluster(x, s, v, seed, part, parts, &shared);
-  s.candidates.clear();
-  collect_candidates(bound, clusters, seed, threshold_of(v, &shared), s.staging, s.candidates);
-  for (std::size_t j = part; j < s.candidates.size(); j += parts) {
-    const ClusterBound& b = s.candidates[j];
-    if (b.bound > threshold_of(v, &shared)) break;
-    visit_cluster(x, s, v, b.cluster, 0, 1, &shared);
-  }
-}
-
 }  // namespace
 
 Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) {
@@ -703,39 +582,18 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
     const QueryParams& params = batch.params.empty() ? default_params : batch.params[qi];
     return QueryView{batch.features.data() + qi * l.dims, params.channel_weights.data(), &params, out.subspan(qi * k, k)};
   };
-  const bool exact = options.nprobe == 0;
-  const unsigned threads = pool_->thread_count();
-
-  if (exact && options.split_single && batch.size < threads && threads > 1) {
-    // Fewer queries than threads: each query is split over the threads.
-    const std::uint32_t parts = threads;
-    l.partial.resize(std::size_t{parts} * k);
-    for (std::size_t qi = 0; qi < batch.size; ++qi) {
-      const QueryView v = view_of(qi);
-      SharedThreshold shared;
-      pool_->parallel_for(parts, [&](std::size_t begin, std::size_t end, unsigned thread) {
-        for (std::size_t part = begin; part < end; ++part) {
-          const QueryView mine{v.q, v.w, v.params, std::span<Match>(l.partial).subspan(part * k, k)};
-          walk_split(x, l.scratch[thread], mine, static_cast<std::uint32_t>(part), parts, shared);
-        }
-      });
-      std::sort(l.partial.begin(), l.partial.end(), match_less);
-      std::copy_n(l.partial.begin(), k, v.best.begin());
+  pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
+    Scratch& s = l.scratch[thread];
+    if (options.batch_by_cluster) {
+      walk_batched(x, s, view_of, first, last);
+      return;
     }
-  } else {
-    pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
-      Scratch& s = l.scratch[thread];
-      if ((exact || !options.probe_by_bound) && options.batch_by_cluster) {
-        walk_batched(x, s, view_of, first, last);
-        return;
-      }
-      for (std::size_t qi = first; qi < last; ++qi) {
-        const QueryView v = view_of(qi);
-        start_query(x, s, v);
-        walk_one(x, s, v);
-      }
-    });
-  }
+    for (std::size_t qi = first; qi < last; ++qi) {
+      const QueryView v = view_of(qi);
+      start_query(x, s, v);
+      walk_one(x, s, v);
+    }
+  });
 
   stats_.queries += batch.size;
   for (const Scratch& s : l.scratch) {

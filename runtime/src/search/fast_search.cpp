@@ -25,7 +25,7 @@ constexpr std::uint32_t kBruteQueries = 4;
 // lacks; the constructor falls back to the widest).
 detail::Kernels kernels_of(const FastSearchOptions& options) {
   detail::Kernels kernels{};
-  if (!detail::select_kernels(options.kernels, options.baseline_kernels, kernels)) kernels = detail::select_kernels(false);
+  if (!detail::select_kernels(options.kernels, kernels)) kernels = detail::select_kernels(false);
   return kernels;
 }
 
@@ -57,7 +57,7 @@ Result<std::unique_ptr<FastSearch>> FastSearch::create(const Database& database,
   // rows_per_block rounds up to a group; only a kernel set this CPU cannot
   // run is refused.
   detail::Kernels kernels{};
-  if (!detail::select_kernels(options.kernels, options.baseline_kernels, kernels)) {
+  if (!detail::select_kernels(options.kernels, kernels)) {
     return make_error("fast search: this CPU cannot run the requested kernels (FastSearchOptions::kernels)");
   }
   return std::unique_ptr<FastSearch>(new FastSearch(database, pool, options));

@@ -317,8 +317,7 @@ Kernels select_kernels(bool baseline) {
   return {evaluate_tiles_generic, box_bounds_generic, "generic", 2};
 }
 
-bool select_kernels(CpuKernels set, bool baseline, Kernels& out) {
-  if (baseline) set = CpuKernels::Generic;
+bool select_kernels(CpuKernels set, Kernels& out) {
   switch (set) {
     case CpuKernels::Widest: out = select_kernels(false); return true;
     case CpuKernels::Generic: out = select_kernels(true); return true;

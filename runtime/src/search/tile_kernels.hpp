@@ -81,8 +81,8 @@ struct Kernels {
 // them to hold every kernel to the reference).
 Kernels select_kernels(bool baseline);
 
-// The kernels of one instruction set (baseline = true: Generic), or false
-// when this CPU cannot run them.
-bool select_kernels(CpuKernels set, bool baseline, Kernels& out);
+// The kernels of one instruction set, or false when this CPU cannot run
+// them.
+bool select_kernels(CpuKernels set, Kernels& out);
 
 }  // namespace mmvk::detail

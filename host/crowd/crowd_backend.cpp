@@ -7,17 +7,14 @@
 #if defined(MMVK_HAS_VULKAN)
 #include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
-#include "mmvk/vulkan/vulkan_async_search.hpp"
-#include "mmvk/vulkan/vulkan_search.hpp"
 #endif
 
 namespace mmvk::crowd {
 
 namespace {
 
-// Queries per backend call: the controller's chunk size and Vulkan's
-// max_batch.
-constexpr std::uint32_t kMaxBatch = 1024;
+// Queries per Vulkan submit (max_batch); a larger tick is paged by the search.
+constexpr std::uint32_t kPageQueries = 1024;
 
 #if defined(MMVK_HAS_VULKAN)
 const char* device_type_name(VkPhysicalDeviceType type) {
@@ -87,12 +84,13 @@ Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std
   BackendSpec spec;
   spec.name = name;
   spec.pool = &pool;
-  spec.max_batch = std::min(kMaxBatch, std::max<std::uint32_t>(agents, 1));
+  spec.max_batch = std::min(kPageQueries, std::max<std::uint32_t>(agents, 1));
   spec.max_k = 1;
   MMVK_ASSIGN_OR_RETURN(out.backend, registry.make(spec, database));
+  out.deferred = out.backend->make_async(agents);
 #if defined(MMVK_HAS_VULKAN)
-  if (auto* gpu = dynamic_cast<vulkan::VulkanSearch*>(out.backend.get())) {
-    out.deferred = std::make_unique<vulkan::VulkanAsyncSearch>(*gpu, agents);
+  // The registry creates the context only for a Vulkan backend.
+  if (out.context) {
     out.device = describe_device(*out.context, device);
     return out;
   }
@@ -100,7 +98,6 @@ Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std
   if (device) return make_error("--device picks a Vulkan device; backend '" + name + "' runs on the CPU");
   out.device = name == "reference" ? std::string("cpu, 1 thread")
                                    : "cpu, " + std::to_string(pool.thread_count()) + " threads";
-  out.deferred = std::make_unique<DeferredSearch>(*out.backend, kMaxBatch, agents);
   return out;
 }
 

@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/async_search.hpp"
 #include "mmvk/database.hpp"
 #include "mmvk/search.hpp"
 #include "mmvk/status.hpp"

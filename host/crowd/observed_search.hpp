@@ -8,7 +8,7 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/async_search.hpp"
 
 namespace mmvk::crowd {
 

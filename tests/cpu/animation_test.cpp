@@ -289,36 +289,10 @@ TEST(CrowdController, BadParametersAndInputAreNamed) {
   EXPECT_FALSE(controller->place(0, glm::vec3(0.0f), 0.0f, 600).ok());
 }
 
-TEST(CrowdController, BatchesSplitAtMaxBatchWithTheSameResult) {
-  const Database db = make_database(true);
-  ReferenceSearch reference(db);
-  ThreadPool pool(2);
-  auto run = [&](std::uint32_t max_batch) {
-    ControllerParams params;
-    params.max_batch = max_batch;
-    Result<CrowdController> controller = CrowdController::create(db, 37, params);
-    EXPECT_TRUE(controller.ok()) << controller.message();
-    std::vector<glm::vec3> velocities(37);
-    std::vector<std::uint32_t> frames;
-    std::uint32_t batches = 0;
-    for (int tick = 0; tick < 20; ++tick) {
-      for (std::uint32_t b = 0; b < 37; ++b) velocities[b] = glm::vec3(std::sin(float(b + tick)), 0.0f, 1.0f);
-      EXPECT_TRUE(controller->tick(1.0f / 30.0f, CrowdInput{velocities, {}}, reference, pool).ok());
-      frames.insert(frames.end(), controller->frames().begin(), controller->frames().end());
-      batches += controller->last_tick().batches;
-    }
-    return std::make_pair(frames, batches);
-  };
-  const auto [whole, whole_batches] = run(1024);
-  const auto [split, split_batches] = run(5);
-  EXPECT_EQ(whole, split);
-  EXPECT_GT(split_batches, whole_batches);
-}
-
 TEST(CrowdController, DeferredAppliesResultsOneTickLater) {
   const Database db = make_database(true);
   ReferenceSearch reference(db);
-  DeferredSearch deferred(reference, 8, 16);
+  DeferredSearch deferred(reference, 16);
   ThreadPool pool(1);
   Result<CrowdController> controller = CrowdController::create(db, 16);
   ASSERT_TRUE(controller.ok());

@@ -121,27 +121,21 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   EXPECT_LT(worst_shown_step, 0.4f);
 }
 
-TEST_F(CrowdControllerData, DeferredAndSplitBatchesMatchTheirReferences) {
+TEST_F(CrowdControllerData, DeferredAppliesTheSameSearchOneTickLater) {
   ReferenceSearch reference(*database_);
   ThreadPool pool(2);
-  auto run_with = [&](std::uint32_t max_batch, bool deferred) {
-    ControllerParams params;
-    params.max_batch = max_batch;
-    Result<CrowdController> controller = CrowdController::create(*database_, test::kCrowdCharacters, params);
+  auto run_with = [&](bool deferred) {
+    Result<CrowdController> controller = CrowdController::create(*database_, test::kCrowdCharacters);
     EXPECT_TRUE(controller.ok()) << controller.message();
-    DeferredSearch later(reference, max_batch, test::kCrowdCharacters);
+    DeferredSearch later(reference, test::kCrowdCharacters);
     Result<test::CrowdRun> run = test::run_crowd(*controller, [&](CrowdController& c, const CrowdInput& in) {
       return deferred ? c.tick(test::kCrowdDt, in, later, pool) : c.tick(test::kCrowdDt, in, reference, pool);
     });
     EXPECT_TRUE(run.ok()) << run.message();
     return std::move(run).value();
   };
-  const test::CrowdRun sync = run_with(1024, false);
-  const test::CrowdRun split = run_with(7, false);
-  EXPECT_EQ(sync.frames, split.frames);
-  const test::CrowdRun deferred = run_with(1024, true);
-  const test::CrowdRun deferred_split = run_with(7, true);
-  EXPECT_EQ(deferred.frames, deferred_split.frames);
+  const test::CrowdRun sync = run_with(false);
+  const test::CrowdRun deferred = run_with(true);
   EXPECT_EQ(deferred.totals.no_candidate, 0u);
   EXPECT_NE(deferred.frames, sync.frames);  // one tick of latency changes the choices
 }

@@ -15,10 +15,8 @@
 namespace mmvk {
 namespace {
 
-test::CrowdRun run_sync(const Database& db, SearchBackend& backend, std::uint32_t max_batch,
-                        ControllerParams params = {}) {
+test::CrowdRun run_sync(const Database& db, SearchBackend& backend, const ControllerParams& params = {}) {
   ThreadPool pool(2);
-  params.max_batch = max_batch;
   Result<CrowdController> controller = CrowdController::create(db, test::kCrowdCharacters, params);
   EXPECT_TRUE(controller.ok()) << controller.message();
   Result<test::CrowdRun> run = test::run_crowd(
@@ -57,12 +55,12 @@ TEST(CrowdControllerVulkan, SameFramesAsTheReferenceEveryTick) {
   ReferenceSearch reference(*db);
   vulkan::VulkanSearchOptions options;
   options.max_k = 1;
-  options.max_batch = 16;  // the first tick's 50 forced searches take 4 chunks, 2 slots
+  options.max_batch = 16;  // the first tick's 50 forced searches: 4 pages on 2 slots
   Result<std::unique_ptr<vulkan::VulkanSearch>> gpu = vulkan::VulkanSearch::create(*context, *db, options);
   ASSERT_TRUE(gpu.ok()) << gpu.message();
 
-  const test::CrowdRun expected = run_sync(*db, reference, 1024);
-  const test::CrowdRun actual = run_sync(*db, **gpu, 16);
+  const test::CrowdRun expected = run_sync(*db, reference);
+  const test::CrowdRun actual = run_sync(*db, **gpu);
   EXPECT_EQ(expected.totals.no_candidate, 0u);
   EXPECT_EQ(actual.totals.no_candidate, 0u);
   EXPECT_GT(actual.totals.jumps, 50u);
@@ -70,7 +68,7 @@ TEST(CrowdControllerVulkan, SameFramesAsTheReferenceEveryTick) {
   EXPECT_EQ(expected.searched, actual.searched);
 
   // The deferred path: the GPU search overlaps the next tick.
-  DeferredSearch later(reference, 1024, test::kCrowdCharacters);
+  DeferredSearch later(reference, test::kCrowdCharacters);
   vulkan::VulkanAsyncSearch async(**gpu, test::kCrowdCharacters);
   const test::CrowdRun expected_deferred = run_deferred(*db, later);
   const test::CrowdRun actual_deferred = run_deferred(*db, async);
@@ -81,8 +79,8 @@ TEST(CrowdControllerVulkan, SameFramesAsTheReferenceEveryTick) {
   // frames on both backends, fewer jumps than without it.
   ControllerParams favour;
   favour.continuing_multiplier = 0.6f;
-  const test::CrowdRun favoured = run_sync(*db, reference, 1024, favour);
-  const test::CrowdRun favoured_gpu = run_sync(*db, **gpu, 16, favour);
+  const test::CrowdRun favoured = run_sync(*db, reference, favour);
+  const test::CrowdRun favoured_gpu = run_sync(*db, **gpu, favour);
   EXPECT_EQ(favoured_gpu.totals.no_candidate, 0u);
   EXPECT_TRUE(favoured.frames == favoured_gpu.frames) << first_difference(favoured, favoured_gpu);
   std::printf("jumps over the run: %u with continuing_multiplier 1, %u with 0.6\n", expected.totals.jumps,

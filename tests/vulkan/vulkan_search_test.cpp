@@ -126,6 +126,22 @@ TEST(VulkanSearch, ChunkedBatchesMatchReference) {
   compare(*search, db, std::span<const float>(queries).first(37 * db.dims()), std::span(params).first(37), 37, 16);
 }
 
+// A batch larger than max_batch x slots is paged inside the search: the
+// same matches as the reference, with constraints, for k = 1 and k > 1.
+TEST(VulkanSearch, PagesABatchLargerThanItsSlotsWithTheSameResult) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  const Database db = synthetic_database({.frames = 3000, .seed = 115, .constraints = true});
+  VulkanSearchOptions options = search_options(8, 4, 4, false);
+  options.slots = 2;  // 37 queries: 5 pages on 2 slots
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
+  ASSERT_NE(search, nullptr);
+  const std::vector<float> queries = synthetic_queries(db, 37, 116);
+  const std::vector<QueryParams> params = random_params(db, 37, 117);
+  compare(*search, db, queries, params, 37, 1);
+  compare(*search, db, queries, {}, 37, 4);
+  EXPECT_EQ(search->stats().queries, 2u * 37u);
+}
+
 // The 32-query tile (k = 1, batches of 512 or more), with a partial last
 // tile and every constraint.
 TEST(VulkanSearch, LargestTileMatchesReference) {
@@ -203,8 +219,8 @@ TEST(VulkanSearch, ErrorsAreReturned) {
   ASSERT_NE(search, nullptr);
   const std::vector<float> queries = synthetic_queries(db, 9, 114);
   std::vector<Match> out(9 * 4);
-  // A batch over max_batch, k over max_k.
-  Status status = search->search(QueryBatch{queries, {}, 9}, 1, std::span<Match>(out).first(9));
+  // A page (submit) over max_batch, k over max_k.
+  Status status = search->submit(QueryBatch{queries, {}, 9}, 1).status();
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("max_batch"), std::string::npos) << status.message();
   status = search->search(QueryBatch{std::span<const float>(queries).first(8 * db.dims()), {}, 8}, 5,

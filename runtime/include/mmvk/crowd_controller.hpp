@@ -23,8 +23,8 @@
 //      batch (query_assembly.hpp): pose channels measured on the pose it
 //      shows (after blending, before foot IK), past trajectory from its
 //      recorded root path, future trajectory from its prediction;
-//   5. search: the batch on the backend, split into chunks of at most
-//      params.max_batch queries;
+//   5. search: the batch on the backend, in one call (every backend takes
+//      any batch up to kMaxBatch);
 //   6. apply: a character jumps only when its match is neither the
 //      continuing frame (the frame nearest its time) nor within
 //      same_location_window of its time in the same clip; a jump plays on
@@ -50,6 +50,7 @@
 #include <glm/vec3.hpp>
 
 #include "mmvk/animation_data.hpp"
+#include "mmvk/async_search.hpp"
 #include "mmvk/database.hpp"
 #include "mmvk/foot_locker.hpp"
 #include "mmvk/pose_batch.hpp"
@@ -86,7 +87,6 @@ struct ControllerParams {
   float continuing_bias = 0.0f;
   float continuing_multiplier = 1.0f;  // finite, >= 0 (QueryParams::continuing_multiplier)
   std::uint32_t exclusion_window = 0;
-  std::uint32_t max_batch = 1024;  // queries per backend call (VulkanSearchOptions::max_batch)
   // A match in the clip being played, within this many seconds of the
   // character's time (before or after), is not jumped to: playing on shows
   // the same motion without a blend (Motion Symphony's "same location"
@@ -110,47 +110,17 @@ struct CrowdInput {
 struct TickStats {
   std::uint32_t searches = 0;      // queries assembled this tick
   std::uint32_t forced = 0;        // of which forced
-  std::uint32_t batches = 0;       // backend calls
+  std::uint32_t batches = 0;       // backend calls (1 on a tick with searches)
   std::uint32_t applied = 0;       // results applied this tick
   std::uint32_t jumps = 0;         // results that were jumped to
   std::uint32_t same_location = 0; // results not jumped to: within same_location_window of the character's time
   std::uint32_t no_candidate = 0;  // results with no frame (kept playing)
 };
 
-// A search the controller starts in one tick and collects in the next.
-class AsyncSearch {
- public:
-  virtual ~AsyncSearch() = default;
-  virtual const Database& database() const = 0;
-  // Starts searching `batch` (k = 1), any size: the implementation splits
-  // it. The spans stay valid until collect(). At most one search in flight.
-  virtual Status submit(const QueryBatch& batch) = 0;
-  // Waits for the submitted search and writes its matches [batch.size].
-  virtual Status collect(std::span<Match> out) = 0;
-};
-
-// The deferred path on any SearchBackend: searches at submit (chunks of
-// max_batch), hands the matches out at collect. Gives the same chosen frames
-// as an asynchronous GPU search of the same backend semantics.
-class DeferredSearch final : public AsyncSearch {
- public:
-  DeferredSearch(SearchBackend& backend, std::uint32_t max_batch, std::uint32_t capacity);
-  const Database& database() const override { return backend_.database(); }
-  Status submit(const QueryBatch& batch) override;
-  Status collect(std::span<Match> out) override;
-
- private:
-  SearchBackend& backend_;
-  std::uint32_t max_batch_;
-  std::vector<Match> matches_;
-  std::size_t pending_ = 0;
-  bool in_flight_ = false;
-};
-
 class CrowdController {
  public:
   // Errors: the database has no animation (missing_animation_error), its
-  // schema has no trajectory_position channel, characters == 0, parameters
+  // schema has no trajectory_position channel, characters == 0 or over kMaxBatch, parameters
   // out of range (each names the field).
   static Result<CrowdController> create(const Database& database, std::uint32_t characters,
                                         const ControllerParams& params = {});
@@ -225,6 +195,8 @@ class CrowdController {
   void begin(float dt, const CrowdInput& input, ThreadPool& pool);
   // Step 4 for due_.
   void assemble(ThreadPool& pool);
+  // The assembled queries of due_ as one batch (views into the scratch).
+  QueryBatch due_batch() const;
   // Step 6: matches [count] for characters[count] whose queries continued
   // continuing[count]; updates last_.
   void apply(std::span<const Match> matches, std::span<const std::uint32_t> characters,

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string_view>
 
@@ -26,6 +27,8 @@
 
 namespace mmvk {
 
+class AsyncSearch;
+
 inline constexpr std::uint32_t kNoFrame = 0xFFFFFFFFu;
 inline constexpr std::uint32_t kMaxK = 16;
 // The most queries one search call (and a device backend's max_batch) may
@@ -34,6 +37,8 @@ inline constexpr std::uint32_t kMaxK = 16;
 // 128 dims) and the B x k results (128 MiB at k = 16) stay allocatable and
 // no size product can overflow. A larger batch is an error up front
 // (validate_search), not an allocation failure; split it (docs/search.md).
+// Every backend takes any batch up to this size; a device backend pages it
+// over its own buffers.
 inline constexpr std::size_t kMaxBatch = std::size_t{1} << 20;
 
 // Per-query options. The defaults give a plain nearest-neighbour query.
@@ -102,6 +107,11 @@ class SearchBackend {
   virtual Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) = 0;
   virtual SearchStats stats() const = 0;
   virtual void reset_stats() = 0;
+  // This backend behind the deferred interface (async_search.hpp) for
+  // batches of up to `capacity` queries (<= kMaxBatch): a DeferredSearch,
+  // which searches at submit, unless the backend runs in the background
+  // (VulkanSearch). The backend must outlive it.
+  virtual std::unique_ptr<AsyncSearch> make_async(std::uint32_t capacity);
 };
 
 // The checks every backend runs before searching: k in [1, kMaxK], a batch
@@ -111,6 +121,9 @@ class SearchBackend {
 // finite query so far from every row, or a weight so large, that its cost
 // bound exceeds FLT_MAX / 2). Errors name the query index and field.
 Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out);
+// The same checks but the result span's size: for a batch submitted now
+// whose results are written later (a paged device search).
+Status validate_queries(const Database& database, const QueryBatch& batch, std::uint32_t k);
 
 // True when frame `frame` may be a result for `params` (flags, tags and the
 // exclusion window); the same rule every backend applies.

@@ -45,6 +45,11 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   const AnimationData* animation = database.animation();
   if (animation == nullptr) return missing_animation_error("crowd controller");
   if (characters == 0) return make_error("crowd controller: characters must be at least 1");
+  // A tick searches every due character in one call (search.hpp's kMaxBatch).
+  if (characters > kMaxBatch) {
+    return make_error("crowd controller: characters = " + std::to_string(characters) + " is over kMaxBatch = " +
+                      std::to_string(kMaxBatch));
+  }
   auto positive = [](float v) { return std::isfinite(v) && v > 0.0f; };
   const struct {
     const char* name;
@@ -72,10 +77,6 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   }
   if (!std::isfinite(params.same_location_window) || params.same_location_window < 0.0f) {
     return make_error("crowd controller: same_location_window must be finite and >= 0 (seconds)");
-  }
-  if (params.max_batch == 0 || params.max_batch > kMaxBatch) {
-    return make_error("crowd controller: max_batch = " + std::to_string(params.max_batch) + " is out of range [1, " +
-                      std::to_string(kMaxBatch) + "] (kMaxBatch)");
   }
   Result<QueryAssembler> assembler = QueryAssembler::create(database);
   if (!assembler.ok()) return make_error("crowd controller: " + assembler.message());
@@ -556,6 +557,14 @@ void add_totals(TickStats& totals, const TickStats& tick) {
 
 }  // namespace
 
+QueryBatch CrowdController::due_batch() const {
+  QueryBatch batch;
+  batch.features = std::span<const float>(queries_).first(std::size_t{due_count_} * database_->dims());
+  batch.params = std::span<const QueryParams>(batch_params_).first(due_count_);
+  batch.size = due_count_;
+  return batch;
+}
+
 Status CrowdController::tick(float dt, const CrowdInput& input, SearchBackend& backend, ThreadPool& pool) {
   MMVK_TRY(check_input(dt, input));
   if (&backend.database() != database_) return make_error("crowd controller: the backend searches another database");
@@ -564,14 +573,8 @@ Status CrowdController::tick(float dt, const CrowdInput& input, SearchBackend& b
   std::fill(suppressed_.begin(), suppressed_.end(), std::uint8_t{0});
   begin(dt, input, pool);
   assemble(pool);
-  const std::uint32_t dims = database_->dims();
-  for (std::uint32_t first = 0; first < due_count_; first += params_.max_batch) {
-    const std::uint32_t count = std::min(params_.max_batch, due_count_ - first);
-    QueryBatch batch;
-    batch.features = std::span<const float>(queries_).subspan(std::size_t{first} * dims, std::size_t{count} * dims);
-    batch.params = std::span<const QueryParams>(batch_params_).subspan(first, count);
-    batch.size = count;
-    Status status = backend.search(batch, 1, std::span(matches_).subspan(first, count));
+  if (due_count_ > 0) {
+    Status status = backend.search(due_batch(), 1, std::span(matches_).first(due_count_));
     if (!status.ok()) return make_error("crowd controller: search: " + status.message());
     ++last_.batches;
   }
@@ -606,11 +609,7 @@ Status CrowdController::tick(float dt, const CrowdInput& input, AsyncSearch& sea
   last_.no_candidate = applied.no_candidate;
   assemble(pool);
   if (due_count_ > 0) {
-    QueryBatch batch;
-    batch.features = std::span<const float>(queries_).first(std::size_t{due_count_} * database_->dims());
-    batch.params = std::span<const QueryParams>(batch_params_).first(due_count_);
-    batch.size = due_count_;
-    Status status = search.submit(batch);
+    Status status = search.submit(due_batch());
     if (!status.ok()) return make_error("crowd controller: search: " + status.message());
     ++last_.batches;
     std::copy_n(due_.begin(), due_count_, pending_.begin());

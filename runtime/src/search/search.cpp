@@ -25,7 +25,7 @@ double cost_bound(const Database& database, std::span<const float> query, const 
 
 }  // namespace
 
-Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out) {
+Status validate_queries(const Database& database, const QueryBatch& batch, std::uint32_t k) {
   if (database.frame_count() == 0) return make_error("search: the database is empty");
   if (k < 1 || k > kMaxK) {
     return make_error("search: k = " + std::to_string(k) + " is out of range [1, " + std::to_string(kMaxK) + "]");
@@ -44,10 +44,6 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
   if (!batch.params.empty() && batch.params.size() != batch.size) {
     return make_error("search: " + std::to_string(batch.params.size()) + " query params for " +
                       std::to_string(batch.size) + " queries");
-  }
-  if (out.size() != batch.size * k) {
-    return make_error("search: result span has " + std::to_string(out.size()) + " slots, expected " +
-                      std::to_string(batch.size) + " x k=" + std::to_string(k));
   }
   for (std::size_t i = 0; i < batch.features.size(); ++i) {
     if (!std::isfinite(batch.features[i])) {
@@ -89,6 +85,15 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
                         ": its costs could overflow float (features or weights too large for this database; "
                         "normalized features are usually within a few hundred)");
     }
+  }
+  return {};
+}
+
+Status validate_search(const Database& database, const QueryBatch& batch, std::uint32_t k, std::span<const Match> out) {
+  MMVK_TRY(validate_queries(database, batch, k));
+  if (out.size() != batch.size * k) {
+    return make_error("search: result span has " + std::to_string(out.size()) + " slots, expected " +
+                      std::to_string(batch.size) + " x k=" + std::to_string(k));
   }
   return {};
 }

@@ -111,6 +111,19 @@ struct VulkanSearch::Impl {
   std::optional<BruteForceKernel> brute;  // BruteForce mode
   std::vector<Slot> slots;
   std::optional<ClusterKernel> clusters;  // ClustersExact and NProbe modes
+  // A paged batch: pages of max_batch queries, pages [done, submitted) in
+  // flight, their tickets in a ring of one entry per slot (sized at create,
+  // so paging allocates nothing). `async` is the one between submit_batch()
+  // and wait_batch(); search() pages through `blocking`, so that it runs on
+  // the slots an async batch leaves free.
+  struct Paged {
+    QueryBatch batch;
+    std::uint32_t k = 1;
+    std::size_t pages = 0, submitted = 0, done = 0;
+    bool active = false;
+    std::vector<Ticket> tickets;
+  };
+  Paged async, blocking;
 
   ~Impl() {
     // Nothing may be destroyed while the GPU still uses it.
@@ -143,6 +156,14 @@ struct VulkanSearch::Impl {
   Result<Ticket> submit(const QueryBatch& batch, std::uint32_t k, std::uint32_t forced_tile);
   Result<Slot*> find_ticket(const Ticket& ticket, const char* caller);
   Status wait(const Ticket& ticket, std::span<Match> out);
+  // Starts paging `batch` (its first pages, up to the free slots).
+  Status begin_pages(Paged& paged, const QueryBatch& batch, std::uint32_t k);
+  // Waits for every page, oldest first, submitting the rest as slots free up.
+  Status finish_pages(Paged& paged, std::span<Match> out);
+  // Submits the paged batch's next page.
+  Status submit_page(Paged& paged);
+  // Waits out the pages still in flight, dropping their results into `out`.
+  void drain(Paged& paged, std::span<Match> out);
 };
 
 Status VulkanSearch::Impl::create_layouts() {
@@ -215,6 +236,8 @@ Status VulkanSearch::Impl::create_slots() {
   MMVK_VK_CHECK(vkAllocateCommandBuffers(context->device(), &command_info, commands.data()));
 
   slots.resize(options.slots);
+  async.tickets.resize(options.slots);
+  blocking.tickets.resize(options.slots);
   for (std::uint32_t s = 0; s < options.slots; ++s) {
     Slot& slot = slots[s];
     std::array<VkBuffer, kSearchSet.storage> handles{};
@@ -510,9 +533,110 @@ Status VulkanSearch::Impl::wait(const Ticket& ticket, std::span<Match> out) {
 }
 
 Status VulkanSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) {
-  Result<Ticket> ticket = submit(batch, k);
+  if (batch.size <= impl_->options.max_batch) {
+    Result<Ticket> ticket = submit(batch, k);
+    if (!ticket) return ticket.error();
+    return wait(*ticket, out);
+  }
+  // The result span is checked before any page runs, with every other check.
+  if (out.size() != batch.size * k) return validate_search(*impl_->database, batch, k, out);
+  MMVK_TRY(impl_->begin_pages(impl_->blocking, batch, k));
+  return impl_->finish_pages(impl_->blocking, out);
+}
+
+Status VulkanSearch::submit_batch(const QueryBatch& batch, std::uint32_t k) {
+  if (impl_->async.active) {
+    return make_error("VulkanSearch: submit_batch() while a batch is in flight (wait_batch() first)");
+  }
+  return impl_->begin_pages(impl_->async, batch, k);
+}
+
+Status VulkanSearch::wait_batch(std::span<Match> out) {
+  if (!impl_->async.active) return make_error("VulkanSearch: wait_batch() without a submitted batch");
+  return impl_->finish_pages(impl_->async, out);
+}
+
+// A batch larger than a slot is paged, as FAISS's GPU indexes page a large
+// batch through their fixed buffers: as many pages in flight as there are
+// free slots, the next page submitted as soon as the oldest one finishes.
+Status VulkanSearch::Impl::begin_pages(Paged& paged, const QueryBatch& batch, std::uint32_t k) {
+  // A paged batch is checked whole up front: an error names the query's
+  // index in the batch and leaves nothing in flight. One page is checked by
+  // its submit().
+  const std::size_t page = options.max_batch;
+  if (batch.size > page) MMVK_TRY(validate_queries(*database, batch, k));
+  paged.batch = batch;
+  paged.k = k;
+  paged.pages = std::max<std::size_t>((batch.size + page - 1) / page, 1);
+  paged.submitted = paged.done = 0;
+  paged.active = true;
+  const auto free_slots =
+      std::size_t(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return !s.in_flight; }));
+  // With no free slot the first page's submit() returns the error.
+  while (paged.submitted < paged.pages && paged.submitted < std::max<std::size_t>(free_slots, 1)) {
+    if (Status status = submit_page(paged); !status.ok()) {
+      std::vector<Match> dropped(page * k);
+      drain(paged, dropped);
+      return status;
+    }
+  }
+  return {};
+}
+
+Status VulkanSearch::Impl::finish_pages(Paged& paged, std::span<Match> out) {
+  const std::size_t page = options.max_batch;
+  if (out.size() != paged.batch.size * paged.k) {
+    const std::string message = "VulkanSearch: wait_batch() got " + std::to_string(out.size()) +
+                                " result slots, expected " + std::to_string(paged.batch.size) +
+                                " queries x k=" + std::to_string(paged.k);
+    std::vector<Match> dropped(page * paged.k);
+    drain(paged, dropped);
+    return make_error(message);
+  }
+  while (paged.done < paged.submitted) {
+    const std::size_t first = paged.done * page;
+    const std::size_t count = std::min(page, paged.batch.size - first);
+    const Ticket ticket = paged.tickets[paged.done % paged.tickets.size()];
+    ++paged.done;
+    Status status = wait(ticket, out.subspan(first * paged.k, count * paged.k));
+    if (status.ok() && paged.submitted < paged.pages) status = submit_page(paged);
+    if (!status.ok()) {
+      drain(paged, out);
+      return status;
+    }
+  }
+  paged.active = false;
+  return {};
+}
+
+Status VulkanSearch::Impl::submit_page(Paged& paged) {
+  const std::size_t page = options.max_batch;
+  const std::size_t dims = database->dims();
+  const std::size_t first = paged.submitted * page;
+  const std::size_t count = std::min(page, paged.batch.size - first);
+  QueryBatch part;
+  part.features = paged.batch.features.subspan(first * dims, count * dims);
+  part.params = paged.batch.params.empty() ? paged.batch.params : paged.batch.params.subspan(first, count);
+  part.size = count;
+  Result<Ticket> ticket = submit(part, paged.k, 0);
   if (!ticket) return ticket.error();
-  return wait(*ticket, out);
+  paged.tickets[paged.submitted % paged.tickets.size()] = *ticket;
+  ++paged.submitted;
+  return {};
+}
+
+void VulkanSearch::Impl::drain(Paged& paged, std::span<Match> out) {
+  const std::size_t page = options.max_batch;
+  for (; paged.done < paged.submitted; ++paged.done) {
+    const std::size_t first = paged.done * page;
+    const std::size_t count = std::min(page, paged.batch.size - first);
+    // A page's own error (a lost device) says nothing the caller is not told.
+    const std::span<Match> into = out.size() >= paged.batch.size * paged.k
+                                      ? out.subspan(first * paged.k, count * paged.k)
+                                      : out.first(count * paged.k);
+    static_cast<void>(wait(paged.tickets[paged.done % paged.tickets.size()], into));
+  }
+  paged.active = false;
 }
 
 }  // namespace mmvk::vulkan

@@ -7,12 +7,14 @@
 // metadata are uploaded into device-local buffers, and every per-search
 // resource (mapped query/parameter/result buffers for `max_batch` queries,
 // scratch, command buffers, descriptor sets, timestamp queries) is created
-// up front, so submit() allocates nothing.
+// up front, so submit() allocates nothing. A larger batch is paged through
+// those buffers (submit_batch), so search() takes any batch up to kMaxBatch.
 //
 // Asynchronous use (a crowd simulation overlapping the search with its own
 // work): submit() returns a Ticket at once; poll() says whether it is done;
 // wait() blocks and copies the matches out. `slots` submissions can be in
-// flight at a time. search() is submit() + wait().
+// flight at a time. submit_batch() and wait_batch() do the same for a batch
+// of any size, paged over the slots.
 //
 // Not thread-safe; the Context and the Database must outlive the search.
 #pragma once
@@ -43,7 +45,7 @@ enum class SearchMode {
 };
 
 struct VulkanSearchOptions {
-  std::uint32_t max_batch = 1024;  // queries per submit, >= 1
+  std::uint32_t max_batch = 1024;  // queries per submit (a page of a larger batch), >= 1
   std::uint32_t max_k = kMaxK;     // largest k a submit may ask for, in [1, kMaxK]
   std::uint32_t slots = 2;         // submissions in flight at a time, >= 1
   SearchMode mode = SearchMode::BruteForce;
@@ -97,14 +99,27 @@ class VulkanSearch final : public SearchBackend {
 
   std::string_view name() const override;
   const Database& database() const override;
-  // Blocking: submit() + wait().
+  // Blocking: any batch up to kMaxBatch, paged as submit_batch() +
+  // wait_batch() (one page: submit() + wait()).
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
   SearchStats stats() const override;
   void reset_stats() override;
+  // A VulkanAsyncSearch: the search runs while the caller works.
+  std::unique_ptr<AsyncSearch> make_async(std::uint32_t capacity) override;
 
-  // Validates the batch (validate_search, batch <= max_batch, k <= max_k),
-  // copies it into a free slot's mapped buffers and submits the kernels.
-  // Error when every slot is in flight: wait() for one first.
+  // Any batch up to kMaxBatch, paged over the slots: the batch is cut into
+  // pages of max_batch queries; as many pages are submitted as there are
+  // free slots, and wait_batch() waits for them oldest first, submitting the
+  // rest as slots free up. One submitted batch at a time (search() pages on
+  // the slots it leaves free); its spans stay valid until wait_batch(). Errors: validate_queries, no free slot, a failed
+  // submit (nothing is left in flight after an error).
+  Status submit_batch(const QueryBatch& batch, std::uint32_t k);
+  // Writes the paged batch's B*k matches to `out` (layout as search()).
+  Status wait_batch(std::span<Match> out);
+
+  // One page: validates the batch (validate_search, batch <= max_batch,
+  // k <= max_k), copies it into a free slot's mapped buffers and submits
+  // the kernels. Error when every slot is in flight: wait() for one first.
   Result<Ticket> submit(const QueryBatch& batch, std::uint32_t k);
   // True once the ticket's results are ready (wait() then returns at once).
   Result<bool> poll(const Ticket& ticket) const;

@@ -1,12 +1,18 @@
-// DeferredSearch (crowd_controller.hpp): the deferred tick on any backend.
+// DeferredSearch (async_search.hpp): a deferred search on any backend.
 #include <algorithm>
+#include <memory>
+#include <string>
 
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/async_search.hpp"
 
 namespace mmvk {
 
-DeferredSearch::DeferredSearch(SearchBackend& backend, std::uint32_t max_batch, std::uint32_t capacity)
-    : backend_(backend), max_batch_(std::max<std::uint32_t>(max_batch, 1)), matches_(capacity) {}
+std::unique_ptr<AsyncSearch> SearchBackend::make_async(std::uint32_t capacity) {
+  return std::make_unique<DeferredSearch>(*this, capacity);
+}
+
+DeferredSearch::DeferredSearch(SearchBackend& backend, std::uint32_t capacity)
+    : backend_(backend), matches_(capacity) {}
 
 Status DeferredSearch::submit(const QueryBatch& batch) {
   if (in_flight_) return make_error("deferred search: submit while a search is in flight (collect it first)");
@@ -14,15 +20,8 @@ Status DeferredSearch::submit(const QueryBatch& batch) {
     return make_error("deferred search: batch of " + std::to_string(batch.size) + " queries, capacity " +
                       std::to_string(matches_.size()));
   }
-  const std::size_t dims = backend_.database().dims();
-  for (std::size_t first = 0; first < batch.size; first += max_batch_) {
-    const std::size_t count = std::min<std::size_t>(max_batch_, batch.size - first);
-    QueryBatch chunk;
-    chunk.features = batch.features.subspan(first * dims, count * dims);
-    chunk.params = batch.params.empty() ? batch.params : batch.params.subspan(first, count);
-    chunk.size = count;
-    MMVK_TRY(backend_.search(chunk, 1, std::span(matches_).subspan(first, count)));
-  }
+  // Every backend takes any batch up to kMaxBatch (a device backend pages it).
+  MMVK_TRY(backend_.search(batch, 1, std::span(matches_).first(batch.size)));
   pending_ = batch.size;
   in_flight_ = true;
   return {};

@@ -221,8 +221,10 @@ TEST(QueryAssembly, ShownPoseWritesEveryDimensionPastOffsetsIncluded) {
   std::vector<glm::vec3> velocities(assembler->velocity_joints().size(), glm::vec3(0.5f));
   const glm::vec3 past[2] = {{2.0f, 0.0f, 2.5f}, {2.0f, 0.0f, 3.0f}};
   const float past_yaws[2] = {0.0f, 0.0f};
-  const glm::vec3 future[3] = {{2.0f, 0.0f, 3.5f}, {2.0f, 0.0f, 4.0f}, {2.0f, 0.0f, 4.0f}};
-  const float future_yaws[3] = {0.0f, 0.0f, 0.0f};
+  // Straight ahead at the predictor's offsets (both channels' future ones).
+  std::vector<glm::vec3> future;
+  for (float t : assembler->trajectory_offsets()) future.push_back(glm::vec3(2.0f, 0.0f, 3.0f + t));
+  const std::vector<float> future_yaws(future.size(), 0.0f);
   ShownPose shown;
   shown.frame = 7;
   shown.joint_positions = joint_positions;

@@ -1,0 +1,88 @@
+#include "tick_observers.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "mmvk/trajectory.hpp"
+
+namespace mmvk::crowd {
+
+namespace {
+
+// The 1 s horizon of the trajectory error, as the controller would predict it.
+constexpr float kErrorHorizon[1] = {1.0f};
+
+MotionMeterParams motion_params(const CrowdController& controller, const ControllerParams& params,
+                                const ClipQuality& clips, float dt, std::uint32_t acceleration_step) {
+  MotionMeterParams p;
+  p.legs = find_leg_joints(controller.animation());
+  p.planted_height = clips.planted_height;
+  p.dt = dt;
+  p.acceleration_step = acceleration_step;
+  // Three half-lives: the inertialization's blend has done 90% of its work.
+  p.jump_window_s = 3.0 * params.inertialization_half_life;
+  return p;
+}
+
+}  // namespace
+
+QualityObserver::QualityObserver(const CrowdController& controller, const ControllerParams& params,
+                                 const ClipQuality& clips, float dt, std::uint32_t acceleration_step)
+    : params_(params),
+      meter_(controller.size(), dt),
+      motion_(controller.size(), controller.animation().joint_count(),
+              motion_params(controller, params, clips, dt, acceleration_step)),
+      desired_xz_(2 * std::size_t{controller.size()}),
+      root_xz_(2 * std::size_t{controller.size()}),
+      animated_(std::size_t{controller.size()} * controller.animation().joint_count()) {}
+
+void QualityObserver::observe(const CrowdController& controller, const TickView& view, ThreadPool& pool) {
+  // Where the controller wants each character 1 s from now, and where it is.
+  const auto sim = controller.simulation();
+  const auto roots = controller.root_positions();
+  glm::vec3 horizon_pos[1];
+  float horizon_yaw[1];
+  for (std::size_t b = 0; b < view.desired.size(); ++b) {
+    predict_trajectory(sim[b], view.desired[b], yaw_of_velocity(view.desired[b], sim[b].yaw), params_.spring,
+                       kErrorHorizon, horizon_pos, horizon_yaw);
+    desired_xz_[2 * b] = horizon_pos[0].x, desired_xz_[2 * b + 1] = horizon_pos[0].z;
+    root_xz_[2 * b] = roots[b].x, root_xz_[2 * b + 1] = roots[b].z;
+  }
+  meter_.record_trajectory(desired_xz_, root_xz_);
+  meter_.add_transitions(controller.last_tick().jumps);
+  meter_.end_tick();
+  // The pose as displayed (after foot IK) and as animated (before).
+  controller.animated_world_positions(animated_, pool);
+  motion_.record({view.world, animated_, controller.contacts(), controller.foot_locked(),
+                  controller.ik_reach_clamped(), controller.jumped()});
+}
+
+void QualityObserver::summarize(CrowdSummary& s) const {
+  s.trajectory_error_m_1s = meter_.trajectory_error_m_median();
+  s.motion = motion_.figures();
+  s.transitions_per_agent_s = meter_.transitions_per_agent_s();
+}
+
+RecordingObserver::RecordingObserver(const CrowdController& controller, const Scenario& scenario, std::string title,
+                                     float dt, std::uint32_t ticks_per_sample)
+    : recorder_(controller, scenario, std::move(title), dt, ticks_per_sample),
+      frames_before_(controller.size()),
+      kinds_before_(controller.size(), 0) {
+  searched_before_.reserve(controller.size());
+  searched_now_.reserve(controller.size());
+}
+
+void RecordingObserver::observe(const CrowdController& controller, const TickView& view) {
+  recorder_.record_tick(view.tick, view.matches, searched_before_, kinds_before_, frames_before_, view.world);
+  searched_now_.clear();
+  const auto kinds = controller.searched();
+  for (std::uint32_t b = 0; b < kinds.size(); ++b) {
+    if (kinds[b] != 0) searched_now_.push_back(b);
+  }
+  searched_before_.swap(searched_now_);
+  std::copy(kinds.begin(), kinds.end(), kinds_before_.begin());
+  const auto frames = controller.frames();
+  std::copy(frames.begin(), frames.end(), frames_before_.begin());
+}
+
+}  // namespace mmvk::crowd

@@ -25,6 +25,15 @@ import sys
 EXTENSIONS = ('.cpp', '.hpp', '.h', '.cc')
 
 
+def literal_end(text, i):
+    """Index of the quote that closes the string or character literal whose
+    opening quote is text[i] (len(text) when unterminated)."""
+    j = i + 1
+    while j < len(text) and text[j] != text[i]:
+        j += 2 if text[j] == '\\' else 1
+    return min(j, len(text))
+
+
 def blank(text):
     """Returns text with comments, literals and preprocessor lines replaced by
     spaces, newlines kept, so that offsets and line numbers stay true."""
@@ -76,9 +85,7 @@ def blank(text):
                 wipe(i + 1, j - 1)
                 i = j
                 continue
-            j = i + 1
-            while j < n and text[j] != '"':
-                j += 2 if text[j] == '\\' else 1
+            j = literal_end(text, i)
             wipe(i + 1, j)
             i = j + 1
         elif c == "'":
@@ -89,9 +96,7 @@ def blank(text):
             if k + 1 < i and text[k + 1].isdigit():
                 i += 1
                 continue
-            j = i + 1
-            while j < n and text[j] != "'":
-                j += 2 if text[j] == '\\' else 1
+            j = literal_end(text, i)
             wipe(i + 1, j)
             i = j + 1
         else:

@@ -77,11 +77,11 @@ namespace {
 class RangePass {
  public:
   RangePass(const Database& db, const FastSearch::Layout& layout, FastSearch::Workspace::Thread& scratch,
-            const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
-            std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best)
-      : db_(db), l_(layout), scratch_(scratch), batch_(batch), k_(k), first_query_(first_query),
-        end_query_(end_query), first_group_(first_group), end_group_(end_group), best_(best),
-        tiles_(layout.tile_arrays()) {}
+            const QueryBatch& batch, const QueryParams& default_params, std::uint32_t k, std::size_t first_query,
+            std::size_t end_query, std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best)
+      : db_(db), l_(layout), scratch_(scratch), batch_(batch), default_params_(default_params), k_(k),
+        first_query_(first_query), end_query_(end_query), first_group_(first_group), end_group_(end_group),
+        best_(best) {}
 
   std::uint64_t rows() const { return rows_; }
 
@@ -105,13 +105,14 @@ class RangePass {
   // Every candidate row, blocks of rows_per_block at a time, up to
   // Kernels::brute_queries queries sharing each pass over a block.
   void brute(std::uint32_t rows_per_block) {
+    const detail::TileArrays tiles = l_.tile_arrays();
     const std::uint32_t block_groups = std::max<std::uint32_t>(1, (rows_per_block + kGroupRows - 1) / kGroupRows);
     for (std::uint32_t block = first_group_; block < end_group_; block += block_groups) {
       const std::uint32_t block_end = std::min(end_group_, block + block_groups);
       for (std::size_t q = first_query_; q < end_query_;) {
         std::uint32_t count = 1;
         while (count * 2 <= l_.kernels.brute_queries && q + count * 2 <= end_query_) count *= 2;
-        brute_block(block, block_end, q, count);
+        brute_block(tiles, block, block_end, q, count);
         q += count;
       }
     }
@@ -120,6 +121,7 @@ class RangePass {
   // Pruned: visit groups by ascending lower bound, stop at the first bound
   // above the k-th best (strictly: an equal cost may still win on frame id).
   void pruned() {
+    const detail::TileArrays tiles = l_.tile_arrays();
     const detail::BoxArrays group_boxes = l_.group_boxes();
     const detail::BoxArrays tile_boxes = l_.tile_boxes();
     for (std::size_t q = first_query_; q < end_query_; ++q) {
@@ -133,14 +135,14 @@ class RangePass {
       const std::uint32_t seed_group = seed->second;
       *seed = order.back();
       order.pop_back();
-      visit_group(tile_boxes, q, seed_group);
+      visit_group(tiles, tile_boxes, q, seed_group);
       const float worst = list[k_ - 1].cost;
       order.erase(std::remove_if(order.begin(), order.end(), [&](const auto& entry) { return entry.first > worst; }),
                   order.end());
       std::sort(order.begin(), order.end());
       for (const auto& [group_bound, group] : order) {
         if (group_bound > list[k_ - 1].cost) break;
-        visit_group(tile_boxes, q, group);
+        visit_group(tiles, tile_boxes, q, group);
       }
     }
   }
@@ -157,7 +159,8 @@ class RangePass {
 
   // Queries [q, q + count) over the groups [block, block_end), skipping the
   // groups and tiles that none of them may match.
-  void brute_block(std::uint32_t block, std::uint32_t block_end, std::size_t q, std::uint32_t count) {
+  void brute_block(const detail::TileArrays& tiles, std::uint32_t block, std::uint32_t block_end, std::size_t q,
+                   std::uint32_t count) {
     std::array<detail::KernelQuery, kBruteQueries> queries{};
     for (std::uint32_t i = 0; i < count; ++i) {
       queries[i].features = query_of(q + i).data();
@@ -180,7 +183,7 @@ class RangePass {
         group_rows += tile_rows(tile);
       }
       for (std::uint32_t i = 0; i < count; ++i) queries[i].threshold = best_of(q + i)[k_ - 1].cost;
-      const std::size_t hits = l_.kernels.evaluate_tiles(tiles_, queries.data(), count, scratch_.tile_ids.data(),
+      const std::size_t hits = l_.kernels.evaluate_tiles(tiles, queries.data(), count, scratch_.tile_ids.data(),
                                                          tile_count, scratch_.hits.data());
       rows_ += std::uint64_t{group_rows} * count;
       for (std::size_t h = 0; h < hits; ++h) offer(scratch_.hits[h], q + scratch_.hits[h].query);
@@ -190,33 +193,36 @@ class RangePass {
   // scratch_.group_order = (lower bound, group) for the groups query q may match.
   void order_groups(const detail::BoxArrays& group_boxes, std::size_t q) {
     const QueryParams& params = params_of(q);
+    std::array<float, detail::kLanes> bounds{};
     scratch_.group_order.clear();
     for (std::uint32_t pack = first_group_ / detail::kLanes; pack * detail::kLanes < end_group_; ++pack) {
-      l_.kernels.box_bounds(group_boxes, pack, 1, query_of(q).data(), params.channel_weights.data(), bounds_.data());
+      l_.kernels.box_bounds(group_boxes, pack, 1, query_of(q).data(), params.channel_weights.data(), bounds.data());
       for (std::uint32_t lane = 0; lane < detail::kLanes; ++lane) {
         const std::uint32_t group = pack * detail::kLanes + lane;
         if (group < first_group_ || group >= end_group_ || !detail::block_may_match(l_.group_summary[group], params)) {
           continue;
         }
         // A NaN bound (0 x inf on overflow) proves nothing: visit first.
-        const float bound = std::isnan(bounds_[lane]) ? -std::numeric_limits<float>::infinity() : bounds_[lane];
+        const float bound = std::isnan(bounds[lane]) ? -std::numeric_limits<float>::infinity() : bounds[lane];
         scratch_.group_order.emplace_back(bound, group);
       }
     }
   }
 
   // Query q over the tiles of one group whose bounds may beat its k-th best.
-  void visit_group(const detail::BoxArrays& tile_boxes, std::size_t q, std::uint32_t group) {
+  void visit_group(const detail::TileArrays& tiles, const detail::BoxArrays& tile_boxes, std::size_t q,
+                   std::uint32_t group) {
     const QueryParams& params = params_of(q);
     const std::span<Match> list = best_of(q);
     detail::KernelQuery kernel_query{query_of(q).data(), params.channel_weights.data(), 0.0f};
-    l_.kernels.box_bounds(tile_boxes, group, 1, kernel_query.features, kernel_query.weights, bounds_.data());
+    std::array<float, detail::kLanes> bounds{};
+    l_.kernels.box_bounds(tile_boxes, group, 1, kernel_query.features, kernel_query.weights, bounds.data());
     std::size_t tile_count = 0;
     std::uint32_t group_rows = 0;
     const std::uint32_t first_tile = group * kFastGroupTiles;
     const std::uint32_t end_tile = std::min(l_.tiles, first_tile + kFastGroupTiles);
     for (std::uint32_t tile = first_tile; tile < end_tile; ++tile) {
-      if (bounds_[tile - first_tile] > list[k_ - 1].cost || !detail::block_may_match(l_.tile_summary[tile], params)) {
+      if (bounds[tile - first_tile] > list[k_ - 1].cost || !detail::block_may_match(l_.tile_summary[tile], params)) {
         continue;
       }
       scratch_.tile_ids[tile_count++] = tile;
@@ -225,7 +231,7 @@ class RangePass {
     if (tile_count == 0) return;
     kernel_query.threshold = list[k_ - 1].cost;
     const std::size_t hits =
-        l_.kernels.evaluate_tiles(tiles_, &kernel_query, 1, scratch_.tile_ids.data(), tile_count, scratch_.hits.data());
+        l_.kernels.evaluate_tiles(tiles, &kernel_query, 1, scratch_.tile_ids.data(), tile_count, scratch_.hits.data());
     rows_ += group_rows;
     for (std::size_t h = 0; h < hits; ++h) offer(scratch_.hits[h], q);
   }
@@ -234,13 +240,13 @@ class RangePass {
   const FastSearch::Layout& l_;
   FastSearch::Workspace::Thread& scratch_;
   const QueryBatch& batch_;
+  // Kept outside the pass, like every array the kernels are given: no
+  // pointer into the pass escapes to them, so its fields stay in registers.
+  const QueryParams& default_params_;
   const std::uint32_t k_;
   const std::size_t first_query_, end_query_;
   const std::uint32_t first_group_, end_group_;
   const std::span<Match> best_;
-  const detail::TileArrays tiles_;
-  const QueryParams default_params_;
-  std::array<float, detail::kLanes> bounds_{};
   std::uint64_t rows_ = 0;
 };
 
@@ -249,8 +255,9 @@ class RangePass {
 void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
                               std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best,
                               unsigned thread) {
-  RangePass pass(*database_, *layout_, workspace_->threads[thread], batch, k, first_query, end_query, first_group,
-                 end_group, best);
+  const QueryParams default_params;
+  RangePass pass(*database_, *layout_, workspace_->threads[thread], batch, default_params, k, first_query, end_query,
+                 first_group, end_group, best);
   pass.seed_continuing_frames();
   if (options_.prune) {
     pass.pruned();

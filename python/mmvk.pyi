@@ -128,6 +128,8 @@ class Crowd:
              desired_facing: Optional[FloatArray] = None) -> None:
         """One tick: own steering, or desired_velocity float32 [agents x 2|3] m/s and
         desired_facing float32 [agents] radians (None: face the velocity)."""
+    def step_toward(self, next_positions: FloatArray, desired_facing: Optional[FloatArray] = None) -> None:
+        """One tick toward the host's next positions, float32 [agents x 2|3] metres."""
     def run(self, seconds: float) -> None:
         """Own steering for `seconds` of simulated time."""
     def place(self, index: int, x: float, z: float, yaw: float = 0.0, frame: int = 0) -> None: ...

@@ -17,6 +17,7 @@
 #include "bindings.hpp"
 #include "crowd_session.hpp"
 #include "errors.hpp"
+#include "mmvk/steering_input.hpp"
 #include "scenario.hpp"
 #include "summary.hpp"
 
@@ -39,33 +40,31 @@ class PyCrowd {
     session_ = take(std::move(made));
     agents_ = session_->agents();
     velocity_.resize(agents_);
+    next_.resize(agents_);
+    positions_.emplace(agents_);
   }
 
   void step(const py::object& desired_velocity, const py::object& desired_facing) {
-    Status status;
     if (desired_velocity.is_none()) {
       if (!desired_facing.is_none()) raise("desired_facing: given without desired_velocity");
-      py::gil_scoped_release released;
-      status = session_->step();
-    } else {
-      // (x, z) pairs, or (x, y, z) with y ignored.
-      FloatRows v;
-      const auto a = py::reinterpret_borrow<py::array>(desired_velocity);
-      const std::size_t cols = py::isinstance<py::array>(desired_velocity) && a.ndim() == 2 && a.shape(1) == 3 ? 3 : 2;
-      v = float_rows(desired_velocity, cols, "desired_velocity", false);
-      if (v.rows != agents_) {
-        raise("desired_velocity: " + std::to_string(v.rows) + " rows for " + std::to_string(agents_) + " agents");
+      Status status;
+      {
+        py::gil_scoped_release released;
+        status = session_->step();
       }
-      for (std::size_t b = 0; b < agents_; ++b) {
-        velocity_[b] = glm::vec3(v.values[b * cols], 0.0f, v.values[b * cols + cols - 1]);
-      }
-      py::array keep;
-      std::span<const float> yaw;
-      if (!desired_facing.is_none()) yaw = float_vector(desired_facing, agents_, "desired_facing", keep);
-      py::gil_scoped_release released;
-      status = session_->step(velocity_, yaw);
+      check(status);
+      return;
     }
-    check(status);
+    read_xz(desired_velocity, "desired_velocity", velocity_);
+    steer(desired_facing);
+  }
+
+  // Velocities from the host's positions at the end of this tick
+  // (PositionSteering, mmvk/steering_input.hpp).
+  void step_toward(const py::object& next_positions, const py::object& desired_facing) {
+    read_xz(next_positions, "next_positions", next_);
+    check(positions_->velocities(session_->controller().simulation(), next_, float(session_->dt()), velocity_));
+    steer(desired_facing);
   }
 
   void run(double seconds) {
@@ -79,15 +78,47 @@ class PyCrowd {
     check(status);
   }
 
+  void place(std::uint32_t index, float x, float z, float yaw, std::uint32_t frame) {
+    check(session_->place(index, x, z, yaw, frame));
+    positions_->reset();  // a teleport is no motion of the host's
+  }
+
   const CrowdSession& session() const { return *session_; }
   CrowdSession& session() { return *session_; }
   std::uint32_t agents() const { return agents_; }
 
  private:
+  // (x, z) rows, or (x, y, z) with y ignored: [agents x 2|3] float32 into out.
+  void read_xz(const py::object& value, const char* what, std::vector<glm::vec3>& out) const {
+    const auto a = py::reinterpret_borrow<py::array>(value);
+    const std::size_t cols = py::isinstance<py::array>(value) && a.ndim() == 2 && a.shape(1) == 3 ? 3 : 2;
+    const FloatRows rows = float_rows(value, cols, what, false);
+    if (rows.rows != agents_) {
+      raise(std::string(what) + ": " + std::to_string(rows.rows) + " rows for " + std::to_string(agents_) + " agents");
+    }
+    for (std::size_t b = 0; b < agents_; ++b) {
+      out[b] = glm::vec3(rows.values[b * cols], 0.0f, rows.values[b * cols + cols - 1]);
+    }
+  }
+
+  // One tick on velocity_, facing `desired_facing` (None: the velocity).
+  void steer(const py::object& desired_facing) {
+    py::array keep;
+    std::span<const float> yaw;
+    if (!desired_facing.is_none()) yaw = float_vector(desired_facing, agents_, "desired_facing", keep);
+    Status status;
+    {
+      py::gil_scoped_release released;
+      status = session_->step(velocity_, yaw);
+    }
+    check(status);
+  }
+
   std::shared_ptr<Database> database_;  // outlives the session
   std::unique_ptr<CrowdSession> session_;
   std::uint32_t agents_ = 0;
-  std::vector<glm::vec3> velocity_;
+  std::vector<glm::vec3> velocity_, next_;  // [agents]
+  std::optional<PositionSteering> positions_;  // step_toward's
 };
 
 // A copy of `values` ([n x 3] floats as glm::vec3) as float32 [n x 3].
@@ -159,12 +190,16 @@ void bind_crowd(py::module_& m) {
            "With desired_velocity (float32 [agents x 2] (x, z) or [agents x 3] (x, y, z), world m/s, y ignored) "
            "and optionally desired_facing (float32 [agents], yaw in radians, 0 faces +Z; None: face the velocity), "
            "another simulator steers. The GIL is released during the tick.")
+      .def("step_toward", &PyCrowd::step_toward, py::arg("next_positions"), py::arg("desired_facing") = py::none(),
+           "One tick toward the host's positions at the end of the tick: float32 [agents x 2] (x, z) or [agents x 3], "
+           "metres. The desired velocity is the host's own motion plus a correction of the gap over 0.2 s "
+           "(mmvk/steering_input.hpp: PositionSteering). desired_facing as for step().")
       .def("run", &PyCrowd::run, py::arg("seconds"),
            "Steps the crowd's own steering for `seconds` of simulated time (rounded to whole ticks), GIL released.")
       .def(
           "place",
           [](PyCrowd& c, std::uint32_t index, float x, float z, float yaw, std::uint32_t frame) {
-            check(c.session().place(index, x, z, yaw, frame));
+            c.place(index, x, z, yaw, frame);
           },
           py::arg("index"), py::arg("x"), py::arg("z"), py::arg("yaw") = 0.0f, py::arg("frame") = 0,
           "Places character `index` at (x, z) metres facing `yaw` radians, playing database frame `frame`; its "

@@ -110,6 +110,8 @@ class Search:
                continuing_bias: float = 0.0, continuing_multiplier: float = 1.0,
                exclusion_window: int = 0) -> tuple[npt.NDArray[np.int64], FloatArray]:
         """queries float32 [B x dims] normalized -> (frames int64 [B x k], -1 = none; costs float32 [B x k])."""
+    def _native_seconds(self, queries: FloatArray, k: int = 1, calls: int = 1) -> float:
+        """Seconds per call of the same backend search made in a C++ loop (the benchmark's baseline)."""
     @property
     def name(self) -> str: ...
     @property

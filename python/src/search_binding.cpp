@@ -1,5 +1,7 @@
 // mmvk.Search and mmvk.backends(): a backend made by name from the library's
 // registry, searched with NumPy query batches, the GIL released meanwhile.
+#include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -43,6 +45,11 @@ class PySearch {
                    const std::vector<std::string>& require, const std::vector<std::string>& exclude,
                    const py::object& weights, float continuing_bias, float continuing_multiplier,
                    std::uint32_t exclusion_window);
+
+  // Seconds per call of `calls` backend searches of `queries` in a C++ loop:
+  // the same call Search.search makes, without Python around it (the
+  // benchmark's baseline, bench/python_overhead.py).
+  double native_seconds(const py::object& queries, std::uint32_t k, std::uint32_t calls);
 
   std::string name() const { return std::string(backend_->name()); }
   const std::string& device() const { return device_; }
@@ -212,6 +219,23 @@ py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py:
   return py::make_tuple(frames, costs);
 }
 
+double PySearch::native_seconds(const py::object& queries, std::uint32_t k, std::uint32_t calls) {
+  const FloatRows rows = float_rows(queries, database_->dims(), "queries", false);
+  std::vector<Match> out(rows.rows * std::size_t(k));
+  const QueryBatch batch{rows.values, {}, rows.rows};
+  Status status;
+  double seconds = 0.0;
+  {
+    py::gil_scoped_release released;
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    for (std::uint32_t c = 0; c < calls && status.ok(); ++c) status = backend_->search(batch, k, out);
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  check(status);
+  return seconds / std::max<std::uint32_t>(calls, 1);
+}
+
 }  // namespace
 
 void bind_search(py::module_& m) {
@@ -245,6 +269,9 @@ void bind_search(py::module_& m) {
            "require / exclude: tag names. weights: {channel name: weight}. Returns frames int64 [B x k] (-1: no "
            "further candidate) and costs float32 [B x k] (inf there), best first; the semantics of docs/search.md, "
            "equal to `mmvk query`. The GIL is released while searching.")
+      .def("_native_seconds", &PySearch::native_seconds, py::arg("queries"), py::arg("k") = 1, py::arg("calls") = 1,
+           "Seconds per call of `calls` searches of `queries` (default params) made in a C++ loop: the same backend "
+           "call as search() without Python around it. For bench/python_overhead.py.")
       .def_property_readonly("name", &PySearch::name, "The backend's name.")
       .def_property_readonly("device", &PySearch::device, "Where it runs: the Vulkan device's name, or 'cpu, N threads'.")
       .def_property_readonly("database", &PySearch::database, "The Database searched.")

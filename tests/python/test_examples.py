@@ -1,6 +1,9 @@
 """The Python examples (host/examples/python) run, on small data."""
 import json
+import os
 import pathlib
+import re
+import shutil
 import subprocess
 import sys
 
@@ -30,6 +33,22 @@ def test_social_force_crowd_writes_the_viewer_page(tmp_path):
     assert page.startswith("<!DOCTYPE html>") and "social force" in page
     figures = json.loads(summary.read_text())
     assert figures["agents"] == 12 and figures["ticks"] == 120
+    # The page loads in headless Chromium and draws every character (the
+    # viewer tests' check; without chromium it is skipped unless
+    # MMVK_REQUIRE_VIEWER is set, as CI does).
+    chromium = shutil.which("chromium")
+    if chromium is None:
+        if os.environ.get("MMVK_REQUIRE_VIEWER"):
+            pytest.fail("chromium is not installed (MMVK_REQUIRE_VIEWER is set)")
+        return
+    dom = subprocess.run(
+        ["timeout", "120", chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--window-size=1280,800", "--virtual-time-budget=10000", f"--user-data-dir={tmp_path / 'profile'}",
+         "--dump-dom", f"file://{html}"], capture_output=True, text=True).stdout
+    status = re.search(r'<div id="status"[^>]*>', dom)
+    assert status and 'data-state="ready"' in status.group(0) and 'data-drawn="12"' in status.group(0), (
+        status.group(0) if status else dom[:500])
 
 
 def test_phase_sidecar(tmp_path):

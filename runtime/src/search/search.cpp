@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "search/cost_bound.hpp"
+#include "database/cost_bound.hpp"
 
 namespace mmvk {
 

@@ -23,7 +23,7 @@ constexpr const char* kCrowdUsage =
     "                  [--search-interval S] [--backend NAME] [--device N] [--seed N]\n"
     "                  [--scenario file.json] [--summary out.json] [--html out.html]\n"
     "                  [--foot-ik on|off] [--continuing-bias B] [--continuing-multiplier M]\n"
-    "                  [--exclusion-window N] [--weights CHANNEL=W,...]\n"
+    "                  [--exclusion-window N] [--weights CHANNEL=W,...] [--correction-half-life S]\n"
     "                  [--trace FILE] [--trace-agents M]\n"
     "\n"
     "Simulates a crowd on a ground plane: each character walks to its goals, steered\n"
@@ -52,6 +52,10 @@ constexpr const char* kCrowdUsage =
     "  --exclusion-window N  frames within N of that frame in its clip are no candidates\n"
     "                        (default 0)\n"
     "  --weights CHANNEL=W,...  reweigh schema channels for every search (W >= 0)\n"
+    "  --correction-half-life S  half-life of the pull of each character's animated root\n"
+    "                        towards its simulated position (default 0.15 s; shorter holds the\n"
+    "                        characters closer to their paths, with more root motion that the\n"
+    "                        animation did not make)\n"
     "  --trace FILE          write the displayed world joint positions of the first\n"
     "                        --trace-agents characters every tick: float32 x, y, z per\n"
     "                        joint, [ticks x agents x joints], and FILE.json beside it\n"
@@ -103,7 +107,7 @@ int run_crowd(Args args, const char* argv0) {
                                  {"--data", "--agents", "--seconds", "--rate", "--search-interval", "--backend",
                                   "--device", "--seed", "--scenario", "--summary", "--html", "--foot-ik",
                                   "--continuing-bias", "--continuing-multiplier", "--exclusion-window", "--weights",
-                                  "--trace", "--trace-agents"},
+                                  "--correction-half-life", "--trace", "--trace-agents"},
                                  {"--help", "-h"});
   if (!parsed) return 2;
   if (parsed->has("--help") || parsed->has("-h")) {
@@ -171,6 +175,11 @@ int run_crowd(Args args, const char* argv0) {
     Result<std::vector<std::pair<std::string, float>>> weights = parse_weight_list("--weights", *v);
     if (!weights) return fail(weights.message());
     options.weights = std::move(*weights);
+  }
+  if (const auto v = parsed->value("--correction-half-life")) {
+    Result<double> half_life = parse_positive("--correction-half-life", *v);
+    if (!half_life) return fail(half_life.message());
+    options.correction_half_life = float(*half_life);
   }
   if (const auto v = parsed->value("--trace")) options.trace = *v;
   if (const auto v = parsed->value("--trace-agents")) {

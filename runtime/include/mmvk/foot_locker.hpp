@@ -167,18 +167,20 @@ class FootLocker {
     glm::quat rotation{};
     bool solve = false;
   };
-  FootView view_foot(std::size_t f, std::size_t side, std::uint8_t contacts, const glm::vec3* world,
-                     const glm::quat* global) const;
-  bool move_point(std::size_t f, const FootView& foot, std::uint8_t to);
-  void hold_lock(std::size_t f, const FootView& foot, float dt);
-  void update_lock(std::size_t f, const FootView& foot, float dt);
-  FootTarget foot_target(std::size_t f, std::size_t side, const FootView& foot, const glm::vec3& root_position,
-                         const glm::quat* global) const;
-  float wanted_hip_drop(std::size_t side, const FootTarget& target, const glm::vec3* world) const;
-  float lower_hips(std::uint32_t b, float dt, float wanted_drop, const glm::quat& root, const glm::quat* global,
-                   glm::vec3* translations, glm::vec3* world);
-  void solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::quat& root, glm::quat* global,
-                 glm::quat* rotations, const glm::vec3* translations, glm::vec3* world);
+  // Inline (defined in foot_locker.cpp, the only caller) so that update(),
+  // run per character per tick, compiles to one function as before its split.
+  inline FootView view_foot(std::size_t f, std::size_t side, std::uint8_t contacts, const glm::vec3* world,
+                            const glm::quat* global) const;
+  inline bool move_point(std::size_t f, const FootView& foot, std::uint8_t to);
+  inline void hold_lock(std::size_t f, const FootView& foot, float dt);
+  inline void update_lock(std::size_t f, const FootView& foot, float dt);
+  inline FootTarget foot_target(std::size_t f, std::size_t side, const FootView& foot, const glm::vec3& root_position,
+                                const glm::quat* global) const;
+  inline float wanted_hip_drop(std::size_t side, const FootTarget& target, const glm::vec3* world) const;
+  inline float lower_hips(std::uint32_t b, float dt, float wanted_drop, const glm::quat& root, const glm::quat* global,
+                          glm::vec3* translations, glm::vec3* world);
+  inline void solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::quat& root,
+                        glm::quat* global, glm::quat* rotations, const glm::vec3* translations, glm::vec3* world);
 
   std::uint32_t characters_ = 0;
   FootIkParams params_;

@@ -26,17 +26,14 @@ class CommandLine {
   // `description`: the paragraph under the usage line, word-wrapped.
   CommandLine(const Command& command, std::string_view description);
 
-  CLI::App& app() { return app_; }
-
   // Options declared next are listed under `name` in the help ("options"
   // until the first call).
   void group(std::string name) { group_ = std::move(name); }
   // The exit code of a bad value for the options declared next (kUsageExit
   // until the first call): some commands report bad values as failures (1).
   void value_error_exit(int code) { value_exit_ = code; }
-  // Sections after the option list, verbatim.
-  void footer(std::string text) { app_.footer(std::move(text)); }
-  // The same, made only when the help is shown.
+  // The sections after the option list, verbatim; made only when the help
+  // is shown.
   void footer(std::function<std::string()> make) { app_.footer(std::move(make)); }
   // Said after "unexpected argument 'X'" for a stray positional argument.
   void stray_argument_hint(std::string hint) { stray_hint_ = std::move(hint); }

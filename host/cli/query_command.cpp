@@ -143,13 +143,14 @@ std::string query_footer() {
 }
 
 void declare_search(CommandLine& cli, QueryArgs& out) {
-  cli.text("--queries,--features", out.queries, "FILE", "the queries, float32 [B x dims] (--features: the same)");
+  cli.text("--queries,--features", out.queries, "FILE", "the queries, float32 [B x dims]");
   cli.text("--pose-targets", out.pose_targets, "FILE", "one pose-matching query from end-effector targets (above)");
   cli.flag("--normalized", out.normalized, "the queries are already normalized");
   cli.text("--backend", out.backend, "NAME", "the search backend (below; default " + BackendSpec{}.name + ")");
   cli.text("--clusters", out.clusters, "FILE",
            "the cluster backends' tables (from `mmvk clusters`); without it they train the tables with the default "
            "k-means parameters");
+  // A bad --nprobe fails the run (1), as its check against the backend does.
   cli.value_error_exit(1);
   cli.integer("--nprobe", out.nprobe, "N", "clusters searched per query by the *-nprobe backends (default 4)", 1);
   cli.value_error_exit(kUsageExit);

@@ -48,10 +48,14 @@ int run_clusters(Args args, const char*) {
   cli.positional("db.mmdb", database);
   cli.text("-o,--output", output, "FILE", "the table file to write (required)")->required();
   cli.integer("--clusters", params.clusters, "K", "number of clusters (default: round(sqrt(frames)))", 1);
-  cli.integer("--iterations", params.iterations, "N", "Lloyd iterations, stops early when stable (default 25)");
-  cli.integer("--seed", params.seed, "S", "k-means++ seed (default 1234)", 0, std::numeric_limits<std::uint64_t>::max());
+  // The defaults in the help are the parameters' own.
+  cli.integer("--iterations", params.iterations, "N",
+              "Lloyd iterations, stops early when stable (default " + std::to_string(params.iterations) + ")");
+  cli.integer("--seed", params.seed, "S", "k-means++ seed (default " + std::to_string(params.seed) + ")", 0,
+              std::numeric_limits<std::uint64_t>::max());
   cli.integer("--training-frames", params.max_training_frames, "M",
-              "train on at most M frames drawn from the seed, 0 = all (default 65536); every frame is then assigned");
+              "train on at most M frames drawn from the seed, 0 = all (default " +
+                  std::to_string(params.max_training_frames) + "); every frame is then assigned");
   cli.integer("--threads", threads, "N", "training threads, 0 = all cores (default)", 0, ThreadPool::kMaxThreads);
   cli.flag("--progress", always_progress, "show the progress bar even when stderr is not a terminal");
   cli.flag("--no-progress", no_progress, "never show it");

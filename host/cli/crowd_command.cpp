@@ -47,7 +47,15 @@ std::string default_data_name() {
   return shipped.empty() ? std::string("none") : std::string(shipped.front().name);
 }
 
-// The motion, the crowd and its clock, the search backend.
+// "0.1", "30": a default as the help shows it.
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
+// The motion, the crowd and its clock, the search backend. The defaults in
+// the help are those `options` holds before the parse.
 void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.text("--data", options.data, "NAME|PATH",
            "the motion: a shipped set by name (below), an .mmdb (built with animation), a manifest or a folder of "
@@ -55,15 +63,17 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
                default_data_name());
   cli.integer("--agents", options.agents, "N",
               "characters (default 1000, at most 10,000,000; with --scenario, its count)", 1, 10'000'000);
-  cli.positive("--seconds", options.seconds, "S", "simulated time (default 10; 1 to 10,000,000 ticks)");
+  cli.positive("--seconds", options.seconds, "S", "simulated time (default " + number(options.seconds) + "; 1 to 10,000,000 ticks)");
   cli.positive("--rate", options.rate_hz, "HZ",
-               "simulation ticks per second (default 30; 1 to 1000: poses are interpolated between database frames)");
+               "simulation ticks per second (default " + number(options.rate_hz) +
+                   "; 1 to 1000: poses are interpolated between database frames)");
   cli.positive("--search-interval", options.search_interval_s, "S",
-               "seconds between a character's regular searches (default 0.1; 0.001 to 3600)");
+               "seconds between a character's regular searches (default " + number(options.search_interval_s) +
+                   "; 0.001 to 3600)");
   cli.text("--backend", options.backend, "NAME",
-           "the search backend (default " + crowd::CrowdOptions{}.backend + ", on the best device)");
+           "the search backend (default " + options.backend + ", on the best device)");
   cli.integer("--device", options.device, "N", "the Vulkan device index (default: the best one)");
-  cli.integer("--seed", options.seed, "N", "the random scenario's seed (default 1)", 0,
+  cli.integer("--seed", options.seed, "N", "the random scenario's seed (default " + std::to_string(options.seed) + ")", 0,
               std::numeric_limits<std::uint64_t>::max());
   cli.text("--scenario", options.scenario, "FILE",
            "starts, goals, speeds and tags from JSON (see host/crowd/scenario.hpp)");
@@ -74,7 +84,8 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
 // How the characters move: foot locking and the search's cost terms.
 void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.value("--foot-ik", options.foot_ik, "on|off",
-            "lock planted feet where they touched down, legs solved by two-bone IK (default on)",
+            "lock planted feet where they touched down, legs solved by two-bone IK (default " +
+                std::string(options.foot_ik ? "on" : "off") + ")",
             [](const std::string& text) -> Result<bool> {
               if (text != "on" && text != "off") return make_error("--foot-ik expects on or off, got '" + text + "'");
               return text == "on";
@@ -98,7 +109,7 @@ void declare_trace(CommandLine& cli, crowd::CrowdOptions& options) {
            "write the displayed world joint positions of the first --trace-agents characters every tick: float32 x, "
            "y, z per joint, [ticks x agents x joints], and FILE.json beside it (joint names, parents, tick rate, "
            "contacts, foot locks); held in memory until the run ends, at most 512 MiB");
-  cli.integer("--trace-agents", options.trace_agents, "M", "characters in the trace (default 1)", 1);
+  cli.integer("--trace-agents", options.trace_agents, "M", "characters in the trace (default " + std::to_string(options.trace_agents) + ")", 1);
 }
 
 // Returns the exit code when the crowd must not run (help, bad options).

@@ -152,7 +152,7 @@ void declare_search(CommandLine& cli, QueryArgs& out) {
            "k-means parameters");
   // A bad --nprobe fails the run (1), as its check against the backend does.
   cli.value_error_exit(1);
-  cli.integer("--nprobe", out.nprobe, "N", "clusters searched per query by the *-nprobe backends (default 4)", 1);
+  cli.integer("--nprobe", out.nprobe, "N", "clusters searched per query by the *-nprobe backends (default " + std::to_string(BackendSpec{}.nprobe) + ")", 1);
   cli.value_error_exit(kUsageExit);
   cli.integer("--k", out.k, "K", "results per query, 1..16 (default 1)", 1, kMaxK);
   cli.integer("--threads", out.threads, "N", "0 = all cores (default), at most 1024", 0, ThreadPool::kMaxThreads);

@@ -129,7 +129,7 @@ void stream_read(benchmark::State& state) {
 
 BENCHMARK(fma_peak<8>)->Name("calibration/fma_peak/avx2")->UseRealTime();
 BENCHMARK(fma_peak<16>)->Name("calibration/fma_peak/avx512")->UseRealTime();
-// The name the first CPU search figures (bench/RESULTS.md) were measured
+// The name the first CPU search figures (bench/HISTORY.md) were measured
 // under, kept so they stay comparable.
 BENCHMARK(fma_peak<8>)->Name("machine/fma_peak_1thread")->UseRealTime();
 const bool stream_registered = [] {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The GPU check (issue 21): on a machine with a GPU, in at most 8 minutes,
+# The GPU check: on a machine with a GPU, in at most 8 minutes,
 #   1. lists the Vulkan devices (one line and exit 3 when there is no GPU
 #      device: no loader, no driver, or only CPU devices such as lavapipe),
 #   2. runs the Vulkan tests (every tests/vulkan executable) on the GPU,

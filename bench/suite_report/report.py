@@ -121,7 +121,7 @@ def section(data, machine, argv, plots_rel, plots_made):
                 "the streaming read bandwidth.", ""] + head + [""]
     scale = tables.scale_table(index)
     if scale:
-        out += ["### µs/query against N (issue 10's scale item)", ""] + scale
+        out += ["### µs/query against N", ""] + scale
     agreement = tables.faiss_agreement(index)
     if agreement:
         out += ["### FAISS flat against the reference", "",

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Crowd soak (issue 13): runs `mmvk crowd` with 1,000 characters for TICKS
+# Crowd soak: runs `mmvk crowd` with 1,000 characters for TICKS
 # ticks at 30 Hz on BACKEND, samples the process's resident memory (VmRSS)
 # every SAMPLE seconds, and fails when
 #   - the run fails,

@@ -1,5 +1,5 @@
 // Cross-size retrieval for limb_vector on the Bandai locomotion set
-// (bench/RESULTS.md, "New feature kinds (issue 12)"): every clip scaled by
+// (bench/RESULTS.md, "Motion quality", "Feature kinds"): every clip scaled by
 // 0.8 (bones and root path); each scaled frame's features, normalized like
 // the unscaled database, are searched in the unscaled database; top-1
 // agreement with the unscaled frame's own query, limb_vector schema vs raw

@@ -102,6 +102,10 @@ void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
               "frames within N of that frame in its clip are no candidates (default 0)");
   cli.value("--weights", options.weights, "CHANNEL=W,...", "reweigh schema channels for every search (W >= 0)",
             [](const std::string& text) { return parse_weight_list("--weights", text); });
+  cli.positive("--correction-half-life", options.correction_half_life, "S",
+               "half-life of the pull of each character's animated root towards its simulated position (default "
+               "0.15 s; shorter holds the characters closer to their paths, with more root motion that the animation "
+               "did not make)");
 }
 
 void declare_trace(CommandLine& cli, crowd::CrowdOptions& options) {

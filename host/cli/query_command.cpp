@@ -24,9 +24,7 @@
 #include "mmvk/thread_pool.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/backends.hpp"
-#include "mmvk/vulkan/context.hpp"
-#include "mmvk/vulkan/pipeline_cache_file.hpp"
+#include "mmvk/vulkan/lazy_context.hpp"
 #include "user_cache_dir.hpp"
 #endif
 
@@ -81,8 +79,15 @@ struct QueryArgs {
   std::vector<std::pair<std::string, float>> weights;
 };
 
+// The Vulkan context, made when a Vulkan backend is (so that listing the
+// backends for --help needs no device). Its pipeline cache is kept between
+// runs in the user's cache directory: loaded when the context is made, saved
+// after the search; a missing directory, or a damaged or foreign file, is a
+// note, never an error.
 #if defined(MMVK_HAS_VULKAN)
-using ContextHolder = std::unique_ptr<vulkan::Context>;
+struct ContextHolder {
+  vulkan::LazyContext lazy{{.context = {}, .cache_directory = user_cache_directory().value_or("")}};
+};
 #else
 struct ContextHolder {};
 #endif
@@ -96,38 +101,24 @@ struct BackendHolder {
 };
 
 #if defined(MMVK_HAS_VULKAN)
-// The Vulkan pipeline cache is kept between runs in the user's cache
-// directory: loaded when the context is made, saved after the search. A
-// missing directory, or a damaged or foreign file, is a note, never an error.
-void load_pipeline_cache(vulkan::Context& context) {
-  const std::optional<std::filesystem::path> dir = user_cache_directory();
-  if (!dir) return;
-  const std::string note = vulkan::load_pipeline_cache_file(context, *dir);
+void report_pipeline_cache_note(const ContextHolder& context) {
+  const std::string& note = context.lazy.pipeline_cache_note();
   if (!note.empty()) std::fprintf(stderr, "mmvk query: note: %s\n", note.c_str());
 }
 
 void save_pipeline_cache(const ContextHolder& context) {
-  const std::optional<std::filesystem::path> dir = user_cache_directory();
-  if (!context || !dir) return;
-  if (const Status saved = vulkan::save_pipeline_cache_file(*context, *dir); !saved) {
+  if (const Status saved = context.lazy.save_pipeline_cache(); !saved) {
     std::fprintf(stderr, "mmvk query: note: the pipeline cache was not saved: %s\n", saved.message().c_str());
   }
 }
 #endif
 
-// The CPU backends, and the Vulkan ones when built with Vulkan. The Vulkan
-// context is created into `context` only when one of them is made, so
-// listing them (--help) needs no device.
+// The CPU backends, and the Vulkan ones when built with Vulkan, on
+// `context`.
 BackendRegistry query_backends([[maybe_unused]] ContextHolder& context) {
   BackendRegistry registry = cpu_backends();
 #if defined(MMVK_HAS_VULKAN)
-  const Status added = vulkan::add_backends(registry, [&context]() -> Result<vulkan::Context*> {
-    if (!context) {
-      MMVK_ASSIGN_OR_RETURN(context, vulkan::Context::create());
-      load_pipeline_cache(*context);
-    }
-    return context.get();
-  });
+  const Status added = context.lazy.add_backends(registry);
   // The CPU and Vulkan names are distinct; a clash is a bug in mmvk itself.
   if (!added) std::fprintf(stderr, "mmvk query: %s\n", added.message().c_str());
 #endif
@@ -220,6 +211,9 @@ Status make_backend(BackendHolder& holder, const Database& db, const QueryArgs& 
     }
   }
   MMVK_ASSIGN_OR_RETURN(holder.backend, registry.make(spec, db));
+#if defined(MMVK_HAS_VULKAN)
+  report_pipeline_cache_note(holder.context);
+#endif
   return {};
 }
 

@@ -26,6 +26,7 @@ struct CrowdOptions {
   std::optional<float> continuing_bias;
   std::optional<float> continuing_multiplier;
   std::optional<std::uint32_t> exclusion_window;
+  std::optional<float> correction_half_life;  // seconds, > 0
   std::vector<std::pair<std::string, float>> weights;  // schema channel name -> weight
   bool foot_ik = true;                                  // lock planted feet with two-bone IK
   // The displayed joint positions of the first trace_agents characters,

@@ -55,6 +55,9 @@ Status check_options(const CrowdOptions& o) {
   if (o.continuing_multiplier && !(std::isfinite(*o.continuing_multiplier) && *o.continuing_multiplier >= 0.0f)) {
     return make_error("--continuing-multiplier must be finite and >= 0");
   }
+  if (o.correction_half_life && !(std::isfinite(*o.correction_half_life) && *o.correction_half_life > 0.0f)) {
+    return make_error("--correction-half-life must be a positive number (seconds)");
+  }
   return check_time_options(o);
 }
 
@@ -171,7 +174,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
   params.continuing_bias = options.continuing_bias.value_or(kContinuingBias);
-  params.correction_half_life = kCorrectionHalfLife;
+  params.correction_half_life = options.correction_half_life.value_or(kCorrectionHalfLife);
   params.continuing_multiplier = options.continuing_multiplier.value_or(params.continuing_multiplier);
   params.exclusion_window = options.exclusion_window.value_or(params.exclusion_window);
   params.foot_ik.enabled = options.foot_ik;
@@ -341,7 +344,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
   s.chosen_frames_hash = chosen.digest();
-  if (Status saved = save_crowd_pipeline_cache(search, options.cache_dir); !saved && log) {
+  if (Status saved = save_crowd_pipeline_cache(search); !saved && log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }
 

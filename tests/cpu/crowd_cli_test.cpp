@@ -107,6 +107,8 @@ TEST_F(CrowdCli, ControlsAndTraceErrorsNameTheOption) {
                  "channel 'left_foot_position' is given twice");
   expect_failure(run + "--weights left_foot_position=-1", "--weights");
   expect_failure(run + "--continuing-multiplier -1", "--continuing-multiplier must be >= 0");
+  expect_failure(run + "--correction-half-life 0", "--correction-half-life expects a positive number");
+  expect_failure(run + "--correction-half-life nan", "--correction-half-life expects a positive number");
   const std::string trace = (dir_ / "t.f32").string();
   expect_failure(run + "--trace " + trace + " --trace-agents 5", "--trace-agents 5 must be in [1, 3]");
   expect_failure(run + "--trace " + trace + " --summary " + trace, "name the same file");

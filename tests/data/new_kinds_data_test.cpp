@@ -1,7 +1,7 @@
 // The phase and foot_contact kinds on the Bandai straight walks: the phase
 // of each toe's height advances monotonically at the stride frequency that
 // the contacts give, and a mirrored clip's left phase is the source's right.
-// Prints a per-clip table (bench/RESULTS.md, "New feature kinds (issue 12)").
+// Prints a per-clip table (bench/RESULTS.md, "Motion quality", "Feature kinds").
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -8,7 +8,7 @@
 // variable. Waking a sleeping thread took 46-52 µs per parallel_for on the
 // 2-vCPU test machine, longer than a whole query of the cluster search; a
 // spinning one picks the next call up in 0.4 µs, 3-4 µs with more threads
-// than cores (bench BM_ThreadPoolHandOver, bench/RESULTS.md). The cost is
+// than cores (bench BM_ThreadPoolHandOver, bench/HISTORY.md, 2026-11-23 19:16). The cost is
 // at most spin_us of each thread's core per call when no call follows.
 #pragma once
 

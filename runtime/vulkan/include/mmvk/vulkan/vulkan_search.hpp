@@ -65,9 +65,7 @@ struct VulkanSearchOptions {
   // items and their sort by block), sized for the worst case (every query
   // of a chunk visiting every block). Larger chunks share more blocks: the
   // scan evaluates a block once for a tile of up to 8 of the chunk's
-  // queries that visit it (Bandai volume 417k, B = 1024: one chunk of 1024
-  // queries scanned 2.1x faster than chunks of 126). On unified memory
-  // only the pages the visited blocks use are touched.
+  // queries that visit it. The whole budget is allocated at creation.
   std::uint64_t cluster_scratch_bytes = std::uint64_t{512} << 20;
   // Runs warm_up() at creation: drivers such as lavapipe compile at the
   // first dispatch, which would otherwise land in a search.

@@ -16,7 +16,6 @@
 #include "crowd_limits.hpp"
 #include "crowd_paths.hpp"
 #include "default_data.hpp"
-#include "mmvk/hash.hpp"
 #include "gait_plan.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
@@ -83,20 +82,6 @@ Result<Scenario> make_scenario(const CrowdOptions& options, bool can_run) {
   return scenario;
 }
 
-// Tags by name, per agent, into the controller's query parameters.
-Status apply_tags(const Scenario& scenario, const Database& database, std::span<QueryParams> params) {
-  for (std::size_t a = 0; a < scenario.agents.size(); ++a) {
-    const AgentPlan& plan = scenario.agents[a];
-    const std::string where = scenario.source + ": agents[" + std::to_string(a) + "].";
-    Result<TagMask> require = database.tag_mask(plan.require_tags);
-    if (!require) return make_error(where + "require_tags: " + require.message());
-    Result<TagMask> exclude = database.tag_mask(plan.exclude_tags);
-    if (!exclude) return make_error(where + "exclude_tags: " + exclude.message());
-    params[a].require_all = *require;
-    params[a].exclude_any = *exclude;
-  }
-  return {};
-}
 
 // Added to the cost of the frame a character would play anyway: a jump must
 // win by this much. Queries measure the pose the character shows, which
@@ -138,12 +123,6 @@ Status apply_weights(const CrowdOptions& options, const Database& database, std:
   return {};
 }
 
-// The spacing of the pose acceleration samples: the database's frame
-// interval in ticks (motion_meter.hpp).
-std::uint32_t acceleration_step(double rate_hz, double fps) {
-  return std::uint32_t(std::clamp(std::lround(rate_hz / fps), 1L, 16L));
-}
-
 // The motion checked for a crowd: it has animation and walks.
 Result<GaitSpeeds> check_motion(const Database& db, const std::string& db_name) {
   if (!db.animation()) {
@@ -182,7 +161,7 @@ Result<CrowdController> make_controller(const Database& db, const std::string& d
   Result<CrowdController> created = CrowdController::create(db, agents, params);
   if (!created) return make_error(db_name + ": " + created.message());
   CrowdController controller = std::move(created.value());
-  MMVK_TRY(apply_tags(scenario, db, controller.query_params()));
+  MMVK_TRY(apply_plan_tags(scenario, db, controller.query_params()));
   MMVK_TRY(apply_weights(options, db, controller.query_params()));
   for (std::uint32_t b = 0; b < agents; ++b) {
     const AgentPlan& plan = scenario.agents[b];
@@ -244,28 +223,18 @@ class TickLoop {
 
   // Runs `ticks` ticks; the per-tick timings are kept for the summary.
   Status run(std::uint64_t ticks, ProgressLine& progress) {
-    search_ms_.reserve(ticks), tick_ms_.reserve(ticks);
+    figures_.reserve(ticks);
     const auto run_start = Clock::now();
     for (std::uint64_t t = 0; t < ticks; ++t) {
       MMVK_TRY(step(t));
-      progress.tick(double(t + 1) * dt_, controller_.last_tick().searches, search_ms_.back());
+      progress.tick(double(t + 1) * dt_, controller_.last_tick().searches, figures_.last_search_ms());
     }
     wall_seconds_ = std::chrono::duration<double>(Clock::now() - run_start).count();
     return {};
   }
 
   // The loop's own figures: searches, their timings and the chosen frames.
-  void summarize(CrowdSummary& s) const {
-    s.searches = searches_;
-    s.queries_per_tick = s.ticks ? double(searches_) / double(s.ticks) : 0.0;
-    s.search_ms_p50 = percentile(search_ms_, 0.5);
-    s.search_ms_p99 = percentile(search_ms_, 0.99);
-    s.tick_ms_p50 = percentile(tick_ms_, 0.5);
-    s.tick_ms_p99 = percentile(tick_ms_, 0.99);
-    s.wall_seconds = wall_seconds_;
-    s.realtime_factor = wall_seconds_ > 0.0 ? s.seconds / wall_seconds_ : 0.0;
-    s.chosen_frames_hash = chosen_.digest();
-  }
+  void summarize(CrowdSummary& s) const { figures_.summarize(s, wall_seconds_); }
 
  private:
   Status step(std::uint64_t t) {
@@ -276,18 +245,12 @@ class TickLoop {
     for (std::uint32_t b = 0; b < controller_.size(); ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
     observed_.begin_tick();
     MMVK_TRY(controller_.tick(dt_, CrowdInput{desired_, {}}, observed_, pool_));
-    tick_ms_.push_back(ms_since(tick_start));
-    search_ms_.push_back(observed_.blocked_seconds() * 1e3);
-
-    // The chosen frames, in order: every applied match of every tick.
     const auto matches = observed_.collected_matches();
-    chosen_.add_u32(std::uint32_t(t));
-    chosen_.add_u32(std::uint32_t(matches.size()));
-    for (const Match& m : matches) chosen_.add_u32(m.frame);
-    searches_ += controller_.last_tick().searches;
+    figures_.record(t, ms_since(tick_start), observed_.blocked_seconds() * 1e3, matches,
+                    controller_.last_tick().searches);
 
     controller_.world_positions(world_, pool_);
-    const TickView view{t, desired_, matches, world_};
+    const TickView view{t, desired_, {}, matches, world_};
     quality_.observe(controller_, view, pool_);
     if (trace_) trace_->record(world_, controller_.contacts(), controller_.foot_locked());
     if (recording_) recording_->observe(controller_, view);
@@ -305,9 +268,7 @@ class TickLoop {
   // Per tick, [agents] or [agents x joints]; sized once.
   std::vector<float> x_, z_, vx_, vz_;
   std::vector<glm::vec3> desired_, world_;
-  std::vector<double> search_ms_, tick_ms_;
-  Hasher chosen_;
-  std::uint64_t searches_ = 0;
+  TickFigures figures_;
   double wall_seconds_ = 0.0;
 };
 
@@ -366,7 +327,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   Steering steering(scenario, speeds);
   ObservedSearch observed(*search.deferred, agents);
   const ClipQuality clips = measure_clip_quality(db, pool);
-  QualityObserver quality(controller, params, clips, dt, acceleration_step(options.rate_hz, db.fps()));
+  QualityObserver quality(controller, params, clips, dt, options.rate_hz, db.fps());
   const std::unique_ptr<RecordingObserver> recording =
       make_recording(options, controller, scenario, data, search, dt);
   ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,

@@ -53,9 +53,9 @@ constexpr const char* kCrowdUsage =
     "                        (default 0)\n"
     "  --weights CHANNEL=W,...  reweigh schema channels for every search (W >= 0)\n"
     "  --correction-half-life S  half-life of the pull of each character's animated root\n"
-    "                        towards its simulated position (default 0.15 s; shorter holds the\n"
-    "                        characters closer to their paths, with more root motion that the\n"
-    "                        animation did not make)\n"
+    "                        towards its simulated position (default: the shipped set's, below;\n"
+    "                        other data 0.15 s; shorter holds the characters closer to their\n"
+    "                        paths, with more root motion that the animation did not make)\n"
     "  --trace FILE          write the displayed world joint positions of the first\n"
     "                        --trace-agents characters every tick: float32 x, y, z per\n"
     "                        joint, [ticks x agents x joints], and FILE.json beside it\n"
@@ -81,7 +81,11 @@ std::string shipped_data_help() {
     line.append(data.name);
     line.resize(std::max(kIndent, line.size() + 1), ' ');
     bool fresh = true;  // no word on this line yet
-    std::string_view rest = data.description;
+    char settings[64];
+    std::snprintf(settings, sizeof(settings), ". Crowd settings: --correction-half-life %g",
+                  double(data.correction_half_life));
+    const std::string text = std::string(data.description) + settings;
+    std::string_view rest = text;
     while (!rest.empty()) {
       const std::size_t space = rest.find(' ');
       const std::string_view word = rest.substr(0, space);

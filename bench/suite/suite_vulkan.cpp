@@ -5,7 +5,7 @@
 
 #if defined(MMVK_HAS_VULKAN)
 #include "mmvk/vulkan/backends.hpp"
-#include "mmvk/vulkan/context.hpp"
+#include "mmvk/vulkan/lazy_context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #endif
 
@@ -15,36 +15,27 @@ namespace mmvk::bench {
 
 namespace {
 
-struct ContextHolder {
-  bool tried = false;
-  std::unique_ptr<vulkan::Context> context;
-  std::string error;
-};
-
-ContextHolder& holder() {
-  static ContextHolder h;
-  return h;
+// The suite's one context (a process-wide object is fine in a benchmark's
+// main program, never in the library). No cache directory: every run
+// measures the same cold start.
+vulkan::LazyContext& lazy_context() {
+  static vulkan::LazyContext context;
+  return context;
 }
 
 }  // namespace
 
-void prepare_vulkan_context() { (void)holder(); }
+void prepare_vulkan_context() { (void)lazy_context(); }
 
 void add_vulkan_backends(BackendRegistry& registry) {
-  vulkan::ContextSource source = []() -> Result<vulkan::Context*> {
-    ContextHolder& h = holder();
-    if (!h.tried) {
-      h.tried = true;
-      Result<std::unique_ptr<vulkan::Context>> created = vulkan::Context::create();
-      if (created) {
-        h.context = std::move(created).value();
-        std::fprintf(stderr, "suite: Vulkan device %s\n", h.context->device_name().c_str());
-      } else {
-        h.error = created.message();
-      }
-    }
-    if (!h.context) return make_error("no Vulkan context: " + h.error);
-    return h.context.get();
+  vulkan::LazyContext& lazy = lazy_context();
+  // The helper makes the context; this source also says which device it is.
+  vulkan::ContextSource source = [&lazy]() -> Result<vulkan::Context*> {
+    const bool first = lazy.created() == nullptr;
+    Result<vulkan::Context*> context = lazy.get();
+    if (!context) return make_error("no Vulkan context: " + context.message());
+    if (first) std::fprintf(stderr, "suite: Vulkan device %s\n", (*context)->device_name().c_str());
+    return context;
   };
   if (Status added = vulkan::add_backends(registry, std::move(source)); !added) {
     std::fprintf(stderr, "suite: %s\n", added.message().c_str());

@@ -11,48 +11,6 @@
 
 namespace mmvk::cli {
 
-std::optional<std::string> ParsedArgs::value(std::string_view option) const {
-  auto it = values.find(option);
-  if (it == values.end()) return std::nullopt;
-  return it->second;
-}
-
-std::optional<ParsedArgs> parse_args(std::string_view command, Args args, const std::set<std::string_view>& with_value,
-                                     const std::set<std::string_view>& without_value) {
-  ParsedArgs parsed;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    std::string_view arg = args[i];
-    if (arg.size() < 2 || arg[0] != '-') {
-      parsed.positional.emplace_back(arg);
-      continue;
-    }
-    std::string_view name = arg;
-    std::optional<std::string_view> inline_value;
-    if (const std::size_t eq = arg.find('='); eq != std::string_view::npos && arg.starts_with("--")) {
-      name = arg.substr(0, eq);
-      inline_value = arg.substr(eq + 1);
-    }
-    if (with_value.count(name)) {
-      if (inline_value) {
-        parsed.values[std::string(name)] = std::string(*inline_value);
-      } else if (i + 1 < args.size()) {
-        parsed.values[std::string(name)] = std::string(args[++i]);
-      } else {
-        std::fprintf(stderr, "mmvk %.*s: %.*s needs a value\n", int(command.size()), command.data(), int(name.size()),
-                     name.data());
-        return std::nullopt;
-      }
-    } else if (without_value.count(name) && !inline_value) {
-      parsed.flags.insert(std::string(name));
-    } else {
-      std::fprintf(stderr, "mmvk %.*s: unknown option '%.*s' (see mmvk %.*s --help)\n", int(command.size()),
-                   command.data(), int(arg.size()), arg.data(), int(command.size()), command.data());
-      return std::nullopt;
-    }
-  }
-  return parsed;
-}
-
 namespace {
 std::string expected(std::string_view option, std::string_view what, std::string_view text) {
   return std::string(option) + " expects " + std::string(what) + ", got '" + std::string(text) + "'";

@@ -1,36 +1,17 @@
-// Small shared helpers for the mmvk subcommands: option parsing and output.
+// Small shared helpers for the mmvk subcommands: the parsers of option values
+// (command_line.hpp declares the options with them) and output.
 #pragma once
 
 #include <cstdint>
 #include <limits>
-#include <map>
-#include <optional>
-#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
-#include "commands.hpp"
 #include "mmvk/status.hpp"
 
 namespace mmvk::cli {
-
-struct ParsedArgs {
-  std::vector<std::string> positional;
-  std::map<std::string, std::string, std::less<>> values;  // "--fps" -> "30"
-  std::set<std::string, std::less<>> flags;                // "--mirror"
-
-  bool has(std::string_view flag) const { return flags.count(flag) != 0; }
-  std::optional<std::string> value(std::string_view option) const;
-};
-
-// Parses `args`: options in `with_value` take the next argument (or
-// "--opt=value"), those in `without_value` are flags; anything else starting
-// with '-' is an error. Returns nullopt after printing "mmvk <command>: ..."
-// to stderr.
-std::optional<ParsedArgs> parse_args(std::string_view command, Args args, const std::set<std::string_view>& with_value,
-                                     const std::set<std::string_view>& without_value);
 
 // Number parsing for every command, in one place: the whole text must be
 // the number, and the error message names the option and what it expects

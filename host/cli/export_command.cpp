@@ -1,11 +1,14 @@
 // mmvk export: the normalized feature matrix as raw float32 plus a JSON
 // sidecar describing its layout, for analysis and training outside mmvk.
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "command_line.hpp"
 #include "animation_report.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
@@ -16,22 +19,25 @@ namespace mmvk::cli {
 
 namespace {
 
-constexpr const char* kExportUsage =
-    "usage: mmvk export db.mmdb --features out.f32 [--sidecar out.f32.json] [--animation anim.f32]\n"
+constexpr const char* kExportDescription =
+    "Writes the normalized feature matrix as raw little-endian float32, row-major [frames x dims], and a JSON "
+    "sidecar (default: <out>.json) with dims, fps, channel names and groups, per-dimension names, offsets, scales "
+    "and weights (raw = normalized * scale + offset; scale already includes 1 / weight), tag names, clip ranges and "
+    "the per-frame flags (1 = do_not_use, 2 = block_transition, 4 = edge_excluded).\n"
     "\n"
-    "Writes the normalized feature matrix as raw little-endian float32, row-major\n"
-    "[frames x dims], and a JSON sidecar (default: <out>.json) with dims, fps,\n"
-    "channel names and groups, per-dimension names, offsets, scales and weights\n"
-    "(raw = normalized * scale + offset; scale already includes 1 / weight), tag\n"
-    "names, clip ranges and the per-frame flags (1 = do_not_use,\n"
-    "2 = block_transition, 4 = edge_excluded).\n"
+    "--animation anim.f32 writes the animation section the same way (float32 [frames x columns] and anim.f32.json "
+    "naming the columns, the skeleton and the clips); either --features or --animation may be given alone.\n"
     "\n"
-    "--animation anim.f32 writes the animation section the same way (float32\n"
-    "[frames x columns] and anim.f32.json naming the columns, the skeleton and\n"
-    "the clips); either --features or --animation may be given alone.\n"
-    "\n"
-    "A device or FIFO output (--features /dev/stdout) is written in place; its\n"
-    "sidecar must then be named with --sidecar (--animation needs a file).\n";
+    "A device or FIFO output (--features /dev/stdout) is written in place; its sidecar must then be named with "
+    "--sidecar (--animation needs a file).";
+
+struct ExportArgs {
+  std::string database;
+  std::optional<std::string> features;
+  std::optional<std::string> sidecar;  // as given
+  std::optional<std::string> animation;
+  std::string sidecar_path;  // as written: --sidecar, else --features + .json
+};
 
 nlohmann::json sidecar(const Database& db, const std::string& source, const std::string& features_path) {
   const FeatureSchema& schema = db.schema();
@@ -93,70 +99,77 @@ nlohmann::json sidecar(const Database& db, const std::string& source, const std:
   return out;
 }
 
-}  // namespace
+// Returns the exit code when the export must not run (help, usage errors).
+std::optional<int> parse_export_args(Args args, ExportArgs& out) {
+  CommandLine cli(kExportCommand, kExportDescription);
+  cli.positional("db.mmdb", out.database);
+  cli.text("--features", out.features, "FILE", "the feature matrix to write (float32)");
+  cli.text("--sidecar", out.sidecar, "FILE", "its JSON sidecar (default: the --features file + .json)");
+  cli.text("--animation", out.animation, "FILE", "the animation section to write (float32), and FILE.json beside it");
+  if (const std::optional<int> exit_code = cli.parse(args)) return exit_code;
+  if (!out.features && !out.animation) return cli.usage_error();
+  if (out.features) out.sidecar_path = out.sidecar.value_or(*out.features + ".json");
+  return std::nullopt;
+}
 
-int run_export(Args args) {
-  const auto parsed = parse_args("export", args, {"--features", "--sidecar", "--animation"}, {"--help", "-h"});
-  if (!parsed) return 2;
-  if (parsed->has("--help") || parsed->has("-h")) {
-    std::fputs(kExportUsage, stdout);
-    return 0;
+// Before any work: an output that is the database, or another output,
+// would destroy it.
+Status check_paths(const ExportArgs& args) {
+  std::vector<NamedPath> paths = {{"the database", args.database, false}};
+  if (args.features) {
+    paths.push_back({"--features", *args.features, true});
+    paths.push_back({args.sidecar ? "--sidecar" : "the sidecar (--features + .json)", args.sidecar_path, true});
   }
-  const std::optional<std::string> features = parsed->value("--features");
-  const std::optional<std::string> animation = parsed->value("--animation");
-  if (parsed->positional.size() != 1 || (!features && !animation)) {
-    std::fputs(kExportUsage, stderr);
-    return 2;
-  }
-  const std::string sidecar_path = features ? parsed->value("--sidecar").value_or(*features + ".json") : std::string();
-  // Before any work: an output that is the database, or another output,
-  // would destroy it.
-  std::vector<NamedPath> paths = {{"the database", parsed->positional[0], false}};
-  if (features) {
-    paths.push_back({"--features", *features, true});
-    paths.push_back({parsed->value("--sidecar") ? "--sidecar" : "the sidecar (--features + .json)", sidecar_path, true});
-  }
-  if (animation) {
-    paths.push_back({"--animation", *animation, true});
-    paths.push_back({"the animation sidecar (--animation + .json)", *animation + ".json", true});
+  if (args.animation) {
+    paths.push_back({"--animation", *args.animation, true});
+    paths.push_back({"the animation sidecar (--animation + .json)", *args.animation + ".json", true});
   }
   // A default sidecar beside a device or FIFO (--features /dev/null) would
   // be a new file in /dev: it must be named.
-  if (features && !parsed->value("--sidecar") && is_stream_path(*features)) {
-    return report_error("export", "--features " + *features + " is a device or FIFO: name the JSON sidecar with --sidecar", 1);
+  if (args.features && !args.sidecar && is_stream_path(*args.features)) {
+    return make_error("--features " + *args.features + " is a device or FIFO: name the JSON sidecar with --sidecar");
   }
-  if (animation && is_stream_path(*animation)) {
-    return report_error("export", "--animation " + *animation + " is a device or FIFO: its sidecar would be " +
-                                      *animation + ".json beside it; write to a file", 1);
+  if (args.animation && is_stream_path(*args.animation)) {
+    return make_error("--animation " + *args.animation + " is a device or FIFO: its sidecar would be " +
+                      *args.animation + ".json beside it; write to a file");
   }
-  if (Status checked = check_command_paths(paths); !checked) return report_error("export", checked.message(), 1);
-  Result<Database> db = load_database(parsed->positional[0]);
-  if (!db.ok()) {
-    std::fprintf(stderr, "mmvk export: %s\n", db.message().c_str());
-    return 1;
-  }
-  if (animation) {
-    if (Status written = export_animation(*db, parsed->positional[0], *animation, *animation + ".json"); !written.ok()) {
-      std::fprintf(stderr, "mmvk export: %s\n", written.message().c_str());
-      return 1;
-    }
-    std::printf("wrote %s (%u frames, float32) and %s.json\n", animation->c_str(), db->frame_count(), animation->c_str());
-    if (!features) return 0;
-  }
+  return check_command_paths(paths);
+}
+
+Status write_features(const Database& db, const ExportArgs& args) {
   // The sidecar's text exists before any file is written; names with
   // invalid UTF-8 are replaced (U+FFFD), never thrown.
   const std::string sidecar_text =
-      sidecar(*db, parsed->positional[0], *features).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
-      "\n";
-  Status written = write_f32_rows(*features, db->features());
-  if (written.ok()) written = write_file_atomically(sidecar_path, sidecar_text);
-  if (!written.ok()) {
-    std::fprintf(stderr, "mmvk export: %s\n", written.message().c_str());
-    return 1;
+      sidecar(db, args.database, *args.features).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  MMVK_TRY(write_f32_rows(*args.features, db.features()));
+  MMVK_TRY(write_file_atomically(args.sidecar_path, sidecar_text));
+  std::printf("wrote %s (%u frames x %u dims, float32) and %s\n", args.features->c_str(), db.frame_count(), db.dims(),
+              args.sidecar_path.c_str());
+  return {};
+}
+
+int run_export(Args args, const char*) {
+  ExportArgs parsed;
+  if (const std::optional<int> exit_code = parse_export_args(args, parsed)) return *exit_code;
+  if (Status checked = check_paths(parsed); !checked) return report_error("export", checked.message(), 1);
+  Result<Database> db = load_database(parsed.database);
+  if (!db.ok()) return report_error("export", db.message(), 1);
+  if (const std::optional<std::string>& animation = parsed.animation) {
+    if (Status written = export_animation(*db, parsed.database, *animation, *animation + ".json"); !written.ok()) {
+      return report_error("export", written.message(), 1);
+    }
+    std::printf("wrote %s (%u frames, float32) and %s.json\n", animation->c_str(), db->frame_count(),
+                animation->c_str());
   }
-  std::printf("wrote %s (%u frames x %u dims, float32) and %s\n", features->c_str(), db->frame_count(), db->dims(),
-              sidecar_path.c_str());
+  if (parsed.features) {
+    if (Status written = write_features(*db, parsed); !written.ok()) return report_error("export", written.message(), 1);
+  }
   return 0;
 }
+
+}  // namespace
+
+const Command kExportCommand{"export", "db.mmdb --features out.f32", "the normalized feature matrix + JSON sidecar",
+                             run_export};
 
 }  // namespace mmvk::cli

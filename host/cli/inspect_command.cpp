@@ -1,11 +1,14 @@
 // mmvk inspect: what is in a database file.
 #include <cinttypes>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "command_line.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/hash.hpp"
@@ -17,14 +20,10 @@ namespace mmvk::cli {
 
 namespace {
 
-constexpr const char* kInspectUsage =
-    "usage: mmvk inspect db.mmdb [--json]\n"
-    "\n"
-    "Prints the database's frames, clips, fps, tags, frame flag counts, the metres\n"
-    "per file unit the import used, the skeleton's standing height, the walk and run\n"
-    "speeds the crowd measures and, per channel and dimension, the normalization\n"
-    "offset and scale and the raw (unnormalized) mean, std, min and max.\n"
-    "  --json   the same as one JSON object on stdout\n";
+constexpr const char* kInspectDescription =
+    "Prints the database's frames, clips, fps, tags, frame flag counts, the metres per file unit the import used, "
+    "the skeleton's standing height, the walk and run speeds the crowd measures and, per channel and dimension, the "
+    "normalization offset and scale and the raw (unnormalized) mean, std, min and max.";
 
 // Names come from files anyone can write: control characters (an escape
 // sequence in a clip name) are shown as \xHH instead of reaching the terminal.
@@ -70,119 +69,123 @@ std::vector<RawDimStats> raw_statistics(const Database& db) {
   return raw;
 }
 
-}  // namespace
-
-int run_inspect(Args args) {
-  const auto parsed = parse_args("inspect", args, {}, {"--json", "--help", "-h"});
-  if (!parsed) return 2;
-  if (parsed->has("--help") || parsed->has("-h")) {
-    std::fputs(kInspectUsage, stdout);
-    return 0;
-  }
-  if (parsed->positional.size() != 1) {
-    std::fputs(kInspectUsage, stderr);
-    return 2;
-  }
-  const std::string& path = parsed->positional[0];
-  Result<Database> loaded = load_database(path);
-  if (!loaded.ok()) {
-    std::fprintf(stderr, "mmvk inspect: %s\n", loaded.message().c_str());
-    return 1;
-  }
-  const Database& db = *loaded;
+// Frame and clip counts: flags, tags, mirrored and looping clips.
+struct Counts {
   std::uint64_t do_not_use = 0, block = 0, edge = 0, candidates = 0;
-  for (std::uint32_t flags : db.frame_flags()) {
-    do_not_use += (flags & kFrameDoNotUse) != 0;
-    block += (flags & kFrameBlockTransition) != 0;
-    edge += (flags & kFrameEdgeExcluded) != 0;
-    candidates += (flags & (kFrameDoNotUse | kFrameEdgeExcluded)) == 0;
-  }
   std::size_t mirrored = 0, looping = 0;
-  std::vector<std::uint64_t> tag_frames(db.tag_names().size(), 0);
+  std::vector<std::uint64_t> tag_frames;  // per tag
+};
+
+Counts count(const Database& db) {
+  Counts counts;
+  for (std::uint32_t flags : db.frame_flags()) {
+    counts.do_not_use += (flags & kFrameDoNotUse) != 0;
+    counts.block += (flags & kFrameBlockTransition) != 0;
+    counts.edge += (flags & kFrameEdgeExcluded) != 0;
+    counts.candidates += (flags & (kFrameDoNotUse | kFrameEdgeExcluded)) == 0;
+  }
   for (const Clip& clip : db.clips()) {
-    mirrored += clip.mirrored;
-    looping += clip.loop;
+    counts.mirrored += clip.mirrored;
+    counts.looping += clip.loop;
   }
   // Per frame: tags on time ranges (manifest tag_ranges) cover part of a clip.
+  counts.tag_frames.assign(db.tag_names().size(), 0);
   for (const TagMask tags : db.frame_tags()) {
-    for (std::size_t t = 0; t < tag_frames.size(); ++t) tag_frames[t] += (tags >> t) & 1u;
+    for (std::size_t t = 0; t < counts.tag_frames.size(); ++t) counts.tag_frames[t] += (tags >> t) & 1u;
   }
-  const std::vector<RawDimStats> raw = raw_statistics(db);
+  return counts;
+}
+
+nlohmann::json channels_json(const Database& db, const std::vector<RawDimStats>& raw) {
   const FeatureSchema& schema = db.schema();
-
-  if (parsed->has("--json")) {
-    nlohmann::json out;
-    out["file"] = path;
-    out["frames"] = db.frame_count();
-    out["dims"] = db.dims();
-    out["fps"] = db.fps();
-    out["content_hash"] = hash_hex(db.content_hash());
-    out["flags"] = {{"do_not_use", do_not_use}, {"block_transition", block}, {"edge_excluded", edge},
-                    {"candidates", candidates}};
-    out["tags"] = nlohmann::json::array();
-    for (std::size_t t = 0; t < tag_frames.size(); ++t) {
-      out["tags"].push_back({{"name", db.tag_names()[t]}, {"frames", tag_frames[t]}});
+  nlohmann::json channels = nlohmann::json::array();
+  for (std::size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& channel = schema.channels[c];
+    nlohmann::json ch = {{"name", channel.name}, {"kind", channel_kind_name(channel.kind)},
+                         {"normalization", normalization_name(channel.normalization)}, {"weight", channel.weight},
+                         {"offset", schema.offset(c)}, {"dims", channel.dims()}};
+    ch["dimensions"] = nlohmann::json::array();
+    for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
+      ch["dimensions"].push_back({{"name", schema.dim_name(d)}, {"offset", db.normalization()[d].offset},
+                                  {"scale", db.normalization()[d].scale}, {"mean", raw[d].mean},
+                                  {"std", raw[d].std}, {"min", raw[d].min}, {"max", raw[d].max}});
     }
-    out["channels"] = nlohmann::json::array();
-    for (std::size_t c = 0; c < schema.channels.size(); ++c) {
-      const FeatureChannel& channel = schema.channels[c];
-      nlohmann::json ch = {{"name", channel.name}, {"kind", channel_kind_name(channel.kind)},
-                           {"normalization", normalization_name(channel.normalization)}, {"weight", channel.weight},
-                           {"offset", schema.offset(c)}, {"dims", channel.dims()}};
-      ch["dimensions"] = nlohmann::json::array();
-      for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
-        ch["dimensions"].push_back({{"name", schema.dim_name(d)}, {"offset", db.normalization()[d].offset},
-                                    {"scale", db.normalization()[d].scale}, {"mean", raw[d].mean},
-                                    {"std", raw[d].std}, {"min", raw[d].min}, {"max", raw[d].max}});
-      }
-      out["channels"].push_back(std::move(ch));
-    }
-    out["animation"] = animation_json(db);
-    out["units"] = units_json(db);
-    out["clips"] = nlohmann::json::array();
-    for (const Clip& clip : db.clips()) {
-      out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
-                              {"frame_count", clip.frame_count}, {"loop", clip.loop}, {"mirrored", clip.mirrored},
-                              {"cost_multiplier", clip.cost_multiplier}, {"cost_bias", clip.cost_bias},
-                              {"tags", tag_list(db, clip.tags)}});
-    }
-    // JSON escapes control characters itself; invalid UTF-8 in a name is
-    // replaced (U+FFFD) rather than thrown as an exception.
-    std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
-    return 0;
+    channels.push_back(std::move(ch));
   }
+  return channels;
+}
 
-  std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n", printable(path).c_str(),
-              thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()), db.clips().size(), mirrored,
-              looping, db.dims(), double(db.fps()));
+void print_json(const Database& db, const std::string& path, const Counts& counts) {
+  nlohmann::json out;
+  out["file"] = path;
+  out["frames"] = db.frame_count();
+  out["dims"] = db.dims();
+  out["fps"] = db.fps();
+  out["content_hash"] = hash_hex(db.content_hash());
+  out["flags"] = {{"do_not_use", counts.do_not_use}, {"block_transition", counts.block},
+                  {"edge_excluded", counts.edge}, {"candidates", counts.candidates}};
+  out["tags"] = nlohmann::json::array();
+  for (std::size_t t = 0; t < counts.tag_frames.size(); ++t) {
+    out["tags"].push_back({{"name", db.tag_names()[t]}, {"frames", counts.tag_frames[t]}});
+  }
+  out["channels"] = channels_json(db, raw_statistics(db));
+  out["animation"] = animation_json(db);
+  out["units"] = units_json(db);
+  out["clips"] = nlohmann::json::array();
+  for (const Clip& clip : db.clips()) {
+    out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
+                            {"frame_count", clip.frame_count}, {"loop", clip.loop}, {"mirrored", clip.mirrored},
+                            {"cost_multiplier", clip.cost_multiplier}, {"cost_bias", clip.cost_bias},
+                            {"tags", tag_list(db, clip.tags)}});
+  }
+  // JSON escapes control characters itself; invalid UTF-8 in a name is
+  // replaced (U+FFFD) rather than thrown as an exception.
+  std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+}
+
+void print_summary(const Database& db, const std::string& path, const Counts& counts) {
+  std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n",
+              printable(path).c_str(), thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()),
+              db.clips().size(), counts.mirrored, counts.looping, db.dims(), double(db.fps()));
   std::printf("content hash: %s\n", hash_hex(db.content_hash()).c_str());
   print_animation(db);
   print_units(db);
   std::printf("frame flags: %s do_not_use, %s block_transition, %s edge_excluded; %s candidate frames\n",
-              thousands(do_not_use).c_str(), thousands(block).c_str(), thousands(edge).c_str(),
-              thousands(candidates).c_str());
+              thousands(counts.do_not_use).c_str(), thousands(counts.block).c_str(), thousands(counts.edge).c_str(),
+              thousands(counts.candidates).c_str());
+  const std::vector<std::uint64_t>& tag_frames = counts.tag_frames;
   std::printf("tags (%zu):", tag_frames.size());
   for (std::size_t t = 0; t < tag_frames.size(); ++t) {
     std::printf(" %s (%s frames)%s", printable(db.tag_names()[t]).c_str(), thousands(tag_frames[t]).c_str(),
                 t + 1 < tag_frames.size() ? "," : "");
   }
   std::printf("%s\n", tag_frames.empty() ? " none" : "");
+}
 
+// What a channel reads: its bones, curves or trajectory offsets.
+std::string channel_detail(const FeatureChannel& channel) {
+  std::string detail = channel.bone;
+  if (!channel.second_bone.empty()) detail += " -> " + channel.second_bone;
+  if (!channel.curves.empty()) {
+    detail = "+-" + std::to_string(channel.window_seconds).substr(0, 5) + " s:";
+    for (const std::string& curve : channel.curves) detail += " " + curve;
+  }
+  if (uses_trajectory_offsets(channel.kind)) {
+    detail = "offsets (s):";
+    for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);
+  }
+  return detail;
+}
+
+void print_channels(const Database& db) {
+  const std::vector<RawDimStats> raw = raw_statistics(db);
+  const FeatureSchema& schema = db.schema();
   std::printf("\nchannels (raw values: metres, m/s; normalized = (raw - offset) / scale):\n");
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
-    std::string detail = channel.bone;
-    if (!channel.second_bone.empty()) detail += " -> " + channel.second_bone;
-    if (!channel.curves.empty()) {
-      detail = "+-" + std::to_string(channel.window_seconds).substr(0, 5) + " s:";
-      for (const std::string& curve : channel.curves) detail += " " + curve;
-    }
-    if (uses_trajectory_offsets(channel.kind)) {
-      detail = "offsets (s):";
-      for (float t : channel.offsets_seconds) detail += " " + std::to_string(t).substr(0, 5);
-    }
-    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", printable(channel.name).c_str(), channel_kind_name(channel.kind).data(),
-                normalization_name(channel.normalization).data(), double(channel.weight), printable(detail).c_str());
+    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", printable(channel.name).c_str(),
+                channel_kind_name(channel.kind).data(), normalization_name(channel.normalization).data(),
+                double(channel.weight), printable(channel_detail(channel)).c_str());
     std::printf("    %-32s %10s %10s %10s %10s %10s %10s\n", "dimension", "offset", "scale", "mean", "std", "min", "max");
     for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
       std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", printable(schema.dim_name(d)).c_str(),
@@ -190,16 +193,41 @@ int run_inspect(Args args) {
                   raw[d].min, raw[d].max);
     }
   }
+}
 
-  std::printf("\nclips:\n  %5s  %-40s %8s %8s  %-5s %-8s %6s %6s  %s\n", "#", "name", "first", "frames", "loop", "mirrored",
-              "mult", "bias", "tags");
+void print_clips(const Database& db) {
+  std::printf("\nclips:\n  %5s  %-40s %8s %8s  %-5s %-8s %6s %6s  %s\n", "#", "name", "first", "frames", "loop",
+              "mirrored", "mult", "bias", "tags");
   for (std::size_t c = 0; c < db.clips().size(); ++c) {
     const Clip& clip = db.clips()[c];
     std::printf("  %5zu  %-40s %8u %8u  %-5s %-8s %6g %6g  %s\n", c, printable(clip.name).c_str(), clip.first_frame,
                 clip.frame_count, clip.loop ? "yes" : "no", clip.mirrored ? "yes" : "no", double(clip.cost_multiplier),
                 double(clip.cost_bias), printable(tag_list(db, clip.tags)).c_str());
   }
+}
+
+int run_inspect(Args args, const char*) {
+  std::string path;
+  bool json = false;
+  CommandLine cli(kInspectCommand, kInspectDescription);
+  cli.positional("db.mmdb", path);
+  cli.flag("--json", json, "the same as one JSON object on stdout");
+  if (const std::optional<int> exit_code = cli.parse(args)) return *exit_code;
+  Result<Database> loaded = load_database(path);
+  if (!loaded.ok()) return report_error("inspect", loaded.message(), 1);
+  const Counts counts = count(*loaded);
+  if (json) {
+    print_json(*loaded, path, counts);
+  } else {
+    print_summary(*loaded, path, counts);
+    print_channels(*loaded);
+    print_clips(*loaded);
+  }
   return 0;
 }
+
+}  // namespace
+
+const Command kInspectCommand{"inspect", "db.mmdb", "clips, frames, channel statistics and tags", run_inspect};
 
 }  // namespace mmvk::cli

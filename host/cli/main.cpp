@@ -3,38 +3,39 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
+#include <string>
 #include <string_view>
 #include <vector>
 
 #include "commands.hpp"
+#include "help_format.hpp"
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: mmvk <command> [options]\n"
-    "\n"
-    "commands:\n"
-    "  build <manifest.json | bvh-dir> -o db.mmdb   build a database from BVH motion capture\n"
-    "  inspect db.mmdb                              clips, frames, channel statistics and tags\n"
-    "  export db.mmdb --features out.f32            the normalized feature matrix + JSON sidecar\n"
-    "  query db.mmdb --queries q.f32 ...            batched search, one result line per query\n"
-    "  crowd [--agents N] [--html out.html] ...     a motion-matched crowd, its figures and a viewer page\n"
-    "  clusters db.mmdb -o table.mmkc               train and save the cluster tables (query --clusters)\n"
-    "\n"
-    "Run `mmvk <command> --help` for a command's options.\n"
-    "\n"
-    "Inputs are regular files (only query --queries may also be a pipe). A regular\n"
-    "output is replaced atomically; a device or FIFO is written in place; an output\n"
-    "that is an input or another output is refused (docs/files-and-limits.md).\n";
+constexpr const mmvk::cli::Command* kCommands[] = {
+    &mmvk::cli::kBuildCommand, &mmvk::cli::kInspectCommand, &mmvk::cli::kExportCommand,
+    &mmvk::cli::kQueryCommand, &mmvk::cli::kCrowdCommand,   &mmvk::cli::kClustersCommand};
 
-int dispatch(std::string_view command, mmvk::cli::Args rest, const char* program) {
-  if (command == "build") return mmvk::cli::run_build(rest);
-  if (command == "inspect") return mmvk::cli::run_inspect(rest);
-  if (command == "export") return mmvk::cli::run_export(rest);
-  if (command == "query") return mmvk::cli::run_query(rest);
-  if (command == "crowd") return mmvk::cli::run_crowd(rest, program);
-  if (command == "clusters") return mmvk::cli::run_clusters(rest);
-  std::fprintf(stderr, "mmvk: unknown command '%.*s'\n\n%s", int(command.size()), command.data(), kUsage);
+std::string usage() {
+  std::string text = "usage: mmvk <command> [options]\n\ncommands:\n";
+  for (const mmvk::cli::Command* command : kCommands) {
+    text += mmvk::cli::help_entry(std::string(command->name) + " " + std::string(command->arguments),
+                                  command->summary, 47, 100);
+  }
+  return text +
+         "\n"
+         "Run `mmvk <command> --help` for a command's options.\n"
+         "\n"
+         "Inputs are regular files (only query --queries may also be a pipe). A regular\n"
+         "output is replaced atomically; a device or FIFO is written in place; an output\n"
+         "that is an input or another output is refused (docs/files-and-limits.md).\n";
+}
+
+int dispatch(std::string_view name, mmvk::cli::Args rest, const char* program) {
+  for (const mmvk::cli::Command* command : kCommands) {
+    if (command->name == name) return command->run(rest, program);
+  }
+  std::fprintf(stderr, "mmvk: unknown command '%.*s'\n\n%s", int(name.size()), name.data(), usage().c_str());
   return 2;
 }
 
@@ -57,10 +58,10 @@ int main(int argc, char** argv) {
   std::vector<std::string_view> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     if (args.empty()) {
-      std::fputs(kUsage, stderr);
+      std::fputs(usage().c_str(), stderr);
       return 2;
     }
-    std::fputs(kUsage, stdout);
+    std::fputs(usage().c_str(), stdout);
     return check_stdout("help", 0);
   }
   const std::string_view command = args[0];

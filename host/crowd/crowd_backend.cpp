@@ -1,15 +1,30 @@
 #include "crowd_backend.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "mmvk/backends.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/backends.hpp"
-#include "mmvk/vulkan/pipeline_cache_file.hpp"
+#include "mmvk/vulkan/lazy_context.hpp"
 #endif
 
 namespace mmvk::crowd {
+
+// Defined in this one file: the header only holds a pointer to it.
+#if defined(MMVK_HAS_VULKAN)
+struct CrowdDevice {
+  explicit CrowdDevice(vulkan::LazyContextOptions options) : context(std::move(options)) {}
+  vulkan::LazyContext context;
+};
+#else
+struct CrowdDevice {};
+#endif
+
+CrowdSearch::CrowdSearch() = default;
+CrowdSearch::~CrowdSearch() = default;
+CrowdSearch::CrowdSearch(CrowdSearch&&) noexcept = default;
+CrowdSearch& CrowdSearch::operator=(CrowdSearch&&) noexcept = default;
 
 namespace {
 
@@ -52,17 +67,13 @@ BackendRegistry crowd_registry([[maybe_unused]] CrowdSearch& out, [[maybe_unused
                                [[maybe_unused]] const std::filesystem::path& cache_dir) {
   BackendRegistry registry = cpu_backends();
 #if defined(MMVK_HAS_VULKAN)
+  vulkan::LazyContextOptions options;
+  options.context.device_index = device;
+  options.context.application_name = "mmvk crowd";
+  options.cache_directory = cache_dir;
+  out.vulkan = std::make_unique<CrowdDevice>(std::move(options));
   // The names are distinct from the CPU ones; a clash would be a bug in mmvk.
-  (void)vulkan::add_backends(registry, [&out, device, cache_dir]() -> Result<vulkan::Context*> {
-    if (!out.context) {
-      vulkan::ContextOptions options;
-      options.device_index = device;
-      options.application_name = "mmvk crowd";
-      MMVK_ASSIGN_OR_RETURN(out.context, vulkan::Context::create(options));
-      if (!cache_dir.empty()) out.pipeline_cache_note = vulkan::load_pipeline_cache_file(*out.context, cache_dir);
-    }
-    return out.context.get();
-  });
+  (void)out.vulkan->context.add_backends(registry);
 #endif
   return registry;
 }
@@ -90,8 +101,9 @@ Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std
   out.deferred = out.backend->make_async(agents);
 #if defined(MMVK_HAS_VULKAN)
   // The registry creates the context only for a Vulkan backend.
-  if (out.context) {
-    out.device = describe_device(*out.context, device);
+  if (const vulkan::Context* context = out.vulkan->context.created()) {
+    out.device = describe_device(*context, device);
+    out.pipeline_cache_note = out.vulkan->context.pipeline_cache_note();
     return out;
   }
 #endif
@@ -101,10 +113,9 @@ Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std
   return out;
 }
 
-Status save_crowd_pipeline_cache([[maybe_unused]] const CrowdSearch& search,
-                                 [[maybe_unused]] const std::filesystem::path& cache_dir) {
+Status save_crowd_pipeline_cache([[maybe_unused]] const CrowdSearch& search) {
 #if defined(MMVK_HAS_VULKAN)
-  if (search.context && !cache_dir.empty()) return vulkan::save_pipeline_cache_file(*search.context, cache_dir);
+  if (search.vulkan) return search.vulkan->context.save_pipeline_cache();
 #endif
   return {};
 }

@@ -18,16 +18,20 @@
 #include "mmvk/status.hpp"
 #include "mmvk/thread_pool.hpp"
 
-#if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/context.hpp"
-#endif
-
 namespace mmvk::crowd {
 
+// The Vulkan context when the build has Vulkan (crowd_backend.cpp defines
+// it): opaque here, so that this struct's layout is the same in every target
+// that includes it, whether or not that target is built with Vulkan.
+struct CrowdDevice;
+
 struct CrowdSearch {
-#if defined(MMVK_HAS_VULKAN)
-  std::unique_ptr<vulkan::Context> context;  // declared first: outlives the backend
-#endif
+  CrowdSearch();
+  ~CrowdSearch();
+  CrowdSearch(CrowdSearch&&) noexcept;
+  CrowdSearch& operator=(CrowdSearch&&) noexcept;
+
+  std::unique_ptr<CrowdDevice> vulkan;       // declared first: outlives the backend
   std::unique_ptr<SearchBackend> backend;
   std::unique_ptr<AsyncSearch> deferred;     // on `backend`
   std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
@@ -41,15 +45,16 @@ std::string crowd_backend_help();
 // Makes `name` from the library's backend registry on `database` for up to
 // `agents` queries per tick. `device` picks the Vulkan device (none: the
 // best one). A Vulkan context starts from the pipeline cache file in
-// `cache_dir` (none when empty); save_crowd_pipeline_cache keeps it. Errors: an unknown name (listing the known ones), no Vulkan
-// device, a database too large, --device with a CPU backend.
+// `cache_dir` (none when empty); save_crowd_pipeline_cache keeps it.
+// Errors: an unknown name (listing the known ones), no Vulkan device, a
+// database too large, --device with a CPU backend.
 Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
                                       const Database& database, std::uint32_t agents, ThreadPool& pool,
                                       const std::filesystem::path& cache_dir);
 
-// Writes the Vulkan context's pipeline cache to its file in `cache_dir`, so
-// that the next run's kernels compile without a stall; nothing for a CPU
-// backend or an empty `cache_dir`.
-Status save_crowd_pipeline_cache(const CrowdSearch& search, const std::filesystem::path& cache_dir);
+// Writes the Vulkan context's pipeline cache to its file in the `cache_dir`
+// given to make_crowd_search, so that the next run's kernels compile without
+// a stall; nothing for a CPU backend or an empty `cache_dir`.
+Status save_crowd_pipeline_cache(const CrowdSearch& search);
 
 }  // namespace mmvk::crowd

@@ -347,7 +347,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
   s.chosen_frames_hash = chosen.digest();
-  if (Status saved = save_crowd_pipeline_cache(search, options.cache_dir); !saved && log) {
+  if (Status saved = save_crowd_pipeline_cache(search); !saved && log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }
 

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "../../runtime/src/clusters/cluster_table_build.hpp"
+#include "clusters/cluster_table_build.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "support/clustered_data.hpp"

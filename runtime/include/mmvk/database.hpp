@@ -12,6 +12,7 @@
 
 #include "mmvk/animation_data.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/normalization.hpp"
 #include "mmvk/status.hpp"
 
 namespace mmvk {
@@ -40,13 +41,6 @@ struct Clip {
   // the manifest or guessed); 0 = not recorded (clips made in code, files
   // before format 4).
   float metres_per_unit = 0.0f;
-};
-
-// Normalization of one feature dimension: normalized = (raw - offset) / scale.
-// The channel weight is folded into the scale (scale = spread / weight).
-struct DimNormalization {
-  float offset = 0.0f;
-  float scale = 1.0f;   // > 0
 };
 
 // Everything a Database is made of; Database::create validates it.

@@ -48,6 +48,11 @@ struct FeatureSchema {
   std::uint32_t offset(std::size_t channel) const;
   // Index of the channel named `name`, or -1.
   int find(std::string_view name) const;
+  // Index of the channel named `name`, or an error "<where>: unknown channel
+  // '<name>' (the schema has: ...)".
+  Result<std::size_t> find_channel(std::string_view name, std::string_view where) const;
+  // The channel names, comma-separated, for messages.
+  std::string channel_names() const;
   // Name of dimension d, e.g. "trajectory_position[1].z".
   std::string dim_name(std::uint32_t d) const;
   // Checks names, dims, weights, offsets and the channel count (<= kMaxChannels).

@@ -25,11 +25,17 @@
 #include <string_view>
 #include <vector>
 
-#include "mmvk/database.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/status.hpp"
 
 namespace mmvk {
+
+// Normalization of one feature dimension: normalized = (raw - offset) / scale.
+// The channel weight is folded into the scale (scale = spread / weight).
+struct DimNormalization {
+  float offset = 0.0f;
+  float scale = 1.0f;   // > 0
+};
 
 // Per-dimension statistics of a [frames x dims] matrix (used by
 // compute_normalization and by `mmvk inspect`).

@@ -15,7 +15,6 @@
 
 #include "mmvk/database.hpp"
 #include "mmvk/feature_schema.hpp"
-#include "mmvk/search.hpp"
 #include "mmvk/status.hpp"
 
 namespace mmvk {
@@ -60,9 +59,5 @@ class QueryBuilder {
   std::vector<float> raw_;
   std::vector<bool> set_;
 };
-
-// Sets the weight of the channel named `channel` in `params` (finite, >= 0;
-// 0 turns the channel off); the error names an unknown channel.
-Status set_channel_weight(const FeatureSchema& schema, QueryParams& params, std::string_view channel, float weight);
 
 }  // namespace mmvk

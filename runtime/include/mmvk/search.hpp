@@ -125,6 +125,10 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
 // whose results are written later (a paged device search).
 Status validate_queries(const Database& database, const QueryBatch& batch, std::uint32_t k);
 
+// Sets the weight of the channel named `channel` in `params` (finite, >= 0;
+// 0 turns the channel off); the error names an unknown channel.
+Status set_channel_weight(const FeatureSchema& schema, QueryParams& params, std::string_view channel, float weight);
+
 // True when frame `frame` may be a result for `params` (flags, tags and the
 // exclusion window); the same rule every backend applies.
 bool is_candidate(const Database& database, std::uint32_t frame, const QueryParams& params);

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "search/cost_bound.hpp"
+#include "database/cost_bound.hpp"
 
 namespace mmvk::detail {
 

@@ -42,6 +42,22 @@ int FeatureSchema::find(std::string_view name) const {
   return -1;
 }
 
+Result<std::size_t> FeatureSchema::find_channel(std::string_view name, std::string_view where) const {
+  const int index = find(name);
+  if (index >= 0) return static_cast<std::size_t>(index);
+  return make_error(std::string(where) + ": unknown channel '" + std::string(name) + "' (the schema has: " +
+                    channel_names() + ")");
+}
+
+std::string FeatureSchema::channel_names() const {
+  std::string names;
+  for (const FeatureChannel& channel : channels) {
+    if (!names.empty()) names += ", ";
+    names += channel.name;
+  }
+  return names;
+}
+
 std::string FeatureSchema::dim_name(std::uint32_t d) const {
   for (const FeatureChannel& channel : channels) {
     const std::uint32_t n = channel.dims();

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "search/cost_bound.hpp"
+#include "database/cost_bound.hpp"
 
 namespace mmvk {
 
@@ -24,6 +24,17 @@ double cost_bound(const Database& database, std::span<const float> query, const 
 }
 
 }  // namespace
+
+Status set_channel_weight(const FeatureSchema& schema, QueryParams& params, std::string_view channel, float weight) {
+  Result<std::size_t> index = schema.find_channel(channel, "query weight");
+  if (!index) return index.status();
+  if (!std::isfinite(weight) || weight < 0.0f) {
+    return make_error("query weight: channel '" + std::string(channel) + "' weight must be finite and >= 0, got " +
+                      std::to_string(weight));
+  }
+  params.channel_weights[*index] = weight;
+  return {};
+}
 
 Status validate_queries(const Database& database, const QueryBatch& batch, std::uint32_t k) {
   if (database.frame_count() == 0) return make_error("search: the database is empty");

@@ -1,5 +1,6 @@
 // An opt-in helper for applications that keep the Context's pipeline cache
-// on disk between runs (the mmvk CLI and the crowd host do, under
+// on disk between runs (the mmvk CLI and the crowd host do, through
+// LazyContext (lazy_context.hpp), under
 // $XDG_CACHE_HOME/mmvk or ~/.cache/mmvk): one file per device in a
 // directory the application names. mmvk itself never calls these; the
 // library reads no environment variables and chooses no directory.

@@ -1,4 +1,4 @@
-#include "search/cost_bound.hpp"
+#include "database/cost_bound.hpp"
 
 #include <cmath>
 

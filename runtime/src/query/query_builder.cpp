@@ -7,24 +7,6 @@ namespace mmvk {
 
 namespace {
 
-std::string channel_list(const FeatureSchema& schema) {
-  std::string names;
-  for (const FeatureChannel& channel : schema.channels) {
-    if (!names.empty()) names += ", ";
-    names += channel.name;
-  }
-  return names;
-}
-
-Result<std::size_t> find_channel(const FeatureSchema& schema, std::string_view name, std::string_view where) {
-  const int index = schema.find(name);
-  if (index < 0) {
-    return make_error(std::string(where) + ": unknown channel '" + std::string(name) + "' (the schema has: " +
-                      channel_list(schema) + ")");
-  }
-  return static_cast<std::size_t>(index);
-}
-
 bool same_layout(const FeatureSchema& a, const FeatureSchema& b) {
   if (a.channels.size() != b.channels.size()) return false;
   for (std::size_t c = 0; c < a.channels.size(); ++c) {
@@ -41,7 +23,7 @@ QueryBuilder::QueryBuilder(FeatureSchema schema)
 QueryBuilder::QueryBuilder(const Database& database) : QueryBuilder(database.schema()) { database_ = &database; }
 
 Status QueryBuilder::set(std::string_view channel, std::span<const float> values) {
-  Result<std::size_t> index = find_channel(schema_, channel, "query");
+  Result<std::size_t> index = schema_.find_channel(channel, "query");
   if (!index) return index.status();
   return set(*index, values);
 }
@@ -95,25 +77,14 @@ Result<std::vector<float>> QueryBuilder::normalized() const {
 
 Status QueryBuilder::normalize(const Database& database, std::span<float> out) const {
   if (!same_layout(schema_, database.schema())) {
-    return make_error("query: the database's schema (" + channel_list(database.schema()) +
-                      ") does not match the query's (" + channel_list(schema_) + ")");
+    return make_error("query: the database's schema (" + database.schema().channel_names() +
+                      ") does not match the query's (" + schema_.channel_names() + ")");
   }
   if (out.size() != raw_.size()) {
     return make_error("query: output has " + std::to_string(out.size()) + " values, expected " +
                       std::to_string(raw_.size()));
   }
   database.normalize(raw_, out);
-  return {};
-}
-
-Status set_channel_weight(const FeatureSchema& schema, QueryParams& params, std::string_view channel, float weight) {
-  Result<std::size_t> index = find_channel(schema, channel, "query weight");
-  if (!index) return index.status();
-  if (!std::isfinite(weight) || weight < 0.0f) {
-    return make_error("query weight: channel '" + std::string(channel) + "' weight must be finite and >= 0, got " +
-                      std::to_string(weight));
-  }
-  params.channel_weights[*index] = weight;
   return {};
 }
 

@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/json_parse.hpp"
-#include "search/cost_bound.hpp"
+#include "database/cost_bound.hpp"
 #include "mmvk/channel_kinds.hpp"
 #include "mmvk/character.hpp"
 #include "mmvk/file_io.hpp"

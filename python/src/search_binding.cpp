@@ -1,0 +1,281 @@
+// mmvk.Search and mmvk.backends(): a backend made by name from the library's
+// registry, searched with NumPy query batches, the GIL released meanwhile.
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "bindings.hpp"
+#include "errors.hpp"
+#include "mmvk/backends.hpp"
+#include "mmvk/cluster_table.hpp"
+#include "mmvk/query_builder.hpp"
+#include "mmvk/search.hpp"
+#include "mmvk/thread_pool.hpp"
+
+#if defined(MMVK_HAS_VULKAN)
+#include "mmvk/vulkan/backends.hpp"
+#include "mmvk/vulkan/context.hpp"
+#endif
+
+namespace mmvk::python {
+
+namespace py = pybind11;
+
+namespace {
+
+// A backend and everything it needs, in the order they must be destroyed
+// last (the database, the pool, the table and the Vulkan context outlive
+// the backend).
+class PySearch {
+ public:
+  PySearch(std::shared_ptr<Database> database, const std::string& backend, const py::object& device,
+           const py::kwargs& options);
+
+  py::tuple search(const py::object& queries, std::uint32_t k, const py::object& continuing,
+                   const std::vector<std::string>& require, const std::vector<std::string>& exclude,
+                   const py::object& weights, float continuing_bias, float continuing_multiplier,
+                   std::uint32_t exclusion_window);
+
+  // Seconds per call of `calls` backend searches of `queries` in a C++ loop:
+  // the same call Search.search makes, without Python around it (the
+  // benchmark's baseline, bench/python_overhead.py).
+  double native_seconds(const py::object& queries, std::uint32_t k, std::uint32_t calls);
+
+  std::string name() const { return std::string(backend_->name()); }
+  const std::string& device() const { return device_; }
+  const std::shared_ptr<Database>& database() const { return database_; }
+
+ private:
+  std::shared_ptr<Database> database_;
+  std::unique_ptr<ThreadPool> pool_;
+  std::optional<ClusterTable> table_;
+#if defined(MMVK_HAS_VULKAN)
+  std::unique_ptr<vulkan::Context> context_;
+#endif
+  std::unique_ptr<SearchBackend> backend_;
+  std::string device_;
+  // A backend is not thread-safe: two Python threads on one Search take turns.
+  std::mutex mutex_;
+};
+
+// The CPU backends, and the Vulkan ones made on a context created (into
+// `context`, on `device`) only when one of them is made.
+BackendRegistry registry([[maybe_unused]] void* context, [[maybe_unused]] std::optional<std::uint32_t> device) {
+  BackendRegistry r = cpu_backends();
+#if defined(MMVK_HAS_VULKAN)
+  if (context == nullptr) {
+    // Listing names only: a source that is never called.
+    (void)vulkan::add_backends(r, []() -> Result<vulkan::Context*> { return make_error("no context"); });
+    return r;
+  }
+  auto* owned = static_cast<std::unique_ptr<vulkan::Context>*>(context);
+  (void)vulkan::add_backends(r, [owned, device]() -> Result<vulkan::Context*> {
+    if (!*owned) {
+      vulkan::ContextOptions options;
+      options.device_index = device;
+      options.application_name = "mmvk (Python)";
+      MMVK_ASSIGN_OR_RETURN(*owned, vulkan::Context::create(options));
+    }
+    return owned->get();
+  });
+#endif
+  return r;
+}
+
+template <class T>
+T option(py::dict& options, const char* name, T fallback) {
+  if (!options.contains(name)) return fallback;
+  T value = options[name].cast<T>();
+  PyDict_DelItemString(options.ptr(), name);
+  return value;
+}
+
+PySearch::PySearch(std::shared_ptr<Database> database, const std::string& backend, const py::object& device,
+                   const py::kwargs& given)
+    : database_(std::move(database)) {
+  py::dict options = given.attr("copy")();  // known options are taken out of the copy
+  const auto threads = option<unsigned>(options, "threads", 0);
+  pool_ = take(ThreadPool::create(threads));
+  BackendSpec spec;
+  spec.name = backend;
+  spec.pool = pool_.get();
+  spec.nprobe = option<std::uint32_t>(options, "nprobe", spec.nprobe);
+  spec.kmeans.clusters = option<std::uint32_t>(options, "kmeans_clusters", spec.kmeans.clusters);
+  spec.kmeans.iterations = option<std::uint32_t>(options, "kmeans_iterations", spec.kmeans.iterations);
+  spec.kmeans.seed = option<std::uint64_t>(options, "kmeans_seed", spec.kmeans.seed);
+  spec.max_batch = option<std::uint32_t>(options, "max_batch", spec.max_batch);
+  spec.max_k = option<std::uint32_t>(options, "max_k", spec.max_k);
+  spec.max_tile = option<std::uint32_t>(options, "max_tile", spec.max_tile);
+  // Compiling every kernel variant up front costs seconds on lavapipe.
+  spec.warm_up = option<bool>(options, "warm_up", false);
+  if (options.contains("clusters")) {
+    const std::filesystem::path path = to_path(options["clusters"], "clusters");
+    PyDict_DelItemString(options.ptr(), "clusters");
+    table_ = take(load_cluster_table(path), kind_for_input(path));
+    spec.clusters = &*table_;
+  }
+  if (!options.empty()) {
+    raise("unknown Search option '" + py::str((*options.begin()).first).cast<std::string>() +
+          "' (known: threads, nprobe, clusters, kmeans_clusters, kmeans_iterations, kmeans_seed, max_batch, max_k, "
+          "max_tile, warm_up)");
+  }
+  std::optional<std::uint32_t> device_index;
+  if (!device.is_none()) device_index = device.cast<std::uint32_t>();
+  void* context = nullptr;
+#if defined(MMVK_HAS_VULKAN)
+  context = &context_;
+#endif
+  const BackendRegistry backends = registry(context, device_index);
+  Result<std::unique_ptr<SearchBackend>> made = make_error("");
+  {
+    py::gil_scoped_release released;  // k-means training and kernel compiles take a while
+    made = backends.make(spec, *database_);
+  }
+  backend_ = take(std::move(made));
+#if defined(MMVK_HAS_VULKAN)
+  if (context_) {
+    device_ = context_->device_name();
+    return;
+  }
+#endif
+  if (device_index) raise("device picks a Vulkan device; backend '" + backend + "' runs on the CPU");
+  device_ = backend == "reference" ? std::string("cpu, 1 thread")
+                                   : "cpu, " + std::to_string(pool_->thread_count()) +
+                                         (pool_->thread_count() == 1 ? " thread" : " threads");
+}
+
+py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py::object& continuing,
+                           const std::vector<std::string>& require, const std::vector<std::string>& exclude,
+                           const py::object& weights, float continuing_bias, float continuing_multiplier,
+                           std::uint32_t exclusion_window) {
+  const Database& db = *database_;
+  const FloatRows rows = float_rows(queries, db.dims(), "queries", false);
+  const std::size_t batch = rows.rows;
+
+  QueryParams base;
+  base.continuing_bias = continuing_bias;
+  base.continuing_multiplier = continuing_multiplier;
+  base.exclusion_window = exclusion_window;
+  if (!require.empty()) base.require_all = take(db.tag_mask(require));
+  if (!exclude.empty()) base.exclude_any = take(db.tag_mask(exclude));
+  if (!weights.is_none()) {
+    const auto weight_dict = weights.cast<py::dict>();
+    for (const auto& [channel, weight] : weight_dict) {
+      check(set_channel_weight(db.schema(), base, channel.cast<std::string>(), weight.cast<float>()));
+    }
+  }
+  // Per-query params only when a query differs from the defaults (an empty
+  // span means default params for every query).
+  std::vector<QueryParams> params;
+  if (!continuing.is_none()) {
+    if (py::isinstance<py::int_>(continuing)) {
+      const long long frame = continuing.cast<long long>();
+      base.continuing_frame = frame < 0 ? kNoFrame : std::uint32_t(std::min<long long>(frame, kNoFrame - 1LL));
+      params.assign(batch, base);
+    } else {
+      const auto frames = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(continuing);
+      if (!frames || frames.ndim() != 1 || std::size_t(frames.shape(0)) != batch) {
+        raise("continuing: expected None, a frame, or an integer array of shape (" + std::to_string(batch) +
+              ",) (-1 = none)");
+      }
+      params.assign(batch, base);
+      for (std::size_t b = 0; b < batch; ++b) {
+        const long long frame = frames.at(b);
+        params[b].continuing_frame = frame < 0 ? kNoFrame : std::uint32_t(std::min<long long>(frame, kNoFrame - 1LL));
+      }
+    }
+  } else if (!(base.require_all == 0 && base.exclude_any == 0 && base.continuing_bias == 0.0f &&
+               base.continuing_multiplier == 1.0f && base.exclusion_window == 0 &&
+               base.channel_weights == QueryParams::filled_weights())) {
+    params.assign(batch, base);
+  }
+
+  std::vector<Match> out(batch * std::size_t(k));
+  Status status;
+  {
+    py::gil_scoped_release released;
+    std::lock_guard<std::mutex> lock(mutex_);
+    status = backend_->search(QueryBatch{rows.values, params, batch}, k, out);
+  }
+  check(status);
+  py::array_t<std::int64_t> frames({py::ssize_t(batch), py::ssize_t(k)});
+  py::array_t<float> costs({py::ssize_t(batch), py::ssize_t(k)});
+  std::int64_t* f = frames.mutable_data();
+  float* c = costs.mutable_data();
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    f[i] = out[i].frame == kNoFrame ? -1 : std::int64_t(out[i].frame);
+    c[i] = out[i].cost;
+  }
+  return py::make_tuple(frames, costs);
+}
+
+double PySearch::native_seconds(const py::object& queries, std::uint32_t k, std::uint32_t calls) {
+  const FloatRows rows = float_rows(queries, database_->dims(), "queries", false);
+  std::vector<Match> out(rows.rows * std::size_t(k));
+  const QueryBatch batch{rows.values, {}, rows.rows};
+  Status status;
+  double seconds = 0.0;
+  {
+    py::gil_scoped_release released;
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    for (std::uint32_t c = 0; c < calls && status.ok(); ++c) status = backend_->search(batch, k, out);
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  check(status);
+  return seconds / std::max<std::uint32_t>(calls, 1);
+}
+
+}  // namespace
+
+void bind_search(py::module_& m) {
+  m.def(
+      "backends",
+      []() {
+        std::vector<std::string> names;
+        const BackendRegistry listed = registry(nullptr, std::nullopt);
+        for (const BackendEntry& e : listed.entries()) names.push_back(e.name);
+        return names;
+      },
+      "The search backends by name: the CPU ones (reference, fast-brute, fast-box, clusters, clusters-nprobe) and, "
+      "when mmvk was built with Vulkan, the vulkan-* ones.");
+
+  py::class_<PySearch>(m, "Search",
+                       "A search backend over a Database, made by name (mmvk.backends()). Search(db, backend='clusters', "
+                       "device=None, **options); options: threads (CPU backends; 0 = all cores), nprobe, clusters (an "
+                       ".mmkc file), kmeans_clusters, kmeans_iterations, kmeans_seed, max_batch, max_k, max_tile, "
+                       "warm_up (Vulkan backends). device: a Vulkan device index.")
+      .def(py::init([](std::shared_ptr<Database> db, const std::string& backend, const py::object& device,
+                       const py::kwargs& options) { return std::make_unique<PySearch>(std::move(db), backend, device, options); }),
+           py::arg("db"), py::arg("backend") = "clusters", py::arg("device") = py::none())
+      .def("search", &PySearch::search, py::arg("queries"), py::arg("k") = 1, py::arg("continuing") = py::none(),
+           py::arg("require") = std::vector<std::string>{}, py::arg("exclude") = std::vector<std::string>{},
+           py::arg("weights") = py::none(), py::arg("continuing_bias") = 0.0f, py::arg("continuing_multiplier") = 1.0f,
+           py::arg("exclusion_window") = 0u,
+           "search(queries, k=1, continuing=None, require=(), exclude=(), weights=None, continuing_bias=0.0, "
+           "continuing_multiplier=1.0, exclusion_window=0) -> (frames, costs)\n\n"
+           "The best k frames of each query. queries: normalized features, float32 [B x dims] (Database.normalize "
+           "makes them from raw values). continuing: None, one frame for every query, or int [B] (-1 = none). "
+           "require / exclude: tag names. weights: {channel name: weight}. Returns frames int64 [B x k] (-1: no "
+           "further candidate) and costs float32 [B x k] (inf there), best first; the semantics of docs/search.md, "
+           "equal to `mmvk query`. The GIL is released while searching.")
+      .def("_native_seconds", &PySearch::native_seconds, py::arg("queries"), py::arg("k") = 1, py::arg("calls") = 1,
+           "Seconds per call of `calls` searches of `queries` (default params) made in a C++ loop: the same backend "
+           "call as search() without Python around it. For bench/python_overhead.py.")
+      .def_property_readonly("name", &PySearch::name, "The backend's name.")
+      .def_property_readonly("device", &PySearch::device, "Where it runs: the Vulkan device's name, or 'cpu, N threads'.")
+      .def_property_readonly("database", &PySearch::database, "The Database searched.")
+      .def("__repr__", [](const PySearch& s) { return "<mmvk.Search: " + s.name() + " on " + s.device() + ">"; });
+}
+
+}  // namespace mmvk::python

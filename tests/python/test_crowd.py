@@ -1,0 +1,123 @@
+"""mmvk.Crowd: its own steering gives `mmvk crowd`'s run, and another
+simulator's steering (a straight line, a circle) is followed within the
+trajectory error of the crowd's own steering."""
+import json
+import math
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import mmvk
+from conftest import CMU131
+
+AGENTS = 16
+SECONDS = 10.0
+
+
+@pytest.fixture(scope="module")
+def builtin(db):
+    crowd = mmvk.Crowd(db, agents=AGENTS, backend="clusters", seed=3)
+    crowd.run(SECONDS)
+    return crowd.summary()
+
+
+def test_own_steering_is_the_command_lines_run(db, cli, tmp_path):
+    crowd = mmvk.Crowd(db, agents=12, backend="clusters", seed=5)
+    for _ in range(90):
+        crowd.step()
+    summary = crowd.summary()
+    out = tmp_path / "crowd.json"
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))
+    subprocess.run([str(cli), "crowd", "--data", str(CMU131), "--agents", "12", "--seconds", "3", "--backend",
+                    "clusters", "--seed", "5", "--summary", str(out)], check=True, capture_output=True, env=env)
+    want = json.loads(out.read_text())
+    # The same chosen frames, in order, and the same figures (summed in
+    # floating point over characters, so to a relative 1e-6).
+    for key in ["agents", "ticks", "searches", "chosen_frames_hash", "goals_reached"]:
+        assert summary[key] == want[key], key
+    for key in ["trajectory_error_m_1s", "foot_sliding_cm_s", "transitions_per_agent_s", "walk_mps"]:
+        assert summary[key] == pytest.approx(want[key], rel=1e-6), key
+
+
+def follow(db, path, facing, by_position=False):
+    """Steps a crowd along path(t) -> (offset (x, z), velocity (x, z)) from each
+    character's start; returns the distance of each root from its path
+    curve after the first second, [ticks x agents], and the summary."""
+    crowd = mmvk.Crowd(db, agents=AGENTS, backend="clusters", seed=3)
+    starts = np.stack([np.arange(AGENTS) * 4.0, np.zeros(AGENTS)], axis=1)
+    for i, (x, z) in enumerate(starts):
+        crowd.place(i, float(x), float(z), facing)
+    errors = []
+    for tick in range(int(SECONDS * crowd.rate)):
+        t = tick * crowd.dt
+        if by_position:
+            # Where the path is at the end of this tick.
+            crowd.step_toward((starts + path(t + crowd.dt)[0]).astype(np.float32))
+        else:
+            crowd.step(np.tile(np.asarray(path(t)[1], np.float32), (AGENTS, 1)))
+        if t >= 1.0:
+            errors.append(path.distance(crowd.root_positions[:, [0, 2]] - starts))
+    return np.array(errors), crowd.summary()
+
+
+class Line:
+    def __init__(self, speed):
+        self.speed = speed
+
+    def __call__(self, t):
+        return (0.0, self.speed * t), (0.0, self.speed)
+
+    def distance(self, offset):
+        return np.abs(offset[:, 0])
+
+
+class Circle:
+    """Radius r through the start, heading +x at first and turning left."""
+
+    def __init__(self, speed, r):
+        self.speed, self.r = speed, r
+
+    def __call__(self, t):
+        a = self.speed * t / self.r
+        return (self.r * math.sin(a), self.r * (1 - math.cos(a))), (self.speed * math.cos(a), self.speed * math.sin(a))
+
+    def distance(self, offset):
+        return np.abs(np.linalg.norm(offset - [0.0, self.r], axis=1) - self.r)
+
+
+@pytest.mark.parametrize("shape", ["line", "circle"])
+@pytest.mark.parametrize("by_position", [False, True], ids=["velocities", "positions"])
+def test_external_steering_follows_the_path(db, builtin, shape, by_position):
+    speed = mmvk.Crowd(db, agents=1).walk_speed
+    path = Line(speed) if shape == "line" else Circle(speed, 3.0)
+    errors, summary = follow(db, path, 0.0 if shape == "line" else math.pi / 2, by_position)
+    budget = builtin["trajectory_error_m_1s"]
+    assert np.isfinite(budget) and budget > 0
+    # Every character, 99% of the ticks: within the built-in steering's
+    # median trajectory error of the path it was given (and never twice it).
+    assert np.percentile(errors, 99) <= budget, (shape, float(np.percentile(errors, 99)), budget)
+    assert errors.max() <= 2 * budget, (shape, float(errors.max()), budget)
+    assert summary["trajectory_error_m_1s"] <= 1.25 * budget
+
+
+def test_arrays_and_errors(db, tmp_path):
+    crowd = mmvk.Crowd(db, agents=4, record=True)
+    crowd.step()
+    joints = len(db.animation.joint_names)
+    assert crowd.joint_positions.shape == (4, joints, 3)
+    assert crowd.root_positions.shape == (4, 3) and crowd.root_yaws.shape == (4,)
+    assert crowd.frames.dtype == np.uint32 and crowd.contacts.shape == (4,)
+    assert crowd.foot_locked.shape == (4, 2)
+    with pytest.raises(ValueError, match=r"desired_velocity: 3 rows for 4 agents"):
+        crowd.step(np.zeros((3, 2), np.float32))
+    with pytest.raises(ValueError, match="float32"):
+        crowd.step(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="desired_facing"):
+        crowd.step(np.zeros((4, 2), np.float32), np.zeros(3, np.float32))
+    with pytest.raises(ValueError, match="not finite|finite"):
+        crowd.step(np.full((4, 2), np.nan, np.float32))
+    assert crowd.write_html(tmp_path / "crowd.html") > 1000
+    with pytest.raises(ValueError, match="unknown backend"):
+        mmvk.Crowd(db, agents=2, backend="nope")

@@ -124,7 +124,8 @@ constexpr float kContinuingBias = -2.5f;
 //   CMU 131, 60 Hz:  0.2 s: 0.051 m, 0.38 cm/s, 1.23;  0.15 s: 0.042, 0.34, 1.18;  0.1 s: 0.031, 0.31, 1.11
 //   Bandai, 60 Hz:   0.2 s: 0.048 m, 0.95 cm/s, 1.93;  0.15 s: 0.043, 0.89, 1.88;  0.1 s: 0.036, 0.87, 1.87
 // 0.1 s clamps the legs' reach more often (7.1% of foot-ticks on CMU against
-// 5.4%), so 0.15 s.
+// 5.4%), so 0.15 s, for data of the user's; a shipped set carries its own
+// (default_data.cpp).
 constexpr float kCorrectionHalfLife = 0.15f;
 
 // The 1 s horizon of the trajectory error, as the controller would predict it.
@@ -174,7 +175,8 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
   params.continuing_bias = options.continuing_bias.value_or(kContinuingBias);
-  params.correction_half_life = options.correction_half_life.value_or(kCorrectionHalfLife);
+  params.correction_half_life =
+      options.correction_half_life.value_or(data.correction_half_life.value_or(kCorrectionHalfLife));
   params.continuing_multiplier = options.continuing_multiplier.value_or(params.continuing_multiplier);
   params.exclusion_window = options.exclusion_window.value_or(params.exclusion_window);
   params.foot_ik.enabled = options.foot_ik;
@@ -338,6 +340,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.realtime_factor = wall > 0.0 ? s.seconds / wall : 0.0;
   s.trajectory_error_m_1s = meter.trajectory_error_m_median();
   s.foot_ik = options.foot_ik;
+  s.correction_half_life_s = std::round(double(params.correction_half_life) * 1e6) / 1e6;  // 0.07, not 0.0700000003
   s.motion = motion.figures();
   s.clips = clips.figures;
   s.planted_height_m = clips.planted_height;

@@ -33,25 +33,28 @@ constexpr const char* kCrowdFiles =
     "and a run that would need more memory than this machine allows is refused\n"
     "with its estimate (docs/files-and-limits.md).\n";
 
+// "0.1", "30": a default as the help shows it.
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
 // The sections after the options: files, the shipped motion sets (one entry
 // each, wrapped like the options) and the backends.
 std::string crowd_footer() {
   std::string out = kCrowdFiles;
   out += "\nshipped motion sets (--data NAME; the first is the default):\n";
-  for (const crowd::ShippedData& data : crowd::shipped_data()) out += help_entry(data.name, data.description, 22);
+  for (const crowd::ShippedData& data : crowd::shipped_data()) {
+    const std::string settings = ". Crowd settings: --correction-half-life " + number(data.correction_half_life);
+    out += help_entry(data.name, std::string(data.description) + settings, 22);
+  }
   return out + "\nbackends:\n" + crowd::crowd_backend_help();
 }
 
 std::string default_data_name() {
   const auto shipped = crowd::shipped_data();
   return shipped.empty() ? std::string("none") : std::string(shipped.front().name);
-}
-
-// "0.1", "30": a default as the help shows it.
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
 }
 
 // The motion, the crowd and its clock, the search backend. The defaults in
@@ -103,9 +106,9 @@ void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.value("--weights", options.weights, "CHANNEL=W,...", "reweigh schema channels for every search (W >= 0)",
             [](const std::string& text) { return parse_weight_list("--weights", text); });
   cli.positive("--correction-half-life", options.correction_half_life, "S",
-               "half-life of the pull of each character's animated root towards its simulated position (default "
-               "0.15 s; shorter holds the characters closer to their paths, with more root motion that the animation "
-               "did not make)");
+               "half-life of the pull of each character's animated root towards its simulated position (default: "
+               "the shipped set's, below; other data 0.15 s; shorter holds the characters closer to their paths, with "
+               "more root motion that the animation did not make)");
 }
 
 void declare_trace(CommandLine& cli, crowd::CrowdOptions& options) {

@@ -107,7 +107,8 @@ constexpr float kContinuingBias = -2.5f;
 //   CMU 131, 60 Hz:  0.2 s: 0.051 m, 0.38 cm/s, 1.23;  0.15 s: 0.042, 0.34, 1.18;  0.1 s: 0.031, 0.31, 1.11
 //   Bandai, 60 Hz:   0.2 s: 0.048 m, 0.95 cm/s, 1.93;  0.15 s: 0.043, 0.89, 1.88;  0.1 s: 0.036, 0.87, 1.87
 // 0.1 s clamps the legs' reach more often (7.1% of foot-ticks on CMU against
-// 5.4%), so 0.15 s.
+// 5.4%), so 0.15 s, for data of the user's; a shipped set carries its own
+// (default_data.cpp).
 constexpr float kCorrectionHalfLife = 0.15f;
 
 // --weights on every character's query options; errors name --weights.
@@ -142,11 +143,13 @@ Result<Scenario> plan_scenario(const CrowdOptions& options, const Database& db, 
   return scenario;
 }
 
-ControllerParams controller_params(const CrowdOptions& options) {
+// The flags' settings, else the shipped set's, else the crowd's defaults.
+ControllerParams controller_params(const CrowdOptions& options, const DataChoice& data) {
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
   params.continuing_bias = options.continuing_bias.value_or(kContinuingBias);
-  params.correction_half_life = options.correction_half_life.value_or(kCorrectionHalfLife);
+  params.correction_half_life =
+      options.correction_half_life.value_or(data.correction_half_life.value_or(kCorrectionHalfLife));
   params.continuing_multiplier = options.continuing_multiplier.value_or(params.continuing_multiplier);
   params.exclusion_window = options.exclusion_window.value_or(params.exclusion_window);
   params.foot_ik.enabled = options.foot_ik;
@@ -312,7 +315,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   const Database& db = opened.database;
   MMVK_ASSIGN_OR_RETURN(const GaitSpeeds speeds, check_motion(db, data.label));
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, plan_scenario(options, db, speeds));
-  const ControllerParams params = controller_params(options);
+  const ControllerParams params = controller_params(options, data);
   MMVK_ASSIGN_OR_RETURN(CrowdController controller, make_controller(db, data.label, scenario, options, params));
   const std::uint32_t agents = controller.size();
   ThreadPool pool(0);
@@ -338,6 +341,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   // Summary: the figures, then the outputs.
   CrowdSummary s = summarize_run(options, opened, data.label, scenario, speeds, search, controller, ticks);
+  s.correction_half_life_s = std::round(double(params.correction_half_life) * 1e6) / 1e6;  // 0.07, not 0.0700000003
   loop.summarize(s);
   quality.summarize(s);
   s.clips = clips.figures;

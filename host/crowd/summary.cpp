@@ -32,6 +32,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["seconds"] = s.seconds;
   j["rate_hz"] = s.rate_hz;
   j["search_interval_s"] = s.search_interval_s;
+  j["correction_half_life_s"] = s.correction_half_life_s;
   j["seed"] = s.seed;
   j["scenario"] = s.scenario;
   j["database"] = s.database;

@@ -19,6 +19,7 @@ struct CrowdSummary {
   double seconds = 0.0;            // simulated
   double rate_hz = 0.0;
   double search_interval_s = 0.0;
+  double correction_half_life_s = 0.0;  // the root correction's half-life it ran with (the set's or the flag's)
   std::uint64_t seed = 0;
   std::string scenario;            // file or "seed N"
   std::string database;            // the .mmdb or source folder

@@ -1,6 +1,8 @@
-// `mmvk crowd` end to end on the shipped CMU walks: the default data is
-// built once and cached, the summary has every key, and bad input gets a
-// clear message and an exit code in 1..127 (never a crash).
+// `mmvk crowd` end to end on the shipped CMU sets: the default data (CMU
+// subject 131's walks) is built once and cached, the summary has
+// every key, each shipped set runs with its own crowd settings unless a flag
+// says otherwise, and bad input gets a clear message and an exit code in
+// 1..127 (never a crash).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -62,7 +64,7 @@ TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
   std::ifstream in(summary);
   const auto json = nlohmann::json::parse(in, nullptr, false);
   ASSERT_FALSE(json.is_discarded());
-  for (const char* key : {"agents", "ticks", "seconds", "walk_mps", "run_mps", "runners", "notes", "backend", "device", "searches", "no_candidate",
+  for (const char* key : {"agents", "ticks", "seconds", "correction_half_life_s", "walk_mps", "run_mps", "runners", "notes", "backend", "device", "searches", "no_candidate",
                           "search_ms_p50", "search_ms_p99", "tick_ms_p50", "tick_ms_p99", "trajectory_error_m_1s",
                           "foot_sliding_cm_s", "transitions_per_agent_s", "chosen_frames_hash", "foot_ik",
                           "foot_sliding_before_ik_cm_s", "foot_sliding_database_cm_s", "foot_lock_fraction",
@@ -80,6 +82,7 @@ TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
   EXPECT_EQ(json["ticks"], 30);
   EXPECT_GT(json["searches"].get<int>(), 20);
   EXPECT_EQ(json["device"].get<std::string>().rfind("cpu", 0), 0u);
+  EXPECT_EQ(json["correction_half_life_s"].get<double>(), 0.15) << json.dump();  // the default set's
 }
 
 TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
@@ -168,6 +171,7 @@ TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
   nlohmann::json json = read_summary(summary);
   EXPECT_TRUE(json["run_mps"].is_null()) << json.dump();
   EXPECT_EQ(json["runners"], 0);
+  EXPECT_EQ(json["correction_half_life_s"].get<double>(), 0.15) << json.dump();  // the set's own
   ASSERT_EQ(json["notes"].size(), 1u) << json.dump();
   EXPECT_NE(json["notes"][0].get<std::string>().find("run_mps is null: the data has no run (no frame is tagged 'run'"),
             std::string::npos)
@@ -179,7 +183,7 @@ TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
                  runner.string() + ": agents[0].speed: asks for the 'run' gait, but the motion data has no run");
 
   // The CMU 16 walks and runs do run: a pedestrian walk, a run over 2.5 m/s
-  // and a fifth of the crowd running.
+  // and a fifth of the crowd running, with the set's correction half-life.
   const auto both = run_command(mmvk_ + " crowd --data cmu-walk-run --agents 50 --seconds 1 --backend fast-box "
                                 "--summary " + summary.string());
   ASSERT_EQ(both.exit_code, 0) << both.output;
@@ -188,6 +192,12 @@ TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
   EXPECT_GE(json["run_mps"].get<double>(), 2.5) << json.dump();
   EXPECT_GT(json["runners"].get<int>(), 0) << json.dump();
   EXPECT_TRUE(json["notes"].empty()) << json.dump();
+  EXPECT_EQ(json["correction_half_life_s"].get<double>(), 0.07) << json.dump();
+  // The flag overrides the set's setting.
+  const auto flagged = run_command(mmvk_ + " crowd --data cmu-walk-run --agents 5 --seconds 1 --backend fast-box "
+                                   "--correction-half-life 0.2 --summary " + summary.string());
+  ASSERT_EQ(flagged.exit_code, 0) << flagged.output;
+  EXPECT_EQ(read_summary(summary)["correction_half_life_s"].get<double>(), 0.2);
 }
 
 TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {

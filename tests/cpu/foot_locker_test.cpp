@@ -511,13 +511,15 @@ TEST(FootLocker, ResetForgetsTheLocksAndOffLeavesThePose) {
 struct DropResult {
   float drop = 0.0f;
   float largest_drop_step = 0.0f;
-  float foot_error = 0.0f;  // the left toe to its anchor, at the end (m)
+  float foot_error = 0.0f;          // the left toe to its anchor, at the end (m)
+  float largest_foot_error = 0.0f;  // the same, the largest over the run (m)
   bool clamped = false;
 };
-DropResult run_hip_drop(float max_hip_drop) {
+DropResult run_hip_drop(float max_hip_drop, float max_hip_goal_rate = FootIkParams{}.max_hip_goal_rate) {
   const AnimationData a = make_skeleton();
   FootIkParams params;
   params.max_hip_drop = max_hip_drop;
+  params.max_hip_goal_rate = max_hip_goal_rate;
   Result<FootLocker> locker = FootLocker::create(a, 1, params);
   EXPECT_TRUE(locker.ok()) << locker.message();
   const float extension = 0.96f * 2.0f * kBone;
@@ -540,6 +542,8 @@ DropResult run_hip_drop(float max_hip_drop) {
     EXPECT_NEAR(world[0].y, hips - drop, 1e-5f);  // the hips joint moved down by the drop
     result.largest_drop_step = std::max(result.largest_drop_step, std::abs(drop - previous_drop));
     previous_drop = drop;
+    const glm::vec3 toe = world[static_cast<std::size_t>(locker->legs()[0].toe)];
+    result.largest_foot_error = std::max(result.largest_foot_error, glm::length(toe - locker->anchors()[0]));
   }
   result.drop = previous_drop;
   result.foot_error = glm::length(world[static_cast<std::size_t>(locker->legs()[0].toe)] - locker->anchors()[0]);
@@ -562,6 +566,20 @@ TEST(FootLocker, HipsLowerForAnOutOfReachTarget) {
   EXPECT_GT(held.foot_error, 1e-3f);  // without the drop the soft clamp leaves it short
   std::printf("hip drop %.4f m, foot error %.2g m (without lowering: %.2g m, clamped)\n", double(lowered.drop),
               double(lowered.foot_error), double(held.foot_error));
+}
+
+// While the root moves away (the wanted drop deepening every tick), hips
+// that only chase the goal lag it and the held foot falls short of its
+// anchor; following the goal's motion keeps it there, still without a jump.
+TEST(FootLocker, HipsFollowADeepeningDropWithoutLag) {
+  const DropResult followed = run_hip_drop(0.1f);
+  const DropResult chased = run_hip_drop(0.1f, 0.0f);
+  EXPECT_LT(followed.largest_foot_error, 1e-3f);
+  EXPECT_GT(chased.largest_foot_error, 2.0f * followed.largest_foot_error);
+  EXPECT_LT(followed.largest_drop_step, 0.002f);
+  EXPECT_NEAR(followed.drop, chased.drop, 1e-4f);  // the same drop once the root stops
+  std::printf("largest foot error while the drop deepens: %.2g m following the goal, %.2g m chasing it\n",
+              double(followed.largest_foot_error), double(chased.largest_foot_error));
 }
 
 TEST(FootLocker, CharactersUpdateConcurrentlyAsSerially) {
@@ -618,6 +636,7 @@ TEST(FootLocker, ErrorsNameTheRoleOrField) {
       {"release_half_life", [](FootIkParams& p) { p.release_half_life = 0.0f; }},
       {"hip_half_life", [](FootIkParams& p) { p.hip_half_life = INFINITY; }},
       {"max_hip_drop", [](FootIkParams& p) { p.max_hip_drop = -0.1f; }},
+      {"max_hip_goal_rate", [](FootIkParams& p) { p.max_hip_goal_rate = NAN; }},
       {"floor_height", [](FootIkParams& p) { p.floor_height = NAN; }},
   };
   for (const BadParam& b : bad) {

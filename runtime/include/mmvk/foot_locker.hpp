@@ -31,7 +31,8 @@
 //     start, or the animated extension where that is longer), the hips are
 //     lowered by the least drop that brings it within reach, for the worse
 //     of the two legs, at most max_hip_drop, followed by a critically
-//     damped spring (hip_half_life).
+//     damped spring (hip_half_life) that moves with the wanted drop up to
+//     max_hip_goal_rate.
 // A foot without correction, with the hips not lowered, is left exactly as
 // animated (no solve).
 //
@@ -78,8 +79,22 @@ struct FootIkParams {
   float release_half_life = 0.1f;
   // Largest lowering of the hips (metres, >= 0; 0 disables it) and the
   // half-life (seconds, > 0) of the spring that follows the wanted drop.
+  // The spring tracks the wanted drop's own motion up to max_hip_goal_rate
+  // (metres per second, >= 0; 0: it chases a goal it treats as still, and
+  // lags a deepening one by about a half-life, long enough for a held foot
+  // at full stride to slip out of reach). Measured in the crowd (1,000
+  // characters x 20 s, sliding after IK at 30 / 60 Hz, bench/RESULTS.md
+  // "The default data"): chasing a still goal (before) gave CMU 16
+  // (cmu-walk-run) 0.60 / 0.74 cm/s, CMU 131 0.51 / 0.34, Bandai 0.86 / 0.89;
+  // following it at up to 1 m/s 0.35 / 0.45, 0.42 / 0.23, 0.63 / 0.65 (0.5
+  // m/s: 0.38 / 0.49, 0.42 / 0.23, 0.68 / 0.68). A 0.2 m drop would take CMU
+  // 16 to 0.19 / 0.26, but bends near-straight legs so far that their knees
+  // flip sides in a tick (tests/data/crowd_controller_test.cpp: a knee moved
+  // 0.46 m in one tick against 0.37 at 0.1 m); a faster hip spring (0.03 s)
+  // shakes the pose (its acceleration p99 up 8%).
   float max_hip_drop = 0.1f;
   float hip_half_life = 0.1f;
+  float max_hip_goal_rate = 1.0f;
   // Keep the ankle and toe joints at or above the floor: floor_height
   // (metres, finite) above the root's y.
   bool clamp_to_floor = true;
@@ -197,7 +212,7 @@ class FootLocker {
   std::vector<glm::vec3> anchor_, offset_, offset_rate_;
   std::vector<float> anchor_yaw_, yaw_offset_, yaw_rate_;
   // Per character [B].
-  std::vector<float> hip_drop_, hip_drop_rate_;
+  std::vector<float> hip_drop_, hip_drop_rate_, hip_goal_;  // hip_goal_: the last tick's wanted drop
 };
 
 }  // namespace mmvk

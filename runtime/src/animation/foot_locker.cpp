@@ -102,6 +102,9 @@ Status FootIkParams::validate() const {
     if (!(std::isfinite(check.value) && check.value > 0.0f)) return fail(check.name, "finite and > 0", check.value);
   }
   if (!(std::isfinite(max_hip_drop) && max_hip_drop >= 0.0f)) return fail("max_hip_drop", "finite and >= 0", max_hip_drop);
+  if (!(std::isfinite(max_hip_goal_rate) && max_hip_goal_rate >= 0.0f)) {
+    return fail("max_hip_goal_rate", "finite and >= 0", max_hip_goal_rate);
+  }
   if (!std::isfinite(floor_height)) return fail("floor_height", "finite", floor_height);
   return {};
 }
@@ -176,6 +179,7 @@ Result<FootLocker> FootLocker::create(const AnimationData& animation, std::uint3
   locker.yaw_rate_.assign(feet, 0.0f);
   locker.hip_drop_.assign(characters, 0.0f);
   locker.hip_drop_rate_.assign(characters, 0.0f);
+  locker.hip_goal_.assign(characters, 0.0f);
   return locker;
 }
 
@@ -192,7 +196,7 @@ void FootLocker::clear(std::uint32_t b) {
     anchor_[f] = offset_[f] = offset_rate_[f] = glm::vec3(0.0f);
     anchor_yaw_[f] = yaw_offset_[f] = yaw_rate_[f] = 0.0f;
   }
-  hip_drop_[b] = hip_drop_rate_[b] = 0.0f;
+  hip_drop_[b] = hip_drop_rate_[b] = hip_goal_[b] = 0.0f;
 }
 
 void FootLocker::reset(std::uint32_t b) {
@@ -408,9 +412,19 @@ float FootLocker::lower_hips(std::uint32_t b, float dt, float wanted_drop, const
   float& drop_rate = hip_drop_rate_[b];
   const float goal = std::min(wanted_drop, params_.max_hip_drop);
   if (dt > 0.0f) {
-    float gap = drop - goal;
-    spring_decay(gap, drop_rate, params_.hip_half_life, dt);
-    drop = std::clamp(goal + gap, 0.0f, params_.max_hip_drop);
+    // The spring follows the goal as it moved since the last tick, at up to
+    // max_hip_goal_rate: a goal that deepens steadily (a stride stretching)
+    // is followed without the spring's lag, which let the held foot slip out
+    // of reach; a faster change (a step) is left to the spring to smooth.
+    float& last_goal = hip_goal_[b];
+    const float goal_rate =
+        std::clamp((goal - last_goal) / dt, -params_.max_hip_goal_rate, params_.max_hip_goal_rate);
+    float gap = drop - last_goal;
+    float gap_rate = drop_rate - goal_rate;
+    spring_decay(gap, gap_rate, params_.hip_half_life, dt);
+    drop = std::clamp(last_goal + goal_rate * dt + gap, 0.0f, params_.max_hip_drop);
+    drop_rate = goal_rate + gap_rate;
+    last_goal = goal;
     if (goal == 0.0f && drop < kSettled && std::abs(drop_rate) < kSettledRate) drop = drop_rate = 0.0f;
   }
   if (drop > 0.0f) {

@@ -15,21 +15,18 @@
 #include "crowd_backend.hpp"
 #include "crowd_limits.hpp"
 #include "crowd_paths.hpp"
-#include "crowd_recorder.hpp"
 #include "default_data.hpp"
-#include "mmvk/hash.hpp"
 #include "gait_plan.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/query_builder.hpp"
-#include "mmvk/trajectory.hpp"
-#include "motion_meter.hpp"
 #include "observed_search.hpp"
 #include "progress_line.hpp"
 #include "quality_meter.hpp"
 #include "scenario.hpp"
 #include "steering.hpp"
+#include "tick_observers.hpp"
 #include "trace.hpp"
 
 #include "viewer/viewer_html.hpp"
@@ -85,20 +82,6 @@ Result<Scenario> make_scenario(const CrowdOptions& options, bool can_run) {
   return scenario;
 }
 
-// Tags by name, per agent, into the controller's query parameters.
-Status apply_tags(const Scenario& scenario, const Database& database, std::span<QueryParams> params) {
-  for (std::size_t a = 0; a < scenario.agents.size(); ++a) {
-    const AgentPlan& plan = scenario.agents[a];
-    const std::string where = scenario.source + ": agents[" + std::to_string(a) + "].";
-    Result<TagMask> require = database.tag_mask(plan.require_tags);
-    if (!require) return make_error(where + "require_tags: " + require.message());
-    Result<TagMask> exclude = database.tag_mask(plan.exclude_tags);
-    if (!exclude) return make_error(where + "exclude_tags: " + exclude.message());
-    params[a].require_all = *require;
-    params[a].exclude_any = *exclude;
-  }
-  return {};
-}
 
 // Added to the cost of the frame a character would play anyway: a jump must
 // win by this much. Queries measure the pose the character shows, which
@@ -128,9 +111,6 @@ constexpr float kContinuingBias = -2.5f;
 // (default_data.cpp).
 constexpr float kCorrectionHalfLife = 0.15f;
 
-// The 1 s horizon of the trajectory error, as the controller would predict it.
-constexpr float kErrorHorizon[1] = {1.0f};
-
 // --weights on every character's query options; errors name --weights.
 Status apply_weights(const CrowdOptions& options, const Database& database, std::span<QueryParams> params) {
   if (options.weights.empty()) return {};
@@ -144,34 +124,27 @@ Status apply_weights(const CrowdOptions& options, const Database& database, std:
   return {};
 }
 
-// The spacing of the pose acceleration samples: the database's frame
-// interval in ticks (motion_meter.hpp).
-std::uint32_t acceleration_step(double rate_hz, double fps) {
-  return std::uint32_t(std::clamp(std::lround(rate_hz / fps), 1L, 16L));
-}
-
-}  // namespace
-
-Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
-  MMVK_TRY(check_options(options));
-  MMVK_ASSIGN_OR_RETURN(const DataChoice data, choose_data(options.data, options.executable));
-  // Before the database, which may take a while to build: every output
-  // writable, none of them an input or another output (crowd_paths.hpp).
-  MMVK_TRY(check_crowd_paths(options, data.source));
-  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
-  const Database& db = opened.database;
-  const std::string& db_name = data.label;
+// The motion checked for a crowd: it has animation and walks.
+Result<GaitSpeeds> check_motion(const Database& db, const std::string& db_name) {
   if (!db.animation()) {
     return make_error(db_name + ": " + missing_animation_error("mmvk crowd").message);
   }
   Result<GaitSpeeds> speeds = measure_gait_speeds(db);
   if (!speeds) return make_error(db_name + ": " + speeds.message());
-  MMVK_TRY(check_crowd_memory(options, db, nullptr));
-  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options, speeds->has_run));
-  MMVK_TRY(check_crowd_memory(options, db, &scenario));
-  MMVK_TRY(resolve_gaits(scenario, *speeds));
-  const auto agents = std::uint32_t(scenario.agents.size());
+  return speeds;
+}
 
+// The scenario, its gaits resolved, once the run is known to fit in memory.
+Result<Scenario> plan_scenario(const CrowdOptions& options, const Database& db, const GaitSpeeds& speeds) {
+  MMVK_TRY(check_crowd_memory(options, db, nullptr));
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, make_scenario(options, speeds.has_run));
+  MMVK_TRY(check_crowd_memory(options, db, &scenario));
+  MMVK_TRY(resolve_gaits(scenario, speeds));
+  return scenario;
+}
+
+// The flags' settings, else the shipped set's, else the crowd's defaults.
+ControllerParams controller_params(const CrowdOptions& options, const DataChoice& data) {
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
   params.continuing_bias = options.continuing_bias.value_or(kContinuingBias);
@@ -180,140 +153,135 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   params.continuing_multiplier = options.continuing_multiplier.value_or(params.continuing_multiplier);
   params.exclusion_window = options.exclusion_window.value_or(params.exclusion_window);
   params.foot_ik.enabled = options.foot_ik;
+  return params;
+}
+
+// The controller with the scenario's tags and --weights, every character at
+// its start facing its first goal.
+Result<CrowdController> make_controller(const Database& db, const std::string& db_name, const Scenario& scenario,
+                                        const CrowdOptions& options, const ControllerParams& params) {
+  const auto agents = std::uint32_t(scenario.agents.size());
   Result<CrowdController> created = CrowdController::create(db, agents, params);
   if (!created) return make_error(db_name + ": " + created.message());
   CrowdController controller = std::move(created.value());
-  MMVK_TRY(apply_tags(scenario, db, controller.query_params()));
+  MMVK_TRY(apply_plan_tags(scenario, db, controller.query_params()));
   MMVK_TRY(apply_weights(options, db, controller.query_params()));
   for (std::uint32_t b = 0; b < agents; ++b) {
     const AgentPlan& plan = scenario.agents[b];
     const float yaw = std::atan2(plan.goals[0][0] - plan.start[0], plan.goals[0][1] - plan.start[1]);
     MMVK_TRY(controller.place(b, glm::vec3(plan.start[0], 0.0f, plan.start[1]), yaw));
   }
+  return controller;
+}
 
-  ThreadPool pool(0);
-  MMVK_ASSIGN_OR_RETURN(CrowdSearch search,
-                        make_crowd_search(options.backend, options.device, db, agents, pool, options.cache_dir));
-  if (log) {
-    char run[48] = "no run: every character walks";
-    if (speeds->has_run) std::snprintf(run, sizeof(run), "run %.2f m/s", double(speeds->run_mps));
-    std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, %s)\n", agents,
-                 options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds->walk_mps, run);
-    if (!speeds->has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds->no_run_reason.c_str());
-    std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
-                 search.device.c_str());
-    if (!search.pipeline_cache_note.empty()) {
-      std::fprintf(log, "mmvk crowd: note: %s\n", search.pipeline_cache_note.c_str());
+void log_start(std::FILE* log, const CrowdOptions& options, const std::string& db_name, const Database& db,
+               const GaitSpeeds& speeds, const CrowdSearch& search, std::uint32_t agents) {
+  if (!log) return;
+  char run[48] = "no run: every character walks";
+  if (speeds.has_run) std::snprintf(run, sizeof(run), "run %.2f m/s", double(speeds.run_mps));
+  std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, %s)\n", agents,
+               options.seconds, options.rate_hz, db_name.c_str(), db.frame_count(), speeds.walk_mps, run);
+  if (!speeds.has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds.no_run_reason.c_str());
+  std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
+               search.device.c_str());
+  if (!search.pipeline_cache_note.empty()) {
+    std::fprintf(log, "mmvk crowd: note: %s\n", search.pipeline_cache_note.c_str());
+  }
+}
+
+Result<std::optional<TraceWriter>> open_trace(const CrowdOptions& options, const AnimationData& animation,
+                                              std::uint64_t ticks, std::uint32_t agents) {
+  if (!options.trace) return std::optional<TraceWriter>();
+  const TraceLayout layout{ticks, options.trace_agents, std::uint32_t(animation.joint_count()), options.rate_hz};
+  Result<TraceWriter> writer =
+      TraceWriter::create(*options.trace, layout, animation.skeleton, animation.contact_joints, agents);
+  if (!writer) return writer.error();
+  return std::optional<TraceWriter>(std::move(writer.value()));
+}
+
+// The viewer's recording for --html: one sample every tenth of a second.
+std::unique_ptr<RecordingObserver> make_recording(const CrowdOptions& options, const CrowdController& controller,
+                                                  const Scenario& scenario, const DataChoice& data,
+                                                  const CrowdSearch& search, float dt) {
+  if (!options.html) return nullptr;
+  const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
+  // Short enough for the page's header: "1000 agents · locomotion-normal · vulkan-brute-force on llvmpipe".
+  const std::string device = search.device.substr(0, search.device.find(" ("));
+  return std::make_unique<RecordingObserver>(
+      controller, scenario,
+      std::to_string(controller.size()) + " agents \u00b7 " + data.short_label + " \u00b7 " +
+          std::string(search.backend->name()) + " on " + device,
+      dt, per_sample);
+}
+
+// The simulation loop: steering, the controller's tick, then every observer.
+class TickLoop {
+ public:
+  TickLoop(CrowdController& controller, Steering& steering, ObservedSearch& observed, ThreadPool& pool,
+           QualityObserver& quality, RecordingObserver* recording, TraceWriter* trace, float dt)
+      : controller_(controller), steering_(steering), observed_(observed), pool_(pool), quality_(quality),
+        recording_(recording), trace_(trace), dt_(dt), x_(controller.size()), z_(controller.size()),
+        vx_(controller.size()), vz_(controller.size()), desired_(controller.size()),
+        world_(std::size_t{controller.size()} * controller.animation().joint_count()) {}
+
+  // Runs `ticks` ticks; the per-tick timings are kept for the summary.
+  Status run(std::uint64_t ticks, ProgressLine& progress) {
+    figures_.reserve(ticks);
+    const auto run_start = Clock::now();
+    for (std::uint64_t t = 0; t < ticks; ++t) {
+      MMVK_TRY(step(t));
+      progress.tick(double(t + 1) * dt_, controller_.last_tick().searches, figures_.last_search_ms());
     }
+    wall_seconds_ = std::chrono::duration<double>(Clock::now() - run_start).count();
+    return {};
   }
 
-  const float dt = float(1.0 / options.rate_hz);
-  const auto ticks = std::uint64_t(std::llround(options.seconds * options.rate_hz));
-  const AnimationData& animation = controller.animation();
-  const std::size_t joints = animation.joint_count();
-  std::optional<TraceWriter> trace;
-  if (options.trace) {
-    const TraceLayout layout{ticks, options.trace_agents, std::uint32_t(joints), options.rate_hz};
-    Result<TraceWriter> writer =
-        TraceWriter::create(*options.trace, layout, animation.skeleton, animation.contact_joints, agents);
-    if (!writer) return writer.error();
-    trace.emplace(std::move(writer.value()));
-  }
-  Steering steering(scenario, *speeds);
-  ObservedSearch observed(*search.deferred, agents);
-  QualityMeter meter(agents, dt);
-  // The clips first: their planted toe height is the crowd's floor.
-  const ClipQuality clips = measure_clip_quality(db, pool);
-  MotionMeterParams motion_params;
-  motion_params.legs = find_leg_joints(animation);
-  motion_params.planted_height = clips.planted_height;
-  motion_params.dt = dt;
-  motion_params.acceleration_step = acceleration_step(options.rate_hz, db.fps());
-  // Three half-lives: the inertialization's blend has done 90% of its work.
-  motion_params.jump_window_s = 3.0 * params.inertialization_half_life;
-  MotionMeter motion(agents, joints, motion_params);
-  std::unique_ptr<CrowdRecorder> recorder;
-  if (options.html) {
-    const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
-    // Short enough for the page's header: "1000 agents · locomotion-normal · vulkan-brute-force on llvmpipe".
-    const std::string device = search.device.substr(0, search.device.find(" ("));
-    recorder = std::make_unique<CrowdRecorder>(
-        controller, scenario,
-        std::to_string(agents) + " agents \u00b7 " + data.short_label + " \u00b7 " + std::string(search.backend->name()) + " on " + device,
-        dt, per_sample);
-  }
-  ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,
-                        std::size_t(std::max(1.0, options.rate_hz)));
+  // The loop's own figures: searches, their timings and the chosen frames.
+  void summarize(CrowdSummary& s) const { figures_.summarize(s, wall_seconds_); }
 
-  // Per tick, [N] each; sized once.
-  std::vector<float> x(agents), z(agents), vx(agents), vz(agents), desired_xz(2 * agents), root_xz(2 * agents);
-  std::vector<glm::vec3> desired(agents), world(agents * joints), animated(agents * joints);
-  std::vector<std::uint32_t> searched_before, searched_now, frames_before(agents);
-  std::vector<std::uint8_t> kinds_before(agents, 0);  // controller.searched() of the tick before
-  searched_before.reserve(agents), searched_now.reserve(agents);
-  glm::vec3 horizon_pos[1];
-  float horizon_yaw[1];
-
-  std::vector<double> search_ms, tick_ms;
-  search_ms.reserve(ticks), tick_ms.reserve(ticks);
-  Hasher chosen;
-  std::uint64_t searches = 0;
-  const auto run_start = Clock::now();
-  for (std::uint64_t t = 0; t < ticks; ++t) {
+ private:
+  Status step(std::uint64_t t) {
     const auto tick_start = Clock::now();
-    const auto roots = controller.root_positions();
-    for (std::uint32_t b = 0; b < agents; ++b) x[b] = roots[b].x, z[b] = roots[b].z;
-    steering.update(x, z, vx, vz);
-    for (std::uint32_t b = 0; b < agents; ++b) desired[b] = glm::vec3(vx[b], 0.0f, vz[b]);
-    observed.begin_tick();
-    MMVK_TRY(controller.tick(dt, CrowdInput{desired, {}}, observed, pool));
-    tick_ms.push_back(ms_since(tick_start));
-    search_ms.push_back(observed.blocked_seconds() * 1e3);
+    const auto roots = controller_.root_positions();
+    for (std::uint32_t b = 0; b < controller_.size(); ++b) x_[b] = roots[b].x, z_[b] = roots[b].z;
+    steering_.update(x_, z_, vx_, vz_);
+    for (std::uint32_t b = 0; b < controller_.size(); ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
+    observed_.begin_tick();
+    MMVK_TRY(controller_.tick(dt_, CrowdInput{desired_, {}}, observed_, pool_));
+    const auto matches = observed_.collected_matches();
+    figures_.record(t, ms_since(tick_start), observed_.blocked_seconds() * 1e3, matches,
+                    controller_.last_tick().searches);
 
-    // The chosen frames, in order: every applied match of every tick.
-    const auto matches = observed.collected_matches();
-    chosen.add_u32(std::uint32_t(t));
-    chosen.add_u32(std::uint32_t(matches.size()));
-    for (const Match& m : matches) chosen.add_u32(m.frame);
-    searches += controller.last_tick().searches;
-
-    // Quality: where the controller wants each character 1 s from now, where
-    // it is, and its feet.
-    const auto sim = controller.simulation();
-    const auto roots_now = controller.root_positions();
-    for (std::uint32_t b = 0; b < agents; ++b) {
-      predict_trajectory(sim[b], desired[b], yaw_of_velocity(desired[b], sim[b].yaw), params.spring, kErrorHorizon,
-                         horizon_pos, horizon_yaw);
-      desired_xz[2 * b] = horizon_pos[0].x, desired_xz[2 * b + 1] = horizon_pos[0].z;
-      root_xz[2 * b] = roots_now[b].x, root_xz[2 * b + 1] = roots_now[b].z;
-    }
-    meter.record_trajectory(desired_xz, root_xz);
-    meter.add_transitions(controller.last_tick().jumps);
-    meter.end_tick();
-    // The pose as displayed (after foot IK) and as animated (before).
-    controller.world_positions(world, pool);
-    controller.animated_world_positions(animated, pool);
-    motion.record({world, animated, controller.contacts(), controller.foot_locked(), controller.ik_reach_clamped(),
-                   controller.jumped()});
-    if (trace) trace->record(world, controller.contacts(), controller.foot_locked());
-
-    if (recorder) recorder->record_tick(t, matches, searched_before, kinds_before, frames_before, world);
-    searched_now.clear();
-    const auto kinds = controller.searched();
-    for (std::uint32_t b = 0; b < agents; ++b) {
-      if (kinds[b] != 0) searched_now.push_back(b);
-    }
-    searched_before.swap(searched_now);
-    std::copy(kinds.begin(), kinds.end(), kinds_before.begin());
-    const auto frames = controller.frames();
-    std::copy(frames.begin(), frames.end(), frames_before.begin());
-    progress.tick(double(t + 1) * dt, controller.last_tick().searches, search_ms.back());
+    controller_.world_positions(world_, pool_);
+    const TickView view{t, desired_, {}, matches, world_};
+    quality_.observe(controller_, view, pool_);
+    if (trace_) trace_->record(world_, controller_.contacts(), controller_.foot_locked());
+    if (recording_) recording_->observe(controller_, view);
+    return {};
   }
-  const double wall = std::chrono::duration<double>(Clock::now() - run_start).count();
-  progress.finish();
 
+  CrowdController& controller_;
+  Steering& steering_;
+  ObservedSearch& observed_;
+  ThreadPool& pool_;
+  QualityObserver& quality_;
+  RecordingObserver* recording_;
+  TraceWriter* trace_;
+  const float dt_;
+  // Per tick, [agents] or [agents x joints]; sized once.
+  std::vector<float> x_, z_, vx_, vz_;
+  std::vector<glm::vec3> desired_, world_;
+  TickFigures figures_;
+  double wall_seconds_ = 0.0;
+};
+
+// The run's settings and the figures measured before and after the loop.
+CrowdSummary summarize_run(const CrowdOptions& options, const OpenedDatabase& opened, const std::string& db_name,
+                           const Scenario& scenario, const GaitSpeeds& speeds, const CrowdSearch& search,
+                           const CrowdController& controller, std::uint64_t ticks) {
+  const Database& db = opened.database;
   CrowdSummary s;
-  s.agents = agents;
+  s.agents = controller.size();
   s.ticks = ticks;
   s.seconds = double(ticks) / options.rate_hz;
   s.rate_hz = options.rate_hz;
@@ -322,42 +290,72 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   s.scenario = scenario.source;
   s.database = opened.path.empty() ? db_name : opened.path.string();
   s.database_frames = db.frame_count();
-  s.walk_mps = speeds->walk_mps;
-  s.run_mps = speeds->has_run ? speeds->run_mps : std::nan("");  // null in the JSON
+  s.walk_mps = speeds.walk_mps;
+  s.run_mps = speeds.has_run ? speeds.run_mps : std::nan("");  // null in the JSON
   s.runners = count_runners(scenario);
-  if (!speeds->has_run) s.notes.push_back("run_mps is null: the data has no run (" + speeds->no_run_reason + ")");
+  if (!speeds.has_run) s.notes.push_back("run_mps is null: the data has no run (" + speeds.no_run_reason + ")");
   s.backend = std::string(search.backend->name());
   s.device = search.device;
-  s.searches = searches;
   s.forced_searches = controller.totals().forced;
   s.no_candidate = controller.totals().no_candidate;
-  s.queries_per_tick = ticks ? double(searches) / double(ticks) : 0.0;
-  s.search_ms_p50 = percentile(search_ms, 0.5);
-  s.search_ms_p99 = percentile(search_ms, 0.99);
-  s.tick_ms_p50 = percentile(tick_ms, 0.5);
-  s.tick_ms_p99 = percentile(tick_ms, 0.99);
-  s.wall_seconds = wall;
-  s.realtime_factor = wall > 0.0 ? s.seconds / wall : 0.0;
-  s.trajectory_error_m_1s = meter.trajectory_error_m_median();
   s.foot_ik = options.foot_ik;
+  return s;
+}
+
+}  // namespace
+
+Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
+  // Setup: the data, the scenario, the controller and the search.
+  MMVK_TRY(check_options(options));
+  MMVK_ASSIGN_OR_RETURN(const DataChoice data, choose_data(options.data, options.executable));
+  // Before the database, which may take a while to build: every output
+  // writable, none of them an input or another output (crowd_paths.hpp).
+  MMVK_TRY(check_crowd_paths(options, data.source));
+  MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
+  const Database& db = opened.database;
+  MMVK_ASSIGN_OR_RETURN(const GaitSpeeds speeds, check_motion(db, data.label));
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, plan_scenario(options, db, speeds));
+  const ControllerParams params = controller_params(options, data);
+  MMVK_ASSIGN_OR_RETURN(CrowdController controller, make_controller(db, data.label, scenario, options, params));
+  const std::uint32_t agents = controller.size();
+  ThreadPool pool(0);
+  MMVK_ASSIGN_OR_RETURN(CrowdSearch search,
+                        make_crowd_search(options.backend, options.device, db, agents, pool, options.cache_dir));
+  log_start(log, options, data.label, db, speeds, search, agents);
+
+  // The observers, then the loop.
+  const float dt = float(1.0 / options.rate_hz);
+  const auto ticks = std::uint64_t(std::llround(options.seconds * options.rate_hz));
+  MMVK_ASSIGN_OR_RETURN(std::optional<TraceWriter> trace, open_trace(options, controller.animation(), ticks, agents));
+  Steering steering(scenario, speeds);
+  ObservedSearch observed(*search.deferred, agents);
+  const ClipQuality clips = measure_clip_quality(db, pool);
+  QualityObserver quality(controller, params, clips, dt, options.rate_hz, db.fps());
+  const std::unique_ptr<RecordingObserver> recording =
+      make_recording(options, controller, scenario, data, search, dt);
+  ProgressLine progress(options.progress ? log : nullptr, double(ticks) * dt,
+                        std::size_t(std::max(1.0, options.rate_hz)));
+  TickLoop loop(controller, steering, observed, pool, quality, recording.get(), trace ? &*trace : nullptr, dt);
+  MMVK_TRY(loop.run(ticks, progress));
+  progress.finish();
+
+  // Summary: the figures, then the outputs.
+  CrowdSummary s = summarize_run(options, opened, data.label, scenario, speeds, search, controller, ticks);
   s.correction_half_life_s = std::round(double(params.correction_half_life) * 1e6) / 1e6;  // 0.07, not 0.0700000003
-  s.motion = motion.figures();
+  loop.summarize(s);
+  quality.summarize(s);
   s.clips = clips.figures;
   s.planted_height_m = clips.planted_height;
-  s.transitions_per_agent_s = meter.transitions_per_agent_s();
   s.goals_reached = steering.goals_reached();
-  s.chosen_frames_hash = chosen.digest();
   if (Status saved = save_crowd_pipeline_cache(search); !saved && log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }
-
   if (trace) {
     MMVK_TRY(trace->finish());
     s.trace = options.trace->string();
   }
-  if (options.html) {
-    Recording recording = recorder->finish(pool);
-    MMVK_ASSIGN_OR_RETURN(const std::size_t bytes, write_viewer_html(*options.html, recording));
+  if (recording) {
+    MMVK_ASSIGN_OR_RETURN(const std::size_t bytes, write_viewer_html(*options.html, recording->finish(pool)));
     s.html = options.html->string();
     s.html_bytes = bytes;
   }

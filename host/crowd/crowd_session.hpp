@@ -27,19 +27,16 @@
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/database.hpp"
-#include "mmvk/hash.hpp"
 #include "mmvk/status.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "scenario.hpp"
 #include "steering.hpp"
 #include "summary.hpp"
+#include "tick_observers.hpp"
 
 namespace mmvk::crowd {
 
-class CrowdRecorder;
-class MotionMeter;
 class ObservedSearch;
-class QualityMeter;
 
 struct CrowdSessionOptions {
   // The characters' starts, goals, speeds and tags; none: a random scenario
@@ -111,21 +108,17 @@ class CrowdSession {
   CrowdSearch search_;
   std::unique_ptr<ObservedSearch> observed_;
   std::unique_ptr<Steering> steering_;
-  std::unique_ptr<QualityMeter> meter_;
-  std::unique_ptr<MotionMeter> motion_;
-  std::unique_ptr<CrowdRecorder> recorder_;
+  // The observers run_crowd has too (tick_observers.hpp).
+  TickFigures figures_;
+  std::unique_ptr<QualityObserver> quality_;
+  std::unique_ptr<RecordingObserver> recording_;
   MotionFigures clip_figures_;
   std::array<float, 2> planted_height_{0.0f, 0.0f};
 
   // Per tick, sized once.
-  std::vector<float> x_, z_, vx_, vz_, desired_xz_, root_xz_;
-  std::vector<glm::vec3> desired_, world_, animated_;
-  std::vector<std::uint32_t> searched_before_, searched_now_, frames_before_;
-  std::vector<std::uint8_t> kinds_before_;
-  std::vector<double> search_ms_, tick_ms_;
-  std::uint64_t searches_ = 0;
-  Hasher chosen_;  // every applied match, in order (summary chosen_frames_hash)
-  double wall_s_ = 0.0;
+  std::vector<float> x_, z_, vx_, vz_;
+  std::vector<glm::vec3> desired_, world_;
+  double wall_s_ = 0.0;  // the ticks' own time, summed
   bool html_written_ = false;
 };
 

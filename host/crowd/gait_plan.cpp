@@ -38,4 +38,18 @@ std::uint64_t count_runners(const Scenario& scenario) {
                                      [](const AgentPlan& plan) { return plan.speed.gait == Gait::Run; }));
 }
 
+Status apply_plan_tags(const Scenario& scenario, const Database& database, std::span<QueryParams> params) {
+  for (std::size_t a = 0; a < scenario.agents.size(); ++a) {
+    const AgentPlan& plan = scenario.agents[a];
+    const std::string where = scenario.source + ": agents[" + std::to_string(a) + "].";
+    Result<TagMask> require = database.tag_mask(plan.require_tags);
+    if (!require) return make_error(where + "require_tags: " + require.message());
+    Result<TagMask> exclude = database.tag_mask(plan.exclude_tags);
+    if (!exclude) return make_error(where + "exclude_tags: " + exclude.message());
+    params[a].require_all = *require;
+    params[a].exclude_any = *exclude;
+  }
+  return {};
+}
+
 }  // namespace mmvk::crowd

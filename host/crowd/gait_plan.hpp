@@ -4,9 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include "gait_speeds.hpp"
+#include "mmvk/database.hpp"
+#include "mmvk/search.hpp"
 #include "mmvk/status.hpp"
 #include "scenario.hpp"
 
@@ -24,6 +27,11 @@ namespace mmvk::crowd {
 // Random scenarios are drawn without runners when the data has no run (the
 // caller sets RandomScenarioOptions::run_fraction), so they never fail here.
 Status resolve_gaits(Scenario& scenario, const GaitSpeeds& speeds);
+
+// Each plan's require_tags and exclude_tags, by name, into the masks of
+// params[agent] (the controller's query parameters, [agents]); an unknown
+// tag is an error naming the file, the agent and the field.
+Status apply_plan_tags(const Scenario& scenario, const Database& database, std::span<QueryParams> params);
 
 // Plans that prefer to run.
 std::uint64_t count_runners(const Scenario& scenario);

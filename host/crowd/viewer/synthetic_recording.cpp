@@ -129,23 +129,12 @@ void add_feet(Recording& r) {
   }
 }
 
-}  // namespace
+using Rng = std::mt19937;
 
-Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
-  Recording r;
-  std::mt19937 rng(params.seed);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  const std::size_t n = params.agents;
-  r.title = "synthetic crowd: " + std::to_string(n) + " agents walking circles";
-  r.sample_rate_hz = params.sample_rate_hz;
-  r.agent_count = n;
-  r.sample_count = static_cast<std::size_t>(std::floor(params.seconds * params.sample_rate_hz)) + 1;
-  r.trajectory_times_s = {0.333f, 0.667f, 1.0f};
-  set_skeleton(r);
-  for (int32_t f = 0; f < kWalk.length; ++f) append_pose(r, kWalk, kWalk.first + f);
-  for (int32_t f = 0; f < kRun.length; ++f) append_pose(r, kRun, kRun.first + f);
+float unit(Rng& rng) { return std::uniform_real_distribution<float>(0.0f, 1.0f)(rng); }
 
-  // Agents on a square grid, 6 m apart, each walking its own circle.
+// Agents on a square grid, 6 m apart, each walking its own circle.
+std::vector<Agent> place_agents(std::size_t n, Rng& rng) {
   const std::size_t side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
   std::vector<Agent> agents(n);
   for (std::size_t a = 0; a < n; ++a) {
@@ -157,14 +146,95 @@ Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
     g.speed = (g.running ? 3.2f : 1.2f + 0.4f * unit(rng)) * (unit(rng) < 0.5f ? 1.0f : -1.0f);
     g.angle0 = 2.0f * kPi * unit(rng);
   }
-  // Position on the circle at time t, with a small sway so the achieved path
-  // differs visibly from the desired one.
-  auto circle = [](const Agent& g, float t, float sway, float& x, float& z) {
-    const float angle = g.angle0 + g.speed / g.radius * t;
-    const float radius = g.radius + sway;
-    x = g.centre_x + radius * std::sin(angle);
-    z = g.centre_z + radius * std::cos(angle);
-  };
+  return agents;
+}
+
+// Position on the circle at time t, with a small sway so the achieved path
+// differs visibly from the desired one.
+void circle(const Agent& g, float t, float sway, float& x, float& z) {
+  const float angle = g.angle0 + g.speed / g.radius * t;
+  const float radius = g.radius + sway;
+  x = g.centre_x + radius * std::sin(angle);
+  z = g.centre_z + radius * std::cos(angle);
+}
+
+// A search at time t from `frame`: about one jump a second. Moves `offset`
+// (the frame's place in its clip) where it jumps.
+SearchEvent random_search(const SyntheticRecordingParams& params, const Clip& clip, float t, int32_t frame,
+                          int32_t& offset, Rng& rng) {
+  SearchEvent event;
+  event.time_s = t;
+  event.from_frame = frame;
+  event.jumped = unit(rng) < params.search_interval_s;
+  event.forced = event.jumped && unit(rng) < 0.1f;
+  const int32_t jump_to = static_cast<int32_t>(unit(rng) * static_cast<float>(clip.length - 1));
+  event.to_frame = event.jumped ? clip.first + jump_to : frame;
+  event.cost = event.jumped ? 0.4f + 1.5f * unit(rng) : 1.5f + 2.0f * unit(rng);
+  if (event.jumped) offset = jump_to;
+  return event;
+}
+
+// Sample `sample` of agent a at time t: its root, facing, frame and trajectories.
+void record_sample(Recording& r, const Agent& g, std::size_t sample, std::size_t a, float t, float sway,
+                   int32_t frame) {
+  const std::size_t i = r.sample_index(sample, a);
+  circle(g, t, sway, r.root_x[i], r.root_z[i]);
+  float ax, az;
+  circle(g, t + 0.05f, sway, ax, az);
+  r.facing[i] = std::atan2(ax - r.root_x[i], az - r.root_z[i]);
+  r.frame[i] = frame;
+  for (std::size_t p = 0; p < r.trajectory_points(); ++p) {
+    const std::size_t j = r.trajectory_index(sample, a, p);
+    const float ahead = r.trajectory_times_s[p];
+    circle(g, t + ahead, 0.0f, r.desired_x[j], r.desired_z[j]);
+    circle(g, t + ahead * 0.93f, sway * 0.5f, r.matched_x[j], r.matched_z[j]);
+  }
+}
+
+// Agent a's goals, searches and samples, tick by tick.
+void simulate_agent(Recording& r, const SyntheticRecordingParams& params, const Agent& g, std::size_t a, Rng& rng) {
+  const Clip& clip = g.running ? kRun : kWalk;
+  const float dt = 1.0f / params.simulation_rate_hz;
+  const std::size_t ticks = static_cast<std::size_t>(std::ceil(params.seconds * params.simulation_rate_hz)) + 1;
+  const int search_ticks = std::max(1, static_cast<int>(std::lround(params.search_interval_s / dt)));
+  for (int k = 0; k < 8; ++k) {
+    float x, z;
+    circle(g, (static_cast<float>(k) + 1.0f) * 2.0f * kPi * g.radius / std::abs(g.speed) / 8.0f, 0.0f, x, z);
+    r.goals[a].push_back({x, z});
+  }
+  int32_t offset = static_cast<int32_t>(unit(rng) * static_cast<float>(clip.length));
+  std::size_t next_sample = 0;
+  const float sway_phase = 2.0f * kPi * unit(rng);
+  for (std::size_t tick = 0; tick < ticks && next_sample < r.sample_count; ++tick) {
+    const float t = static_cast<float>(tick) * dt;
+    const int32_t frame = clip.first + offset;
+    if (static_cast<int>(tick + a) % search_ticks == 0) {  // staggered searches
+      r.searches[a].push_back(random_search(params, clip, t, frame, offset, rng));
+    }
+    if (static_cast<float>(next_sample) / params.sample_rate_hz <= t + 0.5f * dt) {
+      const float sway = 0.15f * std::sin(1.3f * t + sway_phase);
+      record_sample(r, g, next_sample, a, t, sway, clip.first + offset);
+      ++next_sample;
+    }
+    offset = (offset + 1) % clip.length;
+  }
+}
+
+}  // namespace
+
+Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
+  Recording r;
+  Rng rng(params.seed);
+  const std::size_t n = params.agents;
+  r.title = "synthetic crowd: " + std::to_string(n) + " agents walking circles";
+  r.sample_rate_hz = params.sample_rate_hz;
+  r.agent_count = n;
+  r.sample_count = static_cast<std::size_t>(std::floor(params.seconds * params.sample_rate_hz)) + 1;
+  r.trajectory_times_s = {0.333f, 0.667f, 1.0f};
+  set_skeleton(r);
+  for (int32_t f = 0; f < kWalk.length; ++f) append_pose(r, kWalk, kWalk.first + f);
+  for (int32_t f = 0; f < kRun.length; ++f) append_pose(r, kRun, kRun.first + f);
+  const std::vector<Agent> agents = place_agents(n, rng);
 
   const std::size_t samples = r.sample_count * n;
   const std::size_t points = r.trajectory_points();
@@ -172,55 +242,7 @@ Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
   r.desired_x.resize(samples * points), r.desired_z.resize(samples * points);
   r.matched_x.resize(samples * points), r.matched_z.resize(samples * points);
   r.goals.resize(n), r.searches.resize(n);
-
-  const float dt = 1.0f / params.simulation_rate_hz;
-  const std::size_t ticks = static_cast<std::size_t>(std::ceil(params.seconds * params.simulation_rate_hz)) + 1;
-  const int search_ticks = std::max(1, static_cast<int>(std::lround(params.search_interval_s / dt)));
-  for (std::size_t a = 0; a < n; ++a) {
-    const Agent& g = agents[a];
-    const Clip& clip = g.running ? kRun : kWalk;
-    for (int k = 0; k < 8; ++k) {
-      float x, z;
-      circle(g, (static_cast<float>(k) + 1.0f) * 2.0f * kPi * g.radius / std::abs(g.speed) / 8.0f, 0.0f, x, z);
-      r.goals[a].push_back({x, z});
-    }
-    int32_t offset = static_cast<int32_t>(unit(rng) * static_cast<float>(clip.length));
-    std::size_t next_sample = 0;
-    const float sway_phase = 2.0f * kPi * unit(rng);
-    for (std::size_t tick = 0; tick < ticks && next_sample < r.sample_count; ++tick) {
-      const float t = static_cast<float>(tick) * dt;
-      const int32_t frame = clip.first + offset;
-      if (static_cast<int>(tick + a) % search_ticks == 0) {  // staggered searches
-        SearchEvent event;
-        event.time_s = t;
-        event.from_frame = frame;
-        event.jumped = unit(rng) < params.search_interval_s;  // about one jump a second
-        event.forced = event.jumped && unit(rng) < 0.1f;
-        const int32_t jump_to = static_cast<int32_t>(unit(rng) * static_cast<float>(clip.length - 1));
-        event.to_frame = event.jumped ? clip.first + jump_to : frame;
-        event.cost = event.jumped ? 0.4f + 1.5f * unit(rng) : 1.5f + 2.0f * unit(rng);
-        r.searches[a].push_back(event);
-        if (event.jumped) offset = jump_to;
-      }
-      if (static_cast<float>(next_sample) / params.sample_rate_hz <= t + 0.5f * dt) {
-        const std::size_t i = r.sample_index(next_sample, a);
-        const float sway = 0.15f * std::sin(1.3f * t + sway_phase);
-        circle(g, t, sway, r.root_x[i], r.root_z[i]);
-        float ax, az;
-        circle(g, t + 0.05f, sway, ax, az);
-        r.facing[i] = std::atan2(ax - r.root_x[i], az - r.root_z[i]);
-        r.frame[i] = clip.first + offset;
-        for (std::size_t p = 0; p < points; ++p) {
-          const std::size_t j = r.trajectory_index(next_sample, a, p);
-          const float ahead = r.trajectory_times_s[p];
-          circle(g, t + ahead, 0.0f, r.desired_x[j], r.desired_z[j]);
-          circle(g, t + ahead * 0.93f, sway * 0.5f, r.matched_x[j], r.matched_z[j]);
-        }
-        ++next_sample;
-      }
-      offset = (offset + 1) % clip.length;
-    }
-  }
+  for (std::size_t a = 0; a < n; ++a) simulate_agent(r, params, agents[a], a, rng);
   add_feet(r);
   return r;
 }

@@ -227,93 +227,83 @@ Result<std::vector<uint8_t>> deflate_bytes(const std::vector<uint8_t>& raw) {
   return out;
 }
 
-}  // namespace
-
-Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
-  ViewerPayload payload;
-  nlohmann::json sections = nlohmann::json::array();
-  std::vector<uint8_t>& raw = payload.raw;
-  const PoseSlots slots = assign_pose_slots(r);
-  const bool has_matched = !r.matched_x.empty();
-
-  add_section(sections, raw, "roots", [&](VarintWriter& out) {
-    for (std::size_t a = 0; a < r.agent_count; ++a) {
-      int64_t px = 0, pz = 0;
-      for (std::size_t s = 0; s < r.sample_count; ++s) {
-        const int64_t x = quantize(r.root_x[r.sample_index(s, a)], kCm);
-        const int64_t z = quantize(r.root_z[r.sample_index(s, a)], kCm);
-        out.z(x - px);
-        out.z(z - pz);
-        px = x, pz = z;
-      }
+// The sections of the payload, each a stream of varints (the page decodes
+// them in viewer.js): deltas per agent over its samples.
+void write_roots(VarintWriter& out, const Recording& r) {
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    int64_t px = 0, pz = 0;
+    for (std::size_t s = 0; s < r.sample_count; ++s) {
+      const int64_t x = quantize(r.root_x[r.sample_index(s, a)], kCm);
+      const int64_t z = quantize(r.root_z[r.sample_index(s, a)], kCm);
+      out.z(x - px);
+      out.z(z - pz);
+      px = x, pz = z;
     }
-  });
-  add_section(sections, raw, "facings", [&](VarintWriter& out) {
-    for (std::size_t a = 0; a < r.agent_count; ++a) {
-      int64_t previous = 0;
-      for (std::size_t s = 0; s < r.sample_count; ++s) {
-        const int64_t q = facing_steps(r.facing[r.sample_index(s, a)]);
-        int64_t delta = q - previous;
-        if (delta >= kTurn / 2) delta -= kTurn;
-        if (delta < -kTurn / 2) delta += kTurn;
-        out.z(delta);
-        previous = q;
-      }
-    }
-  });
-  add_section(sections, raw, "frames", [&](VarintWriter& out) {
-    for (std::size_t a = 0; a < r.agent_count; ++a) {
-      int64_t previous = 0;
-      for (std::size_t s = 0; s < r.sample_count; ++s) {
-        const int64_t value = slots.sample_slot[r.sample_index(s, a)] + 1;
-        out.z(value - previous);
-        previous = value;
-      }
-    }
-  });
-  add_section(sections, raw, "desired",
-              [&](VarintWriter& out) { write_trajectory(out, r, r.desired_x, r.desired_z); });
-  if (has_matched) {
-    add_section(sections, raw, "matched",
-                [&](VarintWriter& out) { write_trajectory(out, r, r.matched_x, r.matched_z); });
   }
-  add_section(sections, raw, "goals", [&](VarintWriter& out) {
-    for (const auto& goals : r.goals) {
-      out.u(goals.size());
-      int64_t px = 0, pz = 0;
-      for (const auto& goal : goals) {
-        const int64_t x = quantize(goal.x, kCm), z = quantize(goal.z, kCm);
-        out.z(x - px);
-        out.z(z - pz);
-        px = x, pz = z;
-      }
-    }
-  });
-  add_section(sections, raw, "searches", [&](VarintWriter& out) { write_searches(out, r); });
-  add_section(sections, raw, "pose_frames", [&](VarintWriter& out) {
+}
+
+void write_facings(VarintWriter& out, const Recording& r) {
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
     int64_t previous = 0;
-    for (std::size_t p : slots.poses) {
-      out.z(int64_t{r.pose_frames[p]} - previous);
-      previous = r.pose_frames[p];
+    for (std::size_t s = 0; s < r.sample_count; ++s) {
+      const int64_t q = facing_steps(r.facing[r.sample_index(s, a)]);
+      int64_t delta = q - previous;
+      if (delta >= kTurn / 2) delta -= kTurn;
+      if (delta < -kTurn / 2) delta += kTurn;
+      out.z(delta);
+      previous = q;
     }
-  });
-  add_section(sections, raw, "poses", [&](VarintWriter& out) {
-    std::vector<int64_t> previous(r.joint_count() * 3, 0);
-    for (std::size_t p : slots.poses) {
-      for (std::size_t c = 0; c < previous.size(); ++c) {
-        const int64_t mm = quantize(r.pose_positions[r.pose_index(p, 0) + c], kMm);
-        out.z(mm - previous[c]);
-        previous[c] = mm;
-      }
+  }
+}
+
+void write_frames(VarintWriter& out, const Recording& r, const PoseSlots& slots) {
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    int64_t previous = 0;
+    for (std::size_t s = 0; s < r.sample_count; ++s) {
+      const int64_t value = slots.sample_slot[r.sample_index(s, a)] + 1;
+      out.z(value - previous);
+      previous = value;
     }
-  });
+  }
+}
 
-  if (!r.leg_joints.empty()) add_section(sections, raw, "legs", [&](VarintWriter& out) { write_legs(out, r, slots); });
-  const bool has_feet = !r.foot_events.empty();
-  if (has_feet) add_section(sections, raw, "feet", [&](VarintWriter& out) { write_feet(out, r); });
+void write_goals(VarintWriter& out, const Recording& r) {
+  for (const auto& goals : r.goals) {
+    out.u(goals.size());
+    int64_t px = 0, pz = 0;
+    for (const auto& goal : goals) {
+      const int64_t x = quantize(goal.x, kCm), z = quantize(goal.z, kCm);
+      out.z(x - px);
+      out.z(z - pz);
+      px = x, pz = z;
+    }
+  }
+}
 
-  MMVK_ASSIGN_OR_RETURN(payload.compressed, deflate_bytes(raw));
+void write_pose_frames(VarintWriter& out, const Recording& r, const PoseSlots& slots) {
+  int64_t previous = 0;
+  for (std::size_t p : slots.poses) {
+    out.z(int64_t{r.pose_frames[p]} - previous);
+    previous = r.pose_frames[p];
+  }
+}
 
+void write_poses(VarintWriter& out, const Recording& r, const PoseSlots& slots) {
+  std::vector<int64_t> previous(r.joint_count() * 3, 0);
+  for (std::size_t p : slots.poses) {
+    for (std::size_t c = 0; c < previous.size(); ++c) {
+      const int64_t mm = quantize(r.pose_positions[r.pose_index(p, 0) + c], kMm);
+      out.z(mm - previous[c]);
+      previous[c] = mm;
+    }
+  }
+}
+
+// The payload's metadata as JSON for a <script> block: '<' only occurs
+// inside JSON strings, where \u003c means the same; this keeps a title such
+// as "</script>" from ending the page's script block.
+std::string meta_json(const Recording& r, const PoseSlots& slots, const nlohmann::json& sections,
+                      std::size_t raw_bytes) {
   const nlohmann::json meta = {
       {"format", 1},
       {"title", r.title},
@@ -321,18 +311,16 @@ Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
       {"agent_count", r.agent_count},
       {"sample_count", r.sample_count},
       {"trajectory_times_s", r.trajectory_times_s},
-      {"has_matched", has_matched},
+      {"has_matched", !r.matched_x.empty()},
       {"joint_names", r.joint_names},
       {"joint_parents", r.joint_parents},
       {"pose_count", slots.poses.size()},
       {"leg_joints", r.leg_joints},
-      {"has_feet", has_feet},
+      {"has_feet", !r.foot_events.empty()},
       {"bounds", bounds_of(r)},
       {"sections", sections},
-      {"raw_bytes", raw.size()},
+      {"raw_bytes", raw_bytes},
   };
-  // '<' only occurs inside JSON strings, where \u003c means the same; this
-  // keeps a title such as "</script>" from ending the page's script block.
   std::string json = meta.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   std::string escaped;
   escaped.reserve(json.size());
@@ -343,7 +331,35 @@ Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
       escaped += c;
     }
   }
-  payload.meta_json = std::move(escaped);
+  return escaped;
+}
+
+}  // namespace
+
+Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
+  ViewerPayload payload;
+  nlohmann::json sections = nlohmann::json::array();
+  std::vector<uint8_t>& raw = payload.raw;
+  const PoseSlots slots = assign_pose_slots(r);
+
+  add_section(sections, raw, "roots", [&](VarintWriter& out) { write_roots(out, r); });
+  add_section(sections, raw, "facings", [&](VarintWriter& out) { write_facings(out, r); });
+  add_section(sections, raw, "frames", [&](VarintWriter& out) { write_frames(out, r, slots); });
+  add_section(sections, raw, "desired",
+              [&](VarintWriter& out) { write_trajectory(out, r, r.desired_x, r.desired_z); });
+  if (!r.matched_x.empty()) {
+    add_section(sections, raw, "matched",
+                [&](VarintWriter& out) { write_trajectory(out, r, r.matched_x, r.matched_z); });
+  }
+  add_section(sections, raw, "goals", [&](VarintWriter& out) { write_goals(out, r); });
+  add_section(sections, raw, "searches", [&](VarintWriter& out) { write_searches(out, r); });
+  add_section(sections, raw, "pose_frames", [&](VarintWriter& out) { write_pose_frames(out, r, slots); });
+  add_section(sections, raw, "poses", [&](VarintWriter& out) { write_poses(out, r, slots); });
+  if (!r.leg_joints.empty()) add_section(sections, raw, "legs", [&](VarintWriter& out) { write_legs(out, r, slots); });
+  if (!r.foot_events.empty()) add_section(sections, raw, "feet", [&](VarintWriter& out) { write_feet(out, r); });
+
+  MMVK_ASSIGN_OR_RETURN(payload.compressed, deflate_bytes(raw));
+  payload.meta_json = meta_json(r, slots, sections, raw.size());
   return payload;
 }
 

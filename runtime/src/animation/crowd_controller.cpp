@@ -38,12 +38,9 @@ void for_characters(ThreadPool& pool, std::size_t count, const Body& body) {
   }
 }
 
-}  // namespace
-
-Result<CrowdController> CrowdController::create(const Database& database, std::uint32_t characters,
-                                                const ControllerParams& params) {
-  const AnimationData* animation = database.animation();
-  if (animation == nullptr) return missing_animation_error("crowd controller");
+// The checks of CrowdController::create on its arguments, before anything is built.
+Status check_controller_params(const Database& database, std::uint32_t characters, const ControllerParams& params) {
+  if (database.animation() == nullptr) return missing_animation_error("crowd controller");
   if (characters == 0) return make_error("crowd controller: characters must be at least 1");
   // A tick searches every due character in one call (search.hpp's kMaxBatch).
   if (characters > kMaxBatch) {
@@ -78,6 +75,15 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   if (!std::isfinite(params.same_location_window) || params.same_location_window < 0.0f) {
     return make_error("crowd controller: same_location_window must be finite and >= 0 (seconds)");
   }
+  return {};
+}
+
+}  // namespace
+
+Result<CrowdController> CrowdController::create(const Database& database, std::uint32_t characters,
+                                                const ControllerParams& params) {
+  MMVK_TRY(check_controller_params(database, characters, params));
+  const AnimationData* animation = database.animation();
   Result<QueryAssembler> assembler = QueryAssembler::create(database);
   if (!assembler.ok()) return make_error("crowd controller: " + assembler.message());
   Result<FootLocker> locker = FootLocker::create(*animation, characters, params.foot_ik);

@@ -236,135 +236,178 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
   }
 
   // Per foot: the lock's state machine, then its ankle target and rotation.
-  struct Target {
-    glm::vec3 ankle;
-    glm::quat rotation;
-    bool solve;
-  };
-  Target targets[2];
+  FootTarget targets[2];
   float wanted_drop = 0.0f;
   for (std::size_t side = 0; side < 2; ++side) {
-    const Leg& leg = legs_[side];
     const std::size_t f = std::size_t{b} * 2 + side;
-    const glm::vec3 ankle = world[leg.foot];
-    const glm::vec3 toe = leg.toe >= 0 ? world[leg.toe] : ankle;
-    const bool planted = (contacts & kPlantedBit[side]) != 0;
-    const bool toe_touches = (contacts & kToeBit[side]) != 0;
-    const bool heel_touches = (contacts & kHeelBit[side]) != 0;
-    // Data without point bits (older files) counts as planted on the toe.
-    const std::uint8_t point = leg.toe >= 0 && (toe_touches || !heel_touches) ? kToe : kHeel;
-    // The foot's heading, only where a lock reads it.
-    float yaw = 0.0f;
-    const bool has_yaw = params_.lock_yaw && (planted || locked_[f] != 0) &&
-                         heading_yaw(global[leg.foot] * heading_[side], yaw);
+    const FootView foot = view_foot(f, side, contacts, world, global);
+    update_lock(f, foot, dt);
+    targets[side] = foot_target(f, side, foot, root_position, global);
+    if (targets[side].solve) wanted_drop = std::max(wanted_drop, wanted_hip_drop(side, targets[side], world));
+  }
+  const float drop = lower_hips(b, dt, wanted_drop, root, global, translations, world);
 
-    glm::vec3& offset = offset_[f];
-    glm::vec3& offset_rate = offset_rate_[f];
-    float& yaw_offset = yaw_offset_[f];
-    float& yaw_rate = yaw_rate_[f];
-    auto at = [&](std::uint8_t contact_point) { return contact_point == kToe ? toe : ankle; };
-    // A new contact point keeps the displayed foot where it is: the offset
-    // takes up the turn of the new point about the old one.
-    auto move_point = [&](std::uint8_t to) {
-      if (to == point_[f]) return false;
-      const glm::vec3 step = at(to) - at(point_[f]);
-      offset += horizontal(yaw_rotation(yaw_offset) * step - step);
-      point_[f] = to;
-      return true;
-    };
+  // Two-bone IK on each leg that has a correction (both when the hips are
+  // lowered: the other foot must stay where it was animated).
+  for (std::size_t side = 0; side < 2; ++side) {
+    const std::size_t f = std::size_t{b} * 2 + side;
+    clamped_[f] = 0;
+    if (!targets[side].solve && drop <= 0.0f) continue;
+    solve_leg(f, side, targets[side], root, global, rotations, translations, world);
+  }
+}
 
-    if (!planted) drifted_[f] = 0;
-    if (locked_[f] != 0) {
-      if (!planted) {
-        locked_[f] = 0;
-      } else {
-        // Heel to toe (or back): the anchor moves to the new point as shown.
-        if (move_point(point)) anchor_[f] = at(point_[f]) + offset;
-        if (!has_yaw) {
-          anchor_yaw_[f] = kNoYaw;
-        } else if (std::isnan(anchor_yaw_[f])) {
-          anchor_yaw_[f] = yaw + yaw_offset;
-        }
-        const glm::vec3 next = horizontal(anchor_[f] - at(point_[f]));
-        float next_yaw = has_yaw ? wrap_angle(anchor_yaw_[f] - yaw) : yaw_offset;
-        if (std::abs(next_yaw) > params_.max_yaw_correction) {
-          // The animated foot turned further than the lock holds: it pivots
-          // about its contact point from here, the position still held.
-          next_yaw = std::clamp(next_yaw, -params_.max_yaw_correction, params_.max_yaw_correction);
-          anchor_yaw_[f] = yaw + next_yaw;
-        }
-        if (glm::length(next) > params_.unlock_distance) {
-          locked_[f] = 0;
-          drifted_[f] = 1;
-        } else {
-          if (dt > 0.0f) {
-            offset_rate = (next - offset) / dt;
-            yaw_rate = wrap_angle(next_yaw - yaw_offset) / dt;
-          }
-          offset = next;
-          yaw_offset = next_yaw;
-        }
-      }
-    }
-    if (locked_[f] == 0) {
-      if (planted && drifted_[f] == 0) {
-        // Lock where the foot is shown now: the offset carries on, so does
-        // the display.
-        move_point(point);
-        locked_[f] = 1;
-        anchor_[f] = at(point_[f]) + offset;
-        anchor_yaw_[f] = has_yaw ? yaw + yaw_offset : kNoYaw;
-      } else if (dt > 0.0f) {
-        spring_decay(offset, offset_rate, params_.release_half_life, dt);
-        spring_decay(yaw_offset, yaw_rate, params_.release_half_life, dt);
-        if (glm::length(offset) < kSettled && glm::length(offset_rate) < kSettledRate) {
-          offset = offset_rate = glm::vec3(0.0f);
-        }
-        if (std::abs(yaw_offset) < kSettled && std::abs(yaw_rate) < kSettledRate) yaw_offset = yaw_rate = 0.0f;
-      }
-    }
+FootLocker::FootView FootLocker::view_foot(std::size_t f, std::size_t side, std::uint8_t contacts,
+                                           const glm::vec3* world, const glm::quat* global) const {
+  const Leg& leg = legs_[side];
+  FootView foot;
+  foot.ankle = world[leg.foot];
+  foot.toe = leg.toe >= 0 ? world[leg.toe] : foot.ankle;
+  foot.planted = (contacts & kPlantedBit[side]) != 0;
+  const bool toe_touches = (contacts & kToeBit[side]) != 0;
+  const bool heel_touches = (contacts & kHeelBit[side]) != 0;
+  // Data without point bits (older files) counts as planted on the toe.
+  foot.point = leg.toe >= 0 && (toe_touches || !heel_touches) ? kToe : kHeel;
+  // The foot's heading, only where a lock reads it.
+  foot.has_yaw = params_.lock_yaw && (foot.planted || locked_[f] != 0) &&
+                 heading_yaw(global[leg.foot] * heading_[side], foot.yaw);
+  return foot;
+}
 
-    // The ankle's target: the animated foot turned by the yaw offset about
-    // its contact point and moved by the offset, at its animated height.
-    Target& target = targets[side];
-    target.ankle = ankle;
-    target.rotation = global[leg.foot];
-    target.solve = false;
-    if (offset != glm::vec3(0.0f) || yaw_offset != 0.0f) {
-      const glm::vec3 contact = at(point_[f]);
-      const glm::quat turn = yaw_rotation(yaw_offset);
-      target.ankle = contact + offset + turn * (ankle - contact);
-      target.rotation = turn * global[leg.foot];
-      target.solve = true;
-    }
-    if (params_.clamp_to_floor) {
-      // The turn is about +Y, so the toe stays at its animated height above the ankle.
-      const float floor = root_position.y + params_.floor_height;
-      const float lowest = std::min(target.ankle.y, target.ankle.y + (toe.y - ankle.y));
-      if (lowest < floor) {
-        target.ankle.y += floor - lowest;
-        target.solve = true;
-      }
-    }
+namespace {
 
-    // The least drop of the hips that brings the target within the leg's
-    // comfortable reach (the solver's soft start): |target - (hip - drop * up)|
-    // = reach, the smaller root; the drop to the target's height when the
-    // target is horizontally further than the reach. An animated target
-    // needs none: the animated extension is within reach by definition.
-    if (!target.solve) continue;
-    const glm::vec3 hip = world[leg.upper];
-    const float length = glm::length(world[leg.lower] - hip) + glm::length(ankle - world[leg.lower]);
-    const float reach = std::min(length, std::max(params_.soft_reach_start * length, glm::length(ankle - hip)));
-    const glm::vec3 to_target = target.ankle - hip;
-    const float across2 = to_target.x * to_target.x + to_target.z * to_target.z;
-    if (across2 + to_target.y * to_target.y > reach * reach) {
-      const float drop = across2 < reach * reach ? -to_target.y - std::sqrt(reach * reach - across2) : -to_target.y;
-      wanted_drop = std::max(wanted_drop, drop);
+glm::vec3 contact_at(const glm::vec3& ankle, const glm::vec3& toe, std::uint8_t contact_point) {
+  return contact_point == kToe ? toe : ankle;
+}
+
+}  // namespace
+
+// A new contact point keeps the displayed foot where it is: the offset takes
+// up the turn of the new point about the old one.
+bool FootLocker::move_point(std::size_t f, const FootView& foot, std::uint8_t to) {
+  if (to == point_[f]) return false;
+  const glm::vec3 step = contact_at(foot.ankle, foot.toe, to) - contact_at(foot.ankle, foot.toe, point_[f]);
+  offset_[f] += horizontal(yaw_rotation(yaw_offset_[f]) * step - step);
+  point_[f] = to;
+  return true;
+}
+
+// A locked, planted foot: the offsets that hold its contact point on the
+// anchor, or the release when the animation walked it too far away.
+void FootLocker::hold_lock(std::size_t f, const FootView& foot, float dt) {
+  glm::vec3& offset = offset_[f];
+  float& yaw_offset = yaw_offset_[f];
+  // Heel to toe (or back): the anchor moves to the new point as shown.
+  if (move_point(f, foot, foot.point)) anchor_[f] = contact_at(foot.ankle, foot.toe, point_[f]) + offset;
+  if (!foot.has_yaw) {
+    anchor_yaw_[f] = kNoYaw;
+  } else if (std::isnan(anchor_yaw_[f])) {
+    anchor_yaw_[f] = foot.yaw + yaw_offset;
+  }
+  const glm::vec3 next = horizontal(anchor_[f] - contact_at(foot.ankle, foot.toe, point_[f]));
+  float next_yaw = foot.has_yaw ? wrap_angle(anchor_yaw_[f] - foot.yaw) : yaw_offset;
+  if (std::abs(next_yaw) > params_.max_yaw_correction) {
+    // The animated foot turned further than the lock holds: it pivots
+    // about its contact point from here, the position still held.
+    next_yaw = std::clamp(next_yaw, -params_.max_yaw_correction, params_.max_yaw_correction);
+    anchor_yaw_[f] = foot.yaw + next_yaw;
+  }
+  if (glm::length(next) > params_.unlock_distance) {
+    locked_[f] = 0;
+    drifted_[f] = 1;
+  } else {
+    if (dt > 0.0f) {
+      offset_rate_[f] = (next - offset) / dt;
+      yaw_rate_[f] = wrap_angle(next_yaw - yaw_offset) / dt;
+    }
+    offset = next;
+    yaw_offset = next_yaw;
+  }
+}
+
+// The lock's state machine: held while planted, taken where the foot is
+// shown when it plants, and its offsets decaying after release.
+void FootLocker::update_lock(std::size_t f, const FootView& foot, float dt) {
+  if (!foot.planted) drifted_[f] = 0;
+  if (locked_[f] != 0) {
+    if (!foot.planted) {
+      locked_[f] = 0;
+    } else {
+      hold_lock(f, foot, dt);
     }
   }
+  if (locked_[f] != 0) return;
+  glm::vec3& offset = offset_[f];
+  glm::vec3& offset_rate = offset_rate_[f];
+  float& yaw_offset = yaw_offset_[f];
+  float& yaw_rate = yaw_rate_[f];
+  if (foot.planted && drifted_[f] == 0) {
+    // Lock where the foot is shown now: the offset carries on, so does the
+    // display.
+    move_point(f, foot, foot.point);
+    locked_[f] = 1;
+    anchor_[f] = contact_at(foot.ankle, foot.toe, point_[f]) + offset;
+    anchor_yaw_[f] = foot.has_yaw ? foot.yaw + yaw_offset : kNoYaw;
+  } else if (dt > 0.0f) {
+    spring_decay(offset, offset_rate, params_.release_half_life, dt);
+    spring_decay(yaw_offset, yaw_rate, params_.release_half_life, dt);
+    if (glm::length(offset) < kSettled && glm::length(offset_rate) < kSettledRate) {
+      offset = offset_rate = glm::vec3(0.0f);
+    }
+    if (std::abs(yaw_offset) < kSettled && std::abs(yaw_rate) < kSettledRate) yaw_offset = yaw_rate = 0.0f;
+  }
+}
 
-  // The hips follow the wanted drop with a critically damped spring.
+// The ankle's target: the animated foot turned by the yaw offset about its
+// contact point and moved by the offset, at its animated height (raised to
+// the floor when clamped).
+FootLocker::FootTarget FootLocker::foot_target(std::size_t f, std::size_t side, const FootView& foot,
+                                               const glm::vec3& root_position, const glm::quat* global) const {
+  const Leg& leg = legs_[side];
+  FootTarget target;
+  target.ankle = foot.ankle;
+  target.rotation = global[leg.foot];
+  target.solve = false;
+  if (offset_[f] != glm::vec3(0.0f) || yaw_offset_[f] != 0.0f) {
+    const glm::vec3 contact = contact_at(foot.ankle, foot.toe, point_[f]);
+    const glm::quat turn = yaw_rotation(yaw_offset_[f]);
+    target.ankle = contact + offset_[f] + turn * (foot.ankle - contact);
+    target.rotation = turn * global[leg.foot];
+    target.solve = true;
+  }
+  if (params_.clamp_to_floor) {
+    // The turn is about +Y, so the toe stays at its animated height above the ankle.
+    const float floor = root_position.y + params_.floor_height;
+    const float lowest = std::min(target.ankle.y, target.ankle.y + (foot.toe.y - foot.ankle.y));
+    if (lowest < floor) {
+      target.ankle.y += floor - lowest;
+      target.solve = true;
+    }
+  }
+  return target;
+}
+
+// The least drop of the hips that brings a solved target within the leg's
+// comfortable reach (the solver's soft start): |target - (hip - drop * up)|
+// = reach, the smaller root; the drop to the target's height when the target
+// is horizontally further than the reach; 0 within reach. An animated target
+// needs none: the animated extension is within reach by definition.
+float FootLocker::wanted_hip_drop(std::size_t side, const FootTarget& target, const glm::vec3* world) const {
+  const Leg& leg = legs_[side];
+  const glm::vec3 ankle = world[leg.foot];
+  const glm::vec3 hip = world[leg.upper];
+  const float length = glm::length(world[leg.lower] - hip) + glm::length(ankle - world[leg.lower]);
+  const float reach = std::min(length, std::max(params_.soft_reach_start * length, glm::length(ankle - hip)));
+  const glm::vec3 to_target = target.ankle - hip;
+  const float across2 = to_target.x * to_target.x + to_target.z * to_target.z;
+  if (across2 + to_target.y * to_target.y <= reach * reach) return 0.0f;
+  return across2 < reach * reach ? -to_target.y - std::sqrt(reach * reach - across2) : -to_target.y;
+}
+
+// The hips follow the wanted drop with a critically damped spring; returns
+// the drop applied (metres, >= 0).
+float FootLocker::lower_hips(std::uint32_t b, float dt, float wanted_drop, const glm::quat& root,
+                             const glm::quat* global, glm::vec3* translations, glm::vec3* world) {
   float& drop = hip_drop_[b];
   float& drop_rate = hip_drop_rate_[b];
   const float goal = std::min(wanted_drop, params_.max_hip_drop);
@@ -388,43 +431,39 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
     const int parent = parents_[static_cast<std::size_t>(hips_)];
     const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
     translations[static_cast<std::size_t>(hips_)] -= glm::inverse(above) * (kUp * drop);
-    for (std::size_t j = 0; j < joints; ++j) {
+    for (std::size_t j = 0; j < parents_.size(); ++j) {
       if (below_hips_[j] != 0) world[j].y -= drop;
     }
   }
+  return drop;
+}
 
-  // Two-bone IK on each leg that has a correction (both when the hips are
-  // lowered: the other foot must stay where it was animated), then the leg's
-  // joints again from the upper leg down.
+// Two-bone IK on one leg, then the leg's joints again from the upper leg down.
+void FootLocker::solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::quat& root,
+                           glm::quat* global, glm::quat* rotations, const glm::vec3* translations, glm::vec3* world) {
+  const Leg& leg = legs_[side];
   const glm::vec3 forward = root * glm::vec3(0.0f, 0.0f, 1.0f);
-  for (std::size_t side = 0; side < 2; ++side) {
-    const std::size_t f = std::size_t{b} * 2 + side;
-    clamped_[f] = 0;
-    const Target& target = targets[side];
-    if (!target.solve && drop <= 0.0f) continue;
-    const Leg& leg = legs_[side];
-    const TwoBoneIkSolution solution = solve_two_bone_ik(world[leg.upper], world[leg.lower], world[leg.foot],
-                                                         target.ankle, forward, params_.soft_reach_start);
-    clamped_[f] = solution.clamped ? 1 : 0;
-    for (const int joint : leg_joints_[side]) {
-      const std::size_t j = static_cast<std::size_t>(joint);
-      const int parent = parents_[j];
-      const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
-      if (joint == leg.upper) {
-        global[j] = solution.upper * global[j];
+  const TwoBoneIkSolution solution = solve_two_bone_ik(world[leg.upper], world[leg.lower], world[leg.foot],
+                                                       target.ankle, forward, params_.soft_reach_start);
+  clamped_[f] = solution.clamped ? 1 : 0;
+  for (const int joint : leg_joints_[side]) {
+    const std::size_t j = static_cast<std::size_t>(joint);
+    const int parent = parents_[j];
+    const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
+    if (joint == leg.upper) {
+      global[j] = solution.upper * global[j];
+    } else {
+      world[j] = world[static_cast<std::size_t>(parent)] + above * translations[j];
+      if (joint == leg.lower) {
+        global[j] = solution.lower * (above * rotations[j]);
+      } else if (joint == leg.foot) {
+        global[j] = target.rotation;
       } else {
-        world[j] = world[static_cast<std::size_t>(parent)] + above * translations[j];
-        if (joint == leg.lower) {
-          global[j] = solution.lower * (above * rotations[j]);
-        } else if (joint == leg.foot) {
-          global[j] = target.rotation;
-        } else {
-          global[j] = above * rotations[j];
-          continue;
-        }
+        global[j] = above * rotations[j];
+        continue;
       }
-      rotations[j] = glm::normalize(glm::inverse(above) * global[j]);
     }
+    rotations[j] = glm::normalize(glm::inverse(above) * global[j]);
   }
 }
 

@@ -98,13 +98,14 @@ ClusterTable build_cluster_table(const Database& database, std::vector<float> ce
 namespace mmvk {
 
 namespace {
+
 std::string size_error(const char* field, std::size_t got, std::size_t expected) {
   return std::string("cluster table: ") + field + " has " + std::to_string(got) + " entries, expected " +
          std::to_string(expected);
 }
-}  // namespace
 
-Status validate_cluster_table(const ClusterTable& t, const Database& database) {
+// The table's identity and the sizes of its arrays against the database.
+Status check_shape(const ClusterTable& t, const Database& database) {
   const std::uint32_t frames = database.frame_count();
   const std::uint32_t dims = database.dims();
   const FeatureSchema& schema = database.schema();
@@ -142,7 +143,49 @@ Status validate_cluster_table(const ClusterTable& t, const Database& database) {
   }
   const std::size_t kc = std::size_t{k} * t.channel_count;
   if (t.channel_radius.size() != kc) return make_error(size_error("channel_radius", t.channel_radius.size(), kc));
-  for (std::size_t i = 0; i < kd; ++i) {
+  return {};
+}
+
+// Member frame f of cluster c lies inside the cluster's box and channel
+// radii, and within its bounds on modifiers, tags and flags.
+Status check_member(const ClusterTable& t, const Database& database, std::uint32_t c, std::uint32_t f,
+                    const std::string& member) {
+  const std::uint32_t dims = database.dims();
+  const FeatureSchema& schema = database.schema();
+  const float* lo = t.box_min.data() + std::size_t{c} * dims;
+  const float* hi = t.box_max.data() + std::size_t{c} * dims;
+  const float* centroid = t.centroids.data() + std::size_t{c} * dims;
+  const float* radius = t.channel_radius.data() + std::size_t{c} * t.channel_count;
+  const float* row = database.row(f).data();
+  for (std::uint32_t d = 0; d < dims; ++d) {
+    if (row[d] < lo[d] || row[d] > hi[d]) return make_error(member + " lies outside the box in " + schema.dim_name(d));
+  }
+  std::uint32_t begin = 0;
+  for (std::uint32_t ch = 0; ch < t.channel_count; ++ch) {
+    const std::uint32_t end = begin + schema.channels[ch].dims();
+    if (!(detail::channel_distance_up(row, centroid, begin, end) <= radius[ch])) {
+      return make_error(member + " lies outside the radius of channel '" + schema.channels[ch].name + "'");
+    }
+    begin = end;
+  }
+  if (!(database.frame_multiplier()[f] >= t.min_multiplier[c])) return make_error(member + " has a multiplier below min_multiplier");
+  if (!(database.frame_bias()[f] >= t.min_bias[c])) return make_error(member + " has a bias below min_bias");
+  if ((database.frame_tags()[f] & ~t.tag_union[c]) != 0) return make_error(member + " has tags outside tag_union");
+  if ((t.tag_intersection[c] & ~database.frame_tags()[f]) != 0) return make_error(member + " lacks a tag of tag_intersection");
+  if ((t.flags_intersection[c] & ~database.frame_flags()[f]) != 0) {
+    return make_error(member + " lacks a flag of flags_intersection");
+  }
+  return {};
+}
+
+}  // namespace
+
+Status validate_cluster_table(const ClusterTable& t, const Database& database) {
+  MMVK_TRY(check_shape(t, database));
+  const std::uint32_t frames = database.frame_count();
+  const std::uint32_t dims = database.dims();
+  const std::uint32_t k = t.cluster_count;
+  for (std::size_t i = 0; i < std::size_t{k} * dims; ++i) {
     if (!std::isfinite(t.centroids[i]) || !std::isfinite(t.box_min[i]) || !std::isfinite(t.box_max[i])) {
       return make_error("cluster table: cluster " + std::to_string(i / dims) + " has a non-finite centroid or box");
     }
@@ -150,40 +193,18 @@ Status validate_cluster_table(const ClusterTable& t, const Database& database) {
   if (t.offsets[0] != 0 || t.offsets[k] != frames) {
     return make_error("cluster table: offsets must run from 0 to the frame count " + std::to_string(frames));
   }
+  // Every frame in exactly one cluster, each cluster's members ascending.
   std::vector<bool> seen(frames, false);
   for (std::uint32_t c = 0; c < k; ++c) {
     const std::string where = "cluster table: cluster " + std::to_string(c);
     if (t.offsets[c] > t.offsets[c + 1]) return make_error(where + ": offsets decrease");
-    const float* lo = t.box_min.data() + std::size_t{c} * dims;
-    const float* hi = t.box_max.data() + std::size_t{c} * dims;
-    const float* centroid = t.centroids.data() + std::size_t{c} * dims;
-    const float* radius = t.channel_radius.data() + std::size_t{c} * t.channel_count;
     for (std::uint32_t m = t.offsets[c]; m < t.offsets[c + 1]; ++m) {
       const std::uint32_t f = t.members[m];
       if (f >= frames) return make_error(where + ": member frame " + std::to_string(f) + " is out of range");
       if (seen[f]) return make_error(where + ": frame " + std::to_string(f) + " is in more than one cluster");
       seen[f] = true;
       if (m > t.offsets[c] && t.members[m - 1] >= f) return make_error(where + ": members are not in ascending order");
-      const std::string member = where + ": member frame " + std::to_string(f);
-      const float* row = database.row(f).data();
-      for (std::uint32_t d = 0; d < dims; ++d) {
-        if (row[d] < lo[d] || row[d] > hi[d]) return make_error(member + " lies outside the box in " + schema.dim_name(d));
-      }
-      std::uint32_t begin = 0;
-      for (std::uint32_t ch = 0; ch < t.channel_count; ++ch) {
-        const std::uint32_t end = begin + schema.channels[ch].dims();
-        if (!(detail::channel_distance_up(row, centroid, begin, end) <= radius[ch])) {
-          return make_error(member + " lies outside the radius of channel '" + schema.channels[ch].name + "'");
-        }
-        begin = end;
-      }
-      if (!(database.frame_multiplier()[f] >= t.min_multiplier[c])) return make_error(member + " has a multiplier below min_multiplier");
-      if (!(database.frame_bias()[f] >= t.min_bias[c])) return make_error(member + " has a bias below min_bias");
-      if ((database.frame_tags()[f] & ~t.tag_union[c]) != 0) return make_error(member + " has tags outside tag_union");
-      if ((t.tag_intersection[c] & ~database.frame_tags()[f]) != 0) return make_error(member + " lacks a tag of tag_intersection");
-      if ((t.flags_intersection[c] & ~database.frame_flags()[f]) != 0) {
-        return make_error(member + " lacks a flag of flags_intersection");
-      }
+      MMVK_TRY(check_member(t, database, c, f, where + ": member frame " + std::to_string(f)));
     }
   }
   return {};

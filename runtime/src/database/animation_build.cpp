@@ -24,6 +24,78 @@ bool near(const glm::vec3& a, const glm::vec3& b) {
          std::abs(a.z - b.z) <= kConstantTolerance;
 }
 
+// The joints the pose collapses: strict ancestors of the hips (static
+// scene roots such as Bandai's joint_Root). 1 marks one.
+std::vector<std::uint8_t> collapsed_joints(const Skeleton& skeleton, const std::string& hips_bone) {
+  std::vector<std::uint8_t> collapsed(skeleton.size(), 0);
+  if (Result<int> hips = find_bone(skeleton, hips_bone); hips.ok()) {
+    for (int p = skeleton.parents[static_cast<std::size_t>(*hips)]; p >= 0; p = skeleton.parents[static_cast<std::size_t>(p)]) {
+      collapsed[static_cast<std::size_t>(p)] = 1;
+    }
+  }
+  return collapsed;
+}
+
+// The pose is stored relative to the character root. Collapsed joints become
+// the identity at the character root, and every joint hanging directly off
+// them (or off nothing) stores its model-space transform re-expressed in
+// character space. So the hips carry a short translation (about 1 m up) and
+// no far-away scene origin acts as a lever arm when poses are blended.
+// Fills out's rotations and root, and `translations` [frames x joints].
+void to_character_space(const Motion& motion, const CharacterRoot& root, const std::string& hips_bone,
+                        std::span<const glm::vec3> positions, std::span<const glm::quat> globals, ClipAnimation& out,
+                        std::vector<glm::vec3>& translations) {
+  const std::size_t joints = motion.joint_count();
+  const std::vector<std::uint8_t> collapsed = collapsed_joints(motion.skeleton, hips_bone);
+  translations.resize(std::size_t{motion.frame_count} * joints);
+  const glm::vec3 up(0.0f, 1.0f, 0.0f);
+  for (std::uint32_t f = 0; f < motion.frame_count; ++f) {
+    const glm::vec3 facing = root.facings[f];
+    const float yaw = std::atan2(facing.x, facing.z);
+    const glm::quat to_character = glm::angleAxis(-yaw, up);
+    out.root_positions[f] = glm::vec3(root.positions[f].x, 0.0f, root.positions[f].z);
+    out.root_yaws[f] = yaw;
+    for (std::size_t j = 0; j < joints; ++j) {
+      const std::size_t i = motion.index(f, j);
+      const int parent = motion.skeleton.parents[j];
+      glm::quat q = motion.local_rotations[i];
+      glm::vec3 t = motion.local_positions[i];
+      if (collapsed[j]) {
+        q = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+        t = glm::vec3(0.0f);
+      } else if (parent < 0 || collapsed[static_cast<std::size_t>(parent)]) {
+        q = to_character * globals[i];
+        t = to_character * (positions[i] - out.root_positions[f]);
+      }
+      out.rotations[i] = glm::normalize(q);
+      translations[i] = t;
+    }
+  }
+}
+
+// Translations stored once per joint where they stay constant over the clip,
+// per frame for the varying joints only.
+void split_translations(const Motion& motion, std::span<const glm::vec3> translations, ClipAnimation& out) {
+  const std::size_t joints = motion.joint_count();
+  const std::uint32_t frames = motion.frame_count;
+  out.constant.resize(joints);
+  for (std::size_t j = 0; j < joints; ++j) {
+    out.constant[j] = frames > 0 ? translations[j] : motion.skeleton.rest_offsets[j];
+    for (std::uint32_t f = 1; f < frames; ++f) {
+      if (!near(translations[f * joints + j], out.constant[j])) {
+        out.varying.push_back(static_cast<std::uint32_t>(j));
+        break;
+      }
+    }
+  }
+  out.translations.resize(std::size_t{frames} * out.varying.size());
+  for (std::uint32_t f = 0; f < frames; ++f) {
+    for (std::size_t v = 0; v < out.varying.size(); ++v) {
+      out.translations[f * out.varying.size() + v] = translations[f * joints + out.varying[v]];
+    }
+  }
+}
+
 }  // namespace
 
 Result<ClipAnimation> extract_clip_animation(const Motion& motion, const CharacterRoot& root,
@@ -48,59 +120,9 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
   std::vector<glm::vec3> positions(std::size_t{frames} * joints);
   std::vector<glm::quat> globals(std::size_t{frames} * joints);
   forward_kinematics_clip(motion, positions, globals);
-
-  // The pose is stored relative to the character root. Strict ancestors of
-  // the hips (static scene roots such as Bandai's joint_Root) become the
-  // identity at the character root, and every joint hanging directly off
-  // them (or off nothing) stores its model-space transform re-expressed in
-  // character space. So the hips carry a short translation (about 1 m up)
-  // and no far-away scene origin acts as a lever arm when poses are blended.
-  std::vector<std::uint8_t> collapsed(joints, 0);
-  if (Result<int> hips = find_bone(motion.skeleton, hips_bone); hips.ok()) {
-    for (int p = motion.skeleton.parents[static_cast<std::size_t>(*hips)]; p >= 0; p = motion.skeleton.parents[static_cast<std::size_t>(p)]) {
-      collapsed[static_cast<std::size_t>(p)] = 1;
-    }
-  }
-  std::vector<glm::vec3> translations(std::size_t{frames} * joints);
-  const glm::vec3 up(0.0f, 1.0f, 0.0f);
-  for (std::uint32_t f = 0; f < frames; ++f) {
-    const glm::vec3 facing = root.facings[f];
-    const float yaw = std::atan2(facing.x, facing.z);
-    const glm::quat to_character = glm::angleAxis(-yaw, up);
-    out.root_positions[f] = glm::vec3(root.positions[f].x, 0.0f, root.positions[f].z);
-    out.root_yaws[f] = yaw;
-    for (std::size_t j = 0; j < joints; ++j) {
-      const std::size_t i = motion.index(f, j);
-      const int parent = motion.skeleton.parents[j];
-      glm::quat q = motion.local_rotations[i];
-      glm::vec3 t = motion.local_positions[i];
-      if (collapsed[j]) {
-        q = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-        t = glm::vec3(0.0f);
-      } else if (parent < 0 || collapsed[static_cast<std::size_t>(parent)]) {
-        q = to_character * globals[i];
-        t = to_character * (positions[i] - out.root_positions[f]);
-      }
-      out.rotations[i] = glm::normalize(q);
-      translations[i] = t;
-    }
-  }
-  out.constant.resize(joints);
-  for (std::size_t j = 0; j < joints; ++j) {
-    out.constant[j] = frames > 0 ? translations[j] : motion.skeleton.rest_offsets[j];
-    for (std::uint32_t f = 1; f < frames; ++f) {
-      if (!near(translations[f * joints + j], out.constant[j])) {
-        out.varying.push_back(static_cast<std::uint32_t>(j));
-        break;
-      }
-    }
-  }
-  out.translations.resize(std::size_t{frames} * out.varying.size());
-  for (std::uint32_t f = 0; f < frames; ++f) {
-    for (std::size_t v = 0; v < out.varying.size(); ++v) {
-      out.translations[f * out.varying.size() + v] = translations[f * joints + out.varying[v]];
-    }
-  }
+  std::vector<glm::vec3> translations;
+  to_character_space(motion, root, hips_bone, positions, globals, out, translations);
+  split_translations(motion, translations, out);
 
   ClipContacts contacts = detect_foot_contacts(motion.skeleton, positions, frames, motion.fps, params);
   // A side without a toe keeps its heel as its contact joint, so readers of

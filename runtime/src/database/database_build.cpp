@@ -197,6 +197,57 @@ void keep_frames(Motion& motion, std::vector<std::vector<float>>& custom, std::u
   motion.frame_count = count;
 }
 
+// The clips' poses as the database's animation; mixed skeletons are valid
+// for the features: the database is then built without poses and the
+// caller is told why.
+void add_animation(std::vector<ProcessedClip>& clips, const FootContactParams& contacts,
+                   const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
+                   const std::string& source, DatabaseParts& parts) {
+  if (!animation.enabled) return;
+  std::vector<detail::ClipAnimation> animations;
+  animations.reserve(clips.size());
+  for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
+  Result<AnimationData> data = detail::assemble_animation(animations, contacts, animation.encoding, mirror_bones);
+  if (data.ok()) {
+    parts.animation = std::move(*data);
+  } else if (animation.warning) {
+    animation.warning(source + ": " + data.message());
+  }
+}
+
+// A clip's per-frame tags and costs. They are stored only when some clip has
+// time ranges (`per_frame`); the first such clip fills them in for the clips
+// before it.
+Status add_frame_modifiers(const ProcessedClip& processed, const Clip& clip, const std::string& source,
+                           bool& per_frame, DatabaseParts& parts) {
+  const bool ranged = !processed.tag_ranges.empty() || !processed.multiplier.empty();
+  if (ranged && !per_frame) {
+    per_frame = true;
+    for (const Clip& before : parts.clips) {
+      parts.frame_tags.insert(parts.frame_tags.end(), before.frame_count, before.tags);
+      parts.frame_multiplier.insert(parts.frame_multiplier.end(), before.frame_count, before.cost_multiplier);
+      parts.frame_bias.insert(parts.frame_bias.end(), before.frame_count, before.cost_bias);
+    }
+  }
+  if (!per_frame) return {};
+  const std::size_t first = parts.frame_tags.size();
+  parts.frame_tags.insert(parts.frame_tags.end(), clip.frame_count, clip.tags);
+  for (const TagRange& range : processed.tag_ranges) {
+    MMVK_ASSIGN_OR_RETURN(const std::size_t index, tag_index(parts.tag_names, range.tag, source, clip.name));
+    for (std::uint32_t f = 0; f < clip.frame_count; ++f) {
+      if (in_range(f, processed.fps, range.range)) parts.frame_tags[first + f] |= TagMask{1} << index;
+    }
+  }
+  if (processed.multiplier.empty()) {
+    parts.frame_multiplier.insert(parts.frame_multiplier.end(), clip.frame_count, clip.cost_multiplier);
+    parts.frame_bias.insert(parts.frame_bias.end(), clip.frame_count, clip.cost_bias);
+  } else {
+    parts.frame_multiplier.insert(parts.frame_multiplier.end(), processed.multiplier.begin(), processed.multiplier.end());
+    parts.frame_bias.insert(parts.frame_bias.end(), processed.bias.begin(), processed.bias.end());
+  }
+  return {};
+}
+
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
                           const FootContactParams& contacts,
@@ -212,20 +263,7 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
   if (frames > 0xFFFFFFF0u) return make_error(source + ": too many frames (" + std::to_string(frames) + ")");
   parts.features.reserve(frames * dims);
   parts.frame_flags.reserve(frames);
-  if (animation.enabled) {
-    std::vector<detail::ClipAnimation> animations;
-    animations.reserve(clips.size());
-    for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
-    Result<AnimationData> data =
-        detail::assemble_animation(animations, contacts, animation.encoding, mirror_bones);
-    if (data.ok()) {
-      parts.animation = std::move(*data);
-    } else if (animation.warning) {
-      // Mixed skeletons are valid for the features: the database is built
-      // without poses and the caller is told why.
-      animation.warning(source + ": " + data.message());
-    }
-  }
+  add_animation(clips, contacts, animation, mirror_bones, source, parts);
   bool per_frame = false;  // per-frame tags and costs are stored (some clip has time ranges)
   for (ProcessedClip& processed : clips) {
     Clip clip = processed.clip;
@@ -234,34 +272,7 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
       MMVK_ASSIGN_OR_RETURN(const std::size_t index, tag_index(parts.tag_names, tag, source, clip.name));
       clip.tags |= TagMask{1} << index;
     }
-    // Per-frame arrays only when some clip has time ranges; the first such
-    // clip fills them in for the clips before it.
-    const bool ranged = !processed.tag_ranges.empty() || !processed.multiplier.empty();
-    if (ranged && !per_frame) {
-      per_frame = true;
-      for (const Clip& before : parts.clips) {
-        parts.frame_tags.insert(parts.frame_tags.end(), before.frame_count, before.tags);
-        parts.frame_multiplier.insert(parts.frame_multiplier.end(), before.frame_count, before.cost_multiplier);
-        parts.frame_bias.insert(parts.frame_bias.end(), before.frame_count, before.cost_bias);
-      }
-    }
-    if (per_frame) {
-      const std::size_t first = parts.frame_tags.size();
-      parts.frame_tags.insert(parts.frame_tags.end(), clip.frame_count, clip.tags);
-      for (const TagRange& range : processed.tag_ranges) {
-        MMVK_ASSIGN_OR_RETURN(const std::size_t index, tag_index(parts.tag_names, range.tag, source, clip.name));
-        for (std::uint32_t f = 0; f < clip.frame_count; ++f) {
-          if (in_range(f, processed.fps, range.range)) parts.frame_tags[first + f] |= TagMask{1} << index;
-        }
-      }
-      if (processed.multiplier.empty()) {
-        parts.frame_multiplier.insert(parts.frame_multiplier.end(), clip.frame_count, clip.cost_multiplier);
-        parts.frame_bias.insert(parts.frame_bias.end(), clip.frame_count, clip.cost_bias);
-      } else {
-        parts.frame_multiplier.insert(parts.frame_multiplier.end(), processed.multiplier.begin(), processed.multiplier.end());
-        parts.frame_bias.insert(parts.frame_bias.end(), processed.bias.begin(), processed.bias.end());
-      }
-    }
+    MMVK_TRY(add_frame_modifiers(processed, clip, source, per_frame, parts));
     parts.features.insert(parts.features.end(), processed.raw.values.begin(), processed.raw.values.end());
     parts.frame_flags.insert(parts.frame_flags.end(), processed.flags.begin(), processed.flags.end());
     parts.clips.push_back(std::move(clip));

@@ -368,8 +368,11 @@ std::string serialize_database(const Database& database) {
   return std::move(bytes);
 }
 
-Result<Database> deserialize_database(std::string_view bytes, std::string_view source_name) {
-  const std::string source(source_name.empty() ? std::string_view("database") : source_name);
+namespace {
+
+// The file's envelope: magic, version, reserved field, payload size and
+// checksum. Returns the format version.
+Result<std::uint32_t> check_envelope(std::string_view bytes, const std::string& source) {
   if (bytes.empty()) return make_error(source + ": truncated mmvk database (the file is empty)");
   if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
     if (bytes.size() < sizeof(kMagic) && std::memcmp(bytes.data(), kMagic, bytes.size()) == 0) {
@@ -402,101 +405,154 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
   if (hasher.digest() != read_u64_at(bytes, kDatabaseHeaderBytes + payload_size)) {
     return make_error(source + ": checksum mismatch: the mmvk database is corrupt");
   }
+  return version;
+}
 
-  Reader in(bytes, kDatabaseHeaderBytes, kDatabaseHeaderBytes + payload_size);
-  auto corrupt = [&](const std::string& what) {
-    return make_error(source + ": corrupt mmvk database payload: " + what + " at byte " + std::to_string(in.position()));
-  };
+// The payload, read section by section into `parts`; errors name the
+// section and the byte.
+class PayloadReader {
+ public:
+  PayloadReader(std::string_view bytes, const std::string& source, std::uint32_t version)
+      : in_(bytes, kDatabaseHeaderBytes, bytes.size() - 8), source_(source), version_(version) {}
+
+  // The schema, fps and the normalization of every dim.
+  Status schema(DatabaseParts& parts) {
+    std::string schema_json;
+    if (!in_.str(schema_json)) return corrupt("schema");
+    Result<FeatureSchema> schema = parse_schema_json(schema_json, source_ + " (schema)");
+    if (!schema.ok()) return make_error(schema.message());
+    parts.schema = std::move(*schema);
+    if (!in_.f32(parts.fps)) return corrupt("fps");
+    if (!in_.u32(dims_)) return corrupt("dims");
+    if (dims_ != parts.schema.dims()) {
+      return corrupt("normalization has " + std::to_string(dims_) + " dims, the schema " +
+                     std::to_string(parts.schema.dims()));
+    }
+    if (std::uint64_t{dims_} * 8 > in_.left()) return corrupt("normalization");
+    parts.normalization.resize(dims_);
+    for (DimNormalization& n : parts.normalization) {
+      if (!in_.f32(n.offset) || !in_.f32(n.scale)) return corrupt("normalization");
+    }
+    return {};
+  }
+
+  Status tags_and_clips(DatabaseParts& parts) {
+    std::uint32_t tags = 0;
+    if (!in_.u32(tags)) return corrupt("tag count");
+    if (tags > kMaxTags) return corrupt(std::to_string(tags) + " tags");
+    parts.tag_names.resize(tags);
+    for (std::string& tag : parts.tag_names) {
+      if (!in_.str(tag)) return corrupt("tag name");
+    }
+    std::uint32_t clips = 0;
+    if (!in_.u32(clips)) return corrupt("clip count");
+    constexpr std::size_t kMinClipBytes = 4 + 4 + 8 + 1 + 1 + 4 + 4 + 4 + 4;
+    if (std::uint64_t{clips} * kMinClipBytes > in_.left()) return corrupt(std::to_string(clips) + " clips");
+    parts.clips.resize(clips);
+    for (Clip& clip : parts.clips) {
+      std::uint8_t loop = 0;
+      std::uint8_t mirrored = 0;
+      if (!in_.str(clip.name) || !in_.str(clip.source) || !in_.u64(clip.tags) || !in_.u8(loop) || !in_.u8(mirrored) ||
+          !in_.f32(clip.cost_multiplier) || !in_.f32(clip.cost_bias) || !in_.u32(clip.first_frame) ||
+          !in_.u32(clip.frame_count)) {
+        return corrupt("clip");
+      }
+      if (loop > 1 || mirrored > 1) return corrupt("clip flags");
+      clip.loop = loop != 0;
+      clip.mirrored = mirrored != 0;
+    }
+    return {};
+  }
+
+  // The frame flags and the feature matrix.
+  Status frames(DatabaseParts& parts) {
+    std::uint32_t frames = 0;
+    if (!in_.u32(frames)) return corrupt("frame count");
+    if (std::uint64_t{frames} * 4 > in_.left()) return corrupt(std::to_string(frames) + " frame flags");
+    parts.frame_flags.resize(frames);
+    for (std::uint32_t& flags : parts.frame_flags) {
+      if (!in_.u32(flags)) return corrupt("frame flags");
+    }
+    const std::uint64_t values = std::uint64_t{frames} * dims_;
+    // Version 1 ends with the features; version 2 adds a presence byte and
+    // the optional animation section.
+    const std::uint64_t after = version_ == 1 ? 0 : 1;
+    // values > left / 4 first: values * 4 alone could wrap for a multi-GiB file.
+    if (values > in_.left() / 4 || values * 4 + after > in_.left() || (version_ == 1 && values * 4 != in_.left())) {
+      return corrupt("feature matrix of " + std::to_string(frames) + " x " + std::to_string(dims_) +
+                     " floats needs " + std::to_string(values * 4) + " bytes, " + std::to_string(in_.left()) +
+                     " are left");
+    }
+    parts.features.resize(values);
+    in_.f32_array(parts.features);
+    return {};
+  }
+
+  // The sections later versions add after the features, each behind a
+  // presence byte.
+  Status optional_sections(DatabaseParts& parts) {
+    const auto frames = static_cast<std::uint32_t>(parts.frame_flags.size());
+    if (version_ >= 3) {
+      std::uint8_t per_frame = 0;
+      if (!in_.u8(per_frame) || per_frame > 1) return corrupt("per-frame modifiers presence byte");
+      if (per_frame) {
+        if (std::uint64_t{frames} * 16 + 1 > in_.left()) {
+          return corrupt("per-frame modifiers of " + std::to_string(frames) + " frames");
+        }
+        parts.frame_tags.resize(frames);
+        for (TagMask& tags : parts.frame_tags) (void)in_.u64(tags);
+        parts.frame_multiplier.resize(frames);
+        in_.f32_array(parts.frame_multiplier);
+        parts.frame_bias.resize(frames);
+        in_.f32_array(parts.frame_bias);
+      }
+    }
+    if (version_ >= 4) {
+      std::uint8_t has_units = 0;
+      if (!in_.u8(has_units) || has_units > 1) return corrupt("import units presence byte");
+      if (has_units) {
+        if (std::uint64_t{parts.clips.size()} * 4 + 1 > in_.left()) {
+          return corrupt("import units of " + std::to_string(parts.clips.size()) + " clips");
+        }
+        for (Clip& clip : parts.clips) (void)in_.f32(clip.metres_per_unit);
+      }
+    }
+    if (version_ >= 2) {
+      std::uint8_t has_animation = 0;
+      if (!in_.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");
+      if (has_animation) {
+        parts.animation.emplace();
+        if (std::string what = read_animation(in_, version_, *parts.animation); !what.empty()) return corrupt(what);
+      } else if (in_.left() != 0) {
+        return corrupt(std::to_string(in_.left()) + " bytes after the features");
+      }
+    }
+    return {};
+  }
+
+ private:
+  Error corrupt(const std::string& what) const {
+    return make_error(source_ + ": corrupt mmvk database payload: " + what + " at byte " +
+                      std::to_string(in_.position()));
+  }
+
+  Reader in_;
+  const std::string& source_;
+  const std::uint32_t version_;
+  std::uint32_t dims_ = 0;
+};
+
+}  // namespace
+
+Result<Database> deserialize_database(std::string_view bytes, std::string_view source_name) {
+  const std::string source(source_name.empty() ? std::string_view("database") : source_name);
+  MMVK_ASSIGN_OR_RETURN(const std::uint32_t version, check_envelope(bytes, source));
+  PayloadReader payload(bytes, source, version);
   DatabaseParts parts;
-  std::string schema_json;
-  if (!in.str(schema_json)) return corrupt("schema");
-  Result<FeatureSchema> schema = parse_schema_json(schema_json, source + " (schema)");
-  if (!schema.ok()) return make_error(schema.message());
-  parts.schema = std::move(*schema);
-  if (!in.f32(parts.fps)) return corrupt("fps");
-  std::uint32_t dims = 0;
-  if (!in.u32(dims)) return corrupt("dims");
-  if (dims != parts.schema.dims()) {
-    return corrupt("normalization has " + std::to_string(dims) + " dims, the schema " + std::to_string(parts.schema.dims()));
-  }
-  if (std::uint64_t{dims} * 8 > in.left()) return corrupt("normalization");
-  parts.normalization.resize(dims);
-  for (DimNormalization& n : parts.normalization) {
-    if (!in.f32(n.offset) || !in.f32(n.scale)) return corrupt("normalization");
-  }
-  std::uint32_t tags = 0;
-  if (!in.u32(tags)) return corrupt("tag count");
-  if (tags > kMaxTags) return corrupt(std::to_string(tags) + " tags");
-  parts.tag_names.resize(tags);
-  for (std::string& tag : parts.tag_names) {
-    if (!in.str(tag)) return corrupt("tag name");
-  }
-  std::uint32_t clips = 0;
-  if (!in.u32(clips)) return corrupt("clip count");
-  constexpr std::size_t kMinClipBytes = 4 + 4 + 8 + 1 + 1 + 4 + 4 + 4 + 4;
-  if (std::uint64_t{clips} * kMinClipBytes > in.left()) return corrupt(std::to_string(clips) + " clips");
-  parts.clips.resize(clips);
-  for (Clip& clip : parts.clips) {
-    std::uint8_t loop = 0;
-    std::uint8_t mirrored = 0;
-    if (!in.str(clip.name) || !in.str(clip.source) || !in.u64(clip.tags) || !in.u8(loop) || !in.u8(mirrored) ||
-        !in.f32(clip.cost_multiplier) || !in.f32(clip.cost_bias) || !in.u32(clip.first_frame) ||
-        !in.u32(clip.frame_count)) {
-      return corrupt("clip");
-    }
-    if (loop > 1 || mirrored > 1) return corrupt("clip flags");
-    clip.loop = loop != 0;
-    clip.mirrored = mirrored != 0;
-  }
-  std::uint32_t frames = 0;
-  if (!in.u32(frames)) return corrupt("frame count");
-  if (std::uint64_t{frames} * 4 > in.left()) return corrupt(std::to_string(frames) + " frame flags");
-  parts.frame_flags.resize(frames);
-  for (std::uint32_t& flags : parts.frame_flags) {
-    if (!in.u32(flags)) return corrupt("frame flags");
-  }
-  const std::uint64_t values = std::uint64_t{frames} * dims;
-  // Version 1 ends with the features; version 2 adds a presence byte and
-  // the optional animation section.
-  const std::uint64_t after = version == 1 ? 0 : 1;
-  // values > left / 4 first: values * 4 alone could wrap for a multi-GiB file.
-  if (values > in.left() / 4 || values * 4 + after > in.left() || (version == 1 && values * 4 != in.left())) {
-    return corrupt("feature matrix of " + std::to_string(frames) + " x " + std::to_string(dims) + " floats needs " +
-                   std::to_string(values * 4) + " bytes, " + std::to_string(in.left()) + " are left");
-  }
-  parts.features.resize(values);
-  in.f32_array(parts.features);
-  if (version >= 3) {
-    std::uint8_t per_frame = 0;
-    if (!in.u8(per_frame) || per_frame > 1) return corrupt("per-frame modifiers presence byte");
-    if (per_frame) {
-      if (std::uint64_t{frames} * 16 + 1 > in.left()) return corrupt("per-frame modifiers of " + std::to_string(frames) + " frames");
-      parts.frame_tags.resize(frames);
-      for (TagMask& tags : parts.frame_tags) (void)in.u64(tags);
-      parts.frame_multiplier.resize(frames);
-      in.f32_array(parts.frame_multiplier);
-      parts.frame_bias.resize(frames);
-      in.f32_array(parts.frame_bias);
-    }
-  }
-  if (version >= 4) {
-    std::uint8_t has_units = 0;
-    if (!in.u8(has_units) || has_units > 1) return corrupt("import units presence byte");
-    if (has_units) {
-      if (std::uint64_t{clips} * 4 + 1 > in.left()) return corrupt("import units of " + std::to_string(clips) + " clips");
-      for (Clip& clip : parts.clips) (void)in.f32(clip.metres_per_unit);
-    }
-  }
-  if (version >= 2) {
-    std::uint8_t has_animation = 0;
-    if (!in.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");
-    if (has_animation) {
-      parts.animation.emplace();
-      if (std::string what = read_animation(in, version, *parts.animation); !what.empty()) return corrupt(what);
-    } else if (in.left() != 0) {
-      return corrupt(std::to_string(in.left()) + " bytes after the features");
-    }
-  }
+  MMVK_TRY(payload.schema(parts));
+  MMVK_TRY(payload.tags_and_clips(parts));
+  MMVK_TRY(payload.frames(parts));
+  MMVK_TRY(payload.optional_sections(parts));
   Result<Database> database = Database::create(std::move(parts));
   if (!database.ok()) return make_error(source + ": invalid mmvk database: " + database.message());
   return database;

@@ -318,6 +318,105 @@ Result<EdgeRule> parse_edge_rule(std::string_view name) {
                     std::string(name) + "\"");
 }
 
+namespace {
+
+// The steps of parse_manifest_json, one top-level field (or group) each;
+// `at` is "<manifest>: " for messages.
+// "schema": a file beside the manifest, or the schema object inline.
+Status read_schema_field(const Json& root, const std::string& name, const std::string& at,
+                         const std::filesystem::path& base_dir, Manifest& manifest) {
+  if (!root.contains("schema")) return {};
+  const Json& schema = root["schema"];
+  if (schema.is_string()) {
+    std::filesystem::path path = base_dir / schema.get<std::string>();
+    Result<FeatureSchema> loaded = load_schema(path);
+    if (!loaded.ok()) return make_error(at + "schema: " + loaded.message());
+    manifest.schema = std::move(*loaded);
+  } else if (schema.is_object()) {
+    Result<FeatureSchema> parsed = parse_schema_json(schema.dump(-1, ' ', false, Json::error_handler_t::replace), name + ": schema");
+    if (!parsed.ok()) return parsed.error();
+    manifest.schema = std::move(*parsed);
+  } else {
+    return make_error(at + "schema: expected a file name or a schema object");
+  }
+  return {};
+}
+
+Status read_fps_field(const Json& root, const std::string& at, Manifest& manifest) {
+  if (!root.contains("fps")) return {};
+  MMVK_READ(manifest.fps, json_float(root["fps"], at + "fps"));
+  if (!(manifest.fps >= kMinFps && manifest.fps <= kMaxFps)) {
+    char text[120];
+    std::snprintf(text, sizeof(text), "fps: %g is outside the supported [%g, %g] frames/s", double(manifest.fps),
+                  double(kMinFps), double(kMaxFps));
+    return make_error(at + text);
+  }
+  return {};
+}
+
+Status read_import_field(const Json& root, const std::string& at, Manifest& manifest) {
+  if (!root.contains("import")) return {};
+  const Json& import = root["import"];
+  if (!import.is_object()) return make_error(at + "import: expected an object");
+  MMVK_TRY(check_fields(import, at + "import", {"metres_per_unit", "up_axis"}));
+  if (import.contains("metres_per_unit")) {
+    MMVK_READ(manifest.import.metres_per_unit, json_float(import["metres_per_unit"], at + "import.metres_per_unit"));
+    if (manifest.import.metres_per_unit < 0.0f) {
+      return make_error(at + "import.metres_per_unit: must be > 0 (or 0 to guess)");
+    }
+  }
+  if (import.contains("up_axis")) {
+    std::string axis;
+    MMVK_READ(axis, read_string(import["up_axis"], at + "import.up_axis"));
+    if (axis == "y" || axis == "Y") {
+      manifest.import.up_axis = UpAxis::Y;
+    } else if (axis == "z" || axis == "Z") {
+      manifest.import.up_axis = UpAxis::Z;
+    } else {
+      return make_error(at + "import.up_axis: expected \"y\" or \"z\", got \"" + axis + "\"");
+    }
+  }
+  return {};
+}
+
+Status read_character_root_field(const Json& root, const std::string& at, Manifest& manifest) {
+  if (!root.contains("character_root")) return {};
+  const Json& options = root["character_root"];
+  if (!options.is_object()) return make_error(at + "character_root: expected an object");
+  MMVK_TRY(check_fields(options, at + "character_root", {"source_bone", "facing_smoothing_seconds"}));
+  if (options.contains("source_bone")) {
+    MMVK_READ(manifest.character_root.source_bone,
+              read_string(options["source_bone"], at + "character_root.source_bone"));
+  }
+  if (options.contains("facing_smoothing_seconds")) {
+    MMVK_READ(manifest.character_root.facing_smoothing_seconds,
+              json_float(options["facing_smoothing_seconds"], at + "character_root.facing_smoothing_seconds"));
+    if (manifest.character_root.facing_smoothing_seconds < 0.0f) {
+      return make_error(at + "character_root.facing_smoothing_seconds: must be >= 0");
+    }
+  }
+  return {};
+}
+
+// "clips", each mirrored too where the manifest's "mirror" says so.
+Status read_clips_field(const Json& root, const std::string& at, const std::filesystem::path& base_dir, bool mirror_all,
+                        Manifest& manifest) {
+  if (!root.contains("clips") || !root["clips"].is_array()) {
+    return make_error(at + "clips: expected an array of clips");
+  }
+  const Json& clips = root["clips"];
+  if (clips.empty()) return make_error(at + "clips: empty");
+  for (std::size_t i = 0; i < clips.size(); ++i) {
+    Result<ManifestClip> clip = parse_clip(clips[i], at + "clips[" + std::to_string(i) + "]", base_dir);
+    if (!clip.ok()) return clip.error();
+    clip->mirror = clip->mirror || mirror_all;
+    manifest.clips.push_back(std::move(*clip));
+  }
+  return {};
+}
+
+}  // namespace
+
 Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_view source,
                                      const std::filesystem::path& base_dir) {
   const std::string name(source.empty() ? std::string_view("manifest") : source);
@@ -331,74 +430,16 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   Manifest manifest;
   manifest.source = name;
   const std::string at = name + ": ";
-  if (root.contains("schema")) {
-    const Json& schema = root["schema"];
-    if (schema.is_string()) {
-      std::filesystem::path path = base_dir / schema.get<std::string>();
-      Result<FeatureSchema> loaded = load_schema(path);
-      if (!loaded.ok()) return make_error(at + "schema: " + loaded.message());
-      manifest.schema = std::move(*loaded);
-    } else if (schema.is_object()) {
-      Result<FeatureSchema> parsed = parse_schema_json(schema.dump(-1, ' ', false, Json::error_handler_t::replace), name + ": schema");
-      if (!parsed.ok()) return parsed.error();
-      manifest.schema = std::move(*parsed);
-    } else {
-      return make_error(at + "schema: expected a file name or a schema object");
-    }
-  }
-  if (root.contains("fps")) {
-    MMVK_READ(manifest.fps, json_float(root["fps"], at + "fps"));
-    if (!(manifest.fps >= kMinFps && manifest.fps <= kMaxFps)) {
-      char text[120];
-      std::snprintf(text, sizeof(text), "fps: %g is outside the supported [%g, %g] frames/s", double(manifest.fps),
-                    double(kMinFps), double(kMaxFps));
-      return make_error(at + text);
-    }
-  }
-  if (root.contains("import")) {
-    const Json& import = root["import"];
-    if (!import.is_object()) return make_error(at + "import: expected an object");
-    MMVK_TRY(check_fields(import, at + "import", {"metres_per_unit", "up_axis"}));
-    if (import.contains("metres_per_unit")) {
-      MMVK_READ(manifest.import.metres_per_unit, json_float(import["metres_per_unit"], at + "import.metres_per_unit"));
-      if (manifest.import.metres_per_unit < 0.0f) {
-        return make_error(at + "import.metres_per_unit: must be > 0 (or 0 to guess)");
-      }
-    }
-    if (import.contains("up_axis")) {
-      std::string axis;
-      MMVK_READ(axis, read_string(import["up_axis"], at + "import.up_axis"));
-      if (axis == "y" || axis == "Y") {
-        manifest.import.up_axis = UpAxis::Y;
-      } else if (axis == "z" || axis == "Z") {
-        manifest.import.up_axis = UpAxis::Z;
-      } else {
-        return make_error(at + "import.up_axis: expected \"y\" or \"z\", got \"" + axis + "\"");
-      }
-    }
-  }
-  if (root.contains("character_root")) {
-    const Json& options = root["character_root"];
-    if (!options.is_object()) return make_error(at + "character_root: expected an object");
-    MMVK_TRY(check_fields(options, at + "character_root", {"source_bone", "facing_smoothing_seconds"}));
-    if (options.contains("source_bone")) {
-      MMVK_READ(manifest.character_root.source_bone,
-                read_string(options["source_bone"], at + "character_root.source_bone"));
-    }
-    if (options.contains("facing_smoothing_seconds")) {
-      MMVK_READ(manifest.character_root.facing_smoothing_seconds,
-                json_float(options["facing_smoothing_seconds"], at + "character_root.facing_smoothing_seconds"));
-      if (manifest.character_root.facing_smoothing_seconds < 0.0f) {
-        return make_error(at + "character_root.facing_smoothing_seconds: must be >= 0");
-      }
-    }
-  }
+  MMVK_TRY(read_schema_field(root, name, at, base_dir, manifest));
+  MMVK_TRY(read_fps_field(root, at, manifest));
+  MMVK_TRY(read_import_field(root, at, manifest));
+  MMVK_TRY(read_character_root_field(root, at, manifest));
   if (root.contains("edge_rule")) {
     std::string rule;
     MMVK_READ(rule, read_string(root["edge_rule"], at + "edge_rule"));
-    Result<EdgeRule> parsed = parse_edge_rule(rule);
-    if (!parsed.ok()) return make_error(at + "edge_rule: " + parsed.message());
-    manifest.edge_rule = *parsed;
+    Result<EdgeRule> parsed_rule = parse_edge_rule(rule);
+    if (!parsed_rule.ok()) return make_error(at + "edge_rule: " + parsed_rule.message());
+    manifest.edge_rule = *parsed_rule;
   }
   bool mirror_all = false;
   if (root.contains("mirror")) MMVK_READ(mirror_all, read_bool(root["mirror"], at + "mirror"));
@@ -409,17 +450,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
     MMVK_READ(manifest.mirror_map, read_mirror_map(root["mirror_map"], manifest.schema, at + "mirror_map"));
   }
   if (root.contains("contacts")) MMVK_READ(manifest.contacts, read_contacts(root["contacts"], at + "contacts"));
-  if (!root.contains("clips") || !root["clips"].is_array()) {
-    return make_error(at + "clips: expected an array of clips");
-  }
-  const Json& clips = root["clips"];
-  if (clips.empty()) return make_error(at + "clips: empty");
-  for (std::size_t i = 0; i < clips.size(); ++i) {
-    Result<ManifestClip> clip = parse_clip(clips[i], at + "clips[" + std::to_string(i) + "]", base_dir);
-    if (!clip.ok()) return clip.error();
-    clip->mirror = clip->mirror || mirror_all;
-    manifest.clips.push_back(std::move(*clip));
-  }
+  MMVK_TRY(read_clips_field(root, at, base_dir, mirror_all, manifest));
   return manifest;
 }
 

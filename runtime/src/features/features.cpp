@@ -109,115 +109,115 @@ EdgeReach edge_reach(const FeatureSchema& schema, float fps, bool trajectory) {
   return reach;
 }
 
-Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& root, const FeatureSchema& schema,
-                                     const FeatureExtractionOptions& options) {
-  MMVK_TRY(schema.validate());
-  const std::uint32_t frames = motion.frame_count;
-  const std::uint32_t dims = schema.dims();
-  const std::string source = options.source.empty() ? std::string("clip") : options.source;
-  if (!(motion.fps > 0.0f) || !std::isfinite(motion.fps)) {
-    return make_error(source + ": frame rate must be positive, got " + std::to_string(motion.fps));
-  }
-  if (root.positions.size() != frames || root.facings.size() != frames) {
-    return make_error(source + ": character root has " + std::to_string(root.positions.size()) +
-                      " frames, the motion has " + std::to_string(frames));
-  }
+namespace {
 
-  // Resolve each channel's inputs once per clip (skeletons may differ between clips).
-  struct Inputs {
-    int bone = -1;
-    int second_bone = -1;
-    std::span<const float> custom;
-    std::vector<detail::CurveSource> curves;
-  };
-  std::vector<Inputs> inputs(schema.channels.size());
+// A channel's inputs, resolved once per clip (skeletons may differ between clips).
+struct ChannelInputs {
+  int bone = -1;
+  int second_bone = -1;
+  std::span<const float> custom;
+  std::vector<detail::CurveSource> curves;
+};
+
+// Channel c's bones, curves and custom values; `custom_count` counts the
+// custom channels so far (the next one takes options.custom[custom_count]).
+Status resolve_channel(const Motion& motion, const FeatureSchema& schema, std::size_t c,
+                       const FeatureExtractionOptions& options, std::size_t& custom_count, ChannelInputs& inputs) {
+  const FeatureChannel& channel = schema.channels[c];
+  const ChannelKindInfo& info = channel_kind_info(channel.kind);
+  const std::uint32_t frames = motion.frame_count;
+  if (has_field(info.fields, ChannelField::Bone)) {
+    const std::string bone = channel.bone.empty() ? std::string(info.default_bone) : channel.bone;
+    Result<int> index = find_bone(motion.skeleton, bone);
+    if (!index.ok()) return make_error(where(options, channel) + ": " + index.message());
+    inputs.bone = *index;
+  }
+  if (has_field(info.fields, ChannelField::SecondBone)) {
+    Result<int> index = find_bone(motion.skeleton, channel.second_bone);
+    if (!index.ok()) return make_error(where(options, channel) + ": second_bone: " + index.message());
+    inputs.second_bone = *index;
+    if (has_field(info.fields, ChannelField::Bone) && !hangs_below(motion.skeleton, *index, inputs.bone)) {
+      return make_error(where(options, channel) + ": second_bone '" + channel.second_bone + "' (" +
+                        motion.skeleton.names[static_cast<std::size_t>(*index)] + ") does not hang below bone '" +
+                        channel.bone + "' (" + motion.skeleton.names[static_cast<std::size_t>(inputs.bone)] + ")");
+    }
+  }
+  if (has_field(info.fields, ChannelField::Curves)) {
+    const std::uint32_t half = window_frames(channel.window_seconds, motion.fps);
+    if (std::uint64_t{2} * half + 1 > frames) {
+      return make_error(where(options, channel) + ": window_seconds " + std::to_string(channel.window_seconds) +
+                        " spans " + std::to_string(2 * half + 1) + " frames, longer than the clip (" +
+                        std::to_string(frames) + " frames)");
+    }
+    for (std::size_t i = 0; i < channel.curves.size(); ++i) {
+      Result<detail::CurveSource> curve = resolve_curve(motion.skeleton, schema, c, channel.curves[i]);
+      if (!curve.ok()) {
+        return make_error(where(options, channel) + ": curves[" + std::to_string(i) + "]: " + curve.message());
+      }
+      inputs.curves.push_back(*curve);
+    }
+  }
+  if (has_field(info.fields, ChannelField::Dims)) {
+    if (custom_count < options.custom.size()) {
+      const std::vector<float>& values = options.custom[custom_count];
+      if (values.size() != std::size_t{frames} * channel.custom_dims) {
+        return make_error(where(options, channel) + ": custom values hold " + std::to_string(values.size()) +
+                          " floats, expected " + std::to_string(frames) + " frames x " +
+                          std::to_string(channel.custom_dims) + " dims");
+      }
+      inputs.custom = values;
+    }
+    ++custom_count;
+  }
+  return {};
+}
+
+// Every channel's inputs, and whether any channel reads foot contacts.
+Status resolve_inputs(const Motion& motion, const FeatureSchema& schema, const FeatureExtractionOptions& options,
+                      const std::string& source, std::vector<ChannelInputs>& inputs, bool& needs_contacts) {
+  inputs.resize(schema.channels.size());
   std::size_t custom_count = 0;
-  bool needs_contacts = false;
+  needs_contacts = false;
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
-    const FeatureChannel& channel = schema.channels[c];
-    const ChannelKindInfo& info = channel_kind_info(channel.kind);
-    if (has_field(info.fields, ChannelField::Bone)) {
-      const std::string bone = channel.bone.empty() ? std::string(info.default_bone) : channel.bone;
-      Result<int> index = find_bone(motion.skeleton, bone);
-      if (!index.ok()) return make_error(where(options, channel) + ": " + index.message());
-      inputs[c].bone = *index;
-    }
-    if (has_field(info.fields, ChannelField::SecondBone)) {
-      Result<int> index = find_bone(motion.skeleton, channel.second_bone);
-      if (!index.ok()) return make_error(where(options, channel) + ": second_bone: " + index.message());
-      inputs[c].second_bone = *index;
-      if (has_field(info.fields, ChannelField::Bone) && !hangs_below(motion.skeleton, *index, inputs[c].bone)) {
-        return make_error(where(options, channel) + ": second_bone '" + channel.second_bone + "' (" +
-                          motion.skeleton.names[static_cast<std::size_t>(*index)] + ") does not hang below bone '" +
-                          channel.bone + "' (" + motion.skeleton.names[static_cast<std::size_t>(inputs[c].bone)] + ")");
-      }
-    }
-    if (has_field(info.fields, ChannelField::Curves)) {
-      const std::uint32_t half = window_frames(channel.window_seconds, motion.fps);
-      if (std::uint64_t{2} * half + 1 > frames) {
-        return make_error(where(options, channel) + ": window_seconds " + std::to_string(channel.window_seconds) +
-                          " spans " + std::to_string(2 * half + 1) + " frames, longer than the clip (" +
-                          std::to_string(frames) + " frames)");
-      }
-      for (std::size_t i = 0; i < channel.curves.size(); ++i) {
-        Result<detail::CurveSource> curve = resolve_curve(motion.skeleton, schema, c, channel.curves[i]);
-        if (!curve.ok()) {
-          return make_error(where(options, channel) + ": curves[" + std::to_string(i) + "]: " + curve.message());
-        }
-        inputs[c].curves.push_back(*curve);
-      }
-    }
-    if (has_field(info.fields, ChannelField::Contacts)) needs_contacts = true;
-    if (has_field(info.fields, ChannelField::Dims)) {
-      if (custom_count < options.custom.size()) {
-        const std::vector<float>& values = options.custom[custom_count];
-        if (values.size() != std::size_t{frames} * channel.custom_dims) {
-          return make_error(where(options, channel) + ": custom values hold " + std::to_string(values.size()) +
-                            " floats, expected " + std::to_string(frames) + " frames x " +
-                            std::to_string(channel.custom_dims) + " dims");
-        }
-        inputs[c].custom = values;
-      }
-      ++custom_count;
-    }
+    MMVK_TRY(resolve_channel(motion, schema, c, options, custom_count, inputs[c]));
+    if (has_field(channel_kind_info(schema.channels[c].kind).fields, ChannelField::Contacts)) needs_contacts = true;
   }
   if (custom_count != options.custom.size()) {
     return make_error(source + ": the schema has " + std::to_string(custom_count) + " custom channels, " +
                       std::to_string(options.custom.size()) + " custom arrays were given");
   }
+  return {};
+}
 
-  // Global positions of every joint, [frames x joints], shared by the channels.
+// Global positions of every joint, [frames x joints], shared by the channels.
+void sample_global_positions(const Motion& motion, std::vector<glm::vec3>& global) {
   const std::size_t joints = motion.joint_count();
-  const bool extrapolate = options.extrapolate_seconds > 0.0f && !options.loop;
-  const std::uint32_t extrapolate_frames = extrapolate ? window_frames(options.extrapolate_seconds, motion.fps) : 0;
-  detail::ClipSamples clip{motion, root, detail::Trajectory(root, frames, options.loop, extrapolate_frames),
-                           std::vector<glm::vec3>(std::size_t{frames} * joints), options.loop, {}};
-  {
-    std::vector<glm::vec3> positions(joints);
-    std::vector<glm::quat> rotations(joints);
-    for (std::uint32_t f = 0; f < frames; ++f) {
-      forward_kinematics(motion, f, positions, rotations);
-      std::copy(positions.begin(), positions.end(),
-                clip.global.begin() + static_cast<std::ptrdiff_t>(std::size_t{f} * joints));
-    }
+  std::vector<glm::vec3> positions(joints);
+  std::vector<glm::quat> rotations(joints);
+  for (std::uint32_t f = 0; f < motion.frame_count; ++f) {
+    forward_kinematics(motion, f, positions, rotations);
+    std::copy(positions.begin(), positions.end(), global.begin() + static_cast<std::ptrdiff_t>(std::size_t{f} * joints));
   }
+}
 
-  if (needs_contacts) {
-    detail::ClipContacts contacts =
-        detail::detect_foot_contacts(motion.skeleton, clip.global, frames, motion.fps, options.contacts);
-    if (!contacts.resolved()) {
-      return make_error(source + ": foot contacts: neither the toes ('" + options.contacts.left_toe + "', '" +
-                        options.contacts.right_toe + "') nor the heels ('" + options.contacts.left_heel + "', '" +
-                        options.contacts.right_heel + "') of both feet resolve on the clip's skeleton");
-    }
-    clip.contacts = std::move(contacts.bits);
+Status detect_contacts(detail::ClipSamples& clip, const FeatureExtractionOptions& options, const std::string& source) {
+  const Motion& motion = clip.motion;
+  detail::ClipContacts contacts =
+      detail::detect_foot_contacts(motion.skeleton, clip.global, motion.frame_count, motion.fps, options.contacts);
+  if (!contacts.resolved()) {
+    return make_error(source + ": foot contacts: neither the toes ('" + options.contacts.left_toe + "', '" +
+                      options.contacts.right_toe + "') nor the heels ('" + options.contacts.left_heel + "', '" +
+                      options.contacts.right_heel + "') of both feet resolve on the clip's skeleton");
   }
+  clip.contacts = std::move(contacts.bits);
+  return {};
+}
 
-  RawFeatures out;
-  out.frame_count = frames;
-  out.dims = dims;
-  out.values.assign(std::size_t{frames} * dims, 0.0f);
-  out.past_end.assign(frames, 0);
+// Marks the frames whose past or future offsets reach over a non-looping
+// clip's edges; refuses a clip where that is every frame.
+Status mark_past_end(const FeatureSchema& schema, const Motion& motion, const FeatureExtractionOptions& options,
+                     bool extrapolate, const std::string& source, RawFeatures& out) {
+  const std::uint32_t frames = motion.frame_count;
   const EdgeReach reach = edge_reach(schema, motion.fps, !extrapolate);
   // Extrapolated past offsets leave every frame usable: no reach to check.
   const std::string past_owner = extrapolate ? std::string() : past_reach_owner(schema, motion.fps);
@@ -232,6 +232,51 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
       out.past_end[f] = 1;
     }
   }
+  return {};
+}
+
+Status check_finite(const RawFeatures& out, const FeatureSchema& schema, const std::string& source) {
+  for (std::size_t i = 0; i < out.values.size(); ++i) {
+    if (!std::isfinite(out.values[i])) {
+      return make_error(source + ": feature " + schema.dim_name(static_cast<std::uint32_t>(i % out.dims)) +
+                        " of frame " + std::to_string(i / out.dims) + " is not finite");
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& root, const FeatureSchema& schema,
+                                     const FeatureExtractionOptions& options) {
+  MMVK_TRY(schema.validate());
+  const std::uint32_t frames = motion.frame_count;
+  const std::uint32_t dims = schema.dims();
+  const std::string source = options.source.empty() ? std::string("clip") : options.source;
+  if (!(motion.fps > 0.0f) || !std::isfinite(motion.fps)) {
+    return make_error(source + ": frame rate must be positive, got " + std::to_string(motion.fps));
+  }
+  if (root.positions.size() != frames || root.facings.size() != frames) {
+    return make_error(source + ": character root has " + std::to_string(root.positions.size()) +
+                      " frames, the motion has " + std::to_string(frames));
+  }
+  std::vector<ChannelInputs> inputs;
+  bool needs_contacts = false;
+  MMVK_TRY(resolve_inputs(motion, schema, options, source, inputs, needs_contacts));
+
+  const bool extrapolate = options.extrapolate_seconds > 0.0f && !options.loop;
+  const std::uint32_t extrapolate_frames = extrapolate ? window_frames(options.extrapolate_seconds, motion.fps) : 0;
+  detail::ClipSamples clip{motion, root, detail::Trajectory(root, frames, options.loop, extrapolate_frames),
+                           std::vector<glm::vec3>(std::size_t{frames} * motion.joint_count()), options.loop, {}};
+  sample_global_positions(motion, clip.global);
+  if (needs_contacts) MMVK_TRY(detect_contacts(clip, options, source));
+
+  RawFeatures out;
+  out.frame_count = frames;
+  out.dims = dims;
+  out.values.assign(std::size_t{frames} * dims, 0.0f);
+  out.past_end.assign(frames, 0);
+  MMVK_TRY(mark_past_end(schema, motion, options, extrapolate, source, out));
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const detail::ChannelExtraction job{.clip = clip,
                                         .channel = schema.channels[c],
@@ -244,12 +289,7 @@ Result<RawFeatures> extract_features(const Motion& motion, const CharacterRoot& 
                                         .stride = dims};
     channel_kind_info(schema.channels[c].kind).extract(job);
   }
-  for (std::size_t i = 0; i < out.values.size(); ++i) {
-    if (!std::isfinite(out.values[i])) {
-      return make_error(source + ": feature " + schema.dim_name(static_cast<std::uint32_t>(i % dims)) + " of frame " +
-                        std::to_string(i / dims) + " is not finite");
-    }
-  }
+  MMVK_TRY(check_finite(out, schema, source));
   return out;
 }
 

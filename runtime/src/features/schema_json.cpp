@@ -16,15 +16,11 @@ namespace {
 
 using Json = nlohmann::json;
 
-Result<FeatureChannel> parse_channel(const Json& object, const std::string& where) {
-  if (!object.is_object()) return make_error(where + ": expected an object");
-  static const std::set<std::string> kKnown = {"name",   "kind",          "bone",   "second_bone",    "limb",
-                                               "curves", "offsets_seconds", "dims", "window_seconds", "weight",
-                                               "normalization"};
-  for (const auto& item : object.items()) {
-    if (!kKnown.count(item.key())) return make_error(where + "." + item.key() + ": unknown field");
-  }
-  FeatureChannel channel;
+// The steps of parse_channel, in the order its fields are checked; `kind`
+// is the kind's name, for messages. A field the kind would ignore is an
+// error, like an unknown field.
+Result<const ChannelKindInfo*> parse_name_and_kind(const Json& object, const std::string& where,
+                                                   FeatureChannel& channel) {
   if (!object.contains("name") || !object["name"].is_string()) return make_error(where + ".name: expected a string");
   channel.name = object["name"].get<std::string>();
   if (!object.contains("kind") || !object["kind"].is_string()) {
@@ -36,16 +32,20 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     return make_error(where + ".kind: unknown kind \"" + kind + "\", expected one of " + channel_kind_list());
   }
   channel.kind = info->kind;
+  return info;
+}
+
+Status parse_bones(const Json& object, const std::string& where, const ChannelKindInfo& info, const std::string& kind,
+                   FeatureChannel& channel) {
   if (object.contains("bone")) {
-    // Unknown fields are errors, and so is a field the kind would ignore.
-    if (!has_field(info->fields, ChannelField::Bone)) {
+    if (!has_field(info.fields, ChannelField::Bone)) {
       return make_error(where + ".bone: a " + kind + " channel reads no bone");
     }
     if (!object["bone"].is_string()) return make_error(where + ".bone: expected a string");
     channel.bone = object["bone"].get<std::string>();
   }
   if (object.contains("second_bone")) {
-    if (!has_field(info->fields, ChannelField::SecondBone)) {
+    if (!has_field(info.fields, ChannelField::SecondBone)) {
       return make_error(where + ".second_bone: a " + kind + " channel reads no second bone");
     }
     if (!object["second_bone"].is_string()) return make_error(where + ".second_bone: expected a string");
@@ -53,7 +53,7 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
   }
   if (object.contains("limb")) {
     // Shorthand for the limb's root and end bones (named_limbs()).
-    if (info->kind != ChannelKind::LimbVector) return make_error(where + ".limb: a " + kind + " channel reads no limb");
+    if (info.kind != ChannelKind::LimbVector) return make_error(where + ".limb: a " + kind + " channel reads no limb");
     if (object.contains("bone") || object.contains("second_bone")) {
       return make_error(where + ".limb: give either limb or bone and second_bone, not both");
     }
@@ -65,8 +65,13 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     channel.bone = named->root;
     channel.second_bone = named->end;
   }
+  return {};
+}
+
+Status parse_curves(const Json& object, const std::string& where, const ChannelKindInfo& info, const std::string& kind,
+                    FeatureChannel& channel) {
   if (object.contains("curves")) {
-    if (!has_field(info->fields, ChannelField::Curves)) {
+    if (!has_field(info.fields, ChannelField::Curves)) {
       return make_error(where + ".curves: a " + kind + " channel reads no curves");
     }
     const Json& curves = object["curves"];
@@ -79,13 +84,20 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     }
   }
   if (object.contains("window_seconds")) {
-    if (!has_field(info->fields, ChannelField::Curves)) {
+    if (!has_field(info.fields, ChannelField::Curves)) {
       return make_error(where + ".window_seconds: a " + kind + " channel has no window");
     }
     Result<float> window = detail::json_float(object["window_seconds"], where + ".window_seconds");
     if (!window.ok()) return window.error();
     channel.window_seconds = *window;
   }
+  return {};
+}
+
+// offsets_seconds, then dims: a kind's width depends on its offsets and
+// curves, read before.
+Status parse_offsets_and_dims(const Json& object, const std::string& where, const ChannelKindInfo& info,
+                              const std::string& kind, FeatureChannel& channel) {
   if (object.contains("offsets_seconds")) {
     const Json& offsets = object["offsets_seconds"];
     if (!offsets.is_array()) return make_error(where + ".offsets_seconds: expected an array of numbers");
@@ -100,10 +112,9 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     if (!dims.is_number_integer() || dims.get<std::int64_t>() <= 0 || dims.get<std::int64_t>() > 4096) {
       return make_error(where + ".dims: expected an integer in [1, 4096]");
     }
-    if (has_field(info->fields, ChannelField::Dims)) {
+    if (has_field(info.fields, ChannelField::Dims)) {
       channel.custom_dims = static_cast<std::uint32_t>(dims.get<std::int64_t>());
     } else {
-      // Every field the width depends on (offsets, curves) is read above.
       const std::int64_t expected = channel.dims();
       if (dims.get<std::int64_t>() != expected) {
         return make_error(where + ".dims: a " + kind + " channel has " + std::to_string(expected) + " dims, not " +
@@ -111,6 +122,10 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
       }
     }
   }
+  return {};
+}
+
+Status parse_weighting(const Json& object, const std::string& where, FeatureChannel& channel) {
   if (object.contains("weight")) {
     Result<float> weight = detail::json_float(object["weight"], where + ".weight");
     if (!weight.ok()) return weight.error();
@@ -122,6 +137,24 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
     if (info == nullptr) return make_error(where + ".normalization: expected one of " + normalization_list());
     channel.normalization = info->mode;
   }
+  return {};
+}
+
+Result<FeatureChannel> parse_channel(const Json& object, const std::string& where) {
+  if (!object.is_object()) return make_error(where + ": expected an object");
+  static const std::set<std::string> kKnown = {"name",   "kind",          "bone",   "second_bone",    "limb",
+                                               "curves", "offsets_seconds", "dims", "window_seconds", "weight",
+                                               "normalization"};
+  for (const auto& item : object.items()) {
+    if (!kKnown.count(item.key())) return make_error(where + "." + item.key() + ": unknown field");
+  }
+  FeatureChannel channel;
+  MMVK_ASSIGN_OR_RETURN(const ChannelKindInfo* const info, parse_name_and_kind(object, where, channel));
+  const std::string kind = object["kind"].get<std::string>();
+  MMVK_TRY(parse_bones(object, where, *info, kind, channel));
+  MMVK_TRY(parse_curves(object, where, *info, kind, channel));
+  MMVK_TRY(parse_offsets_and_dims(object, where, *info, kind, channel));
+  MMVK_TRY(parse_weighting(object, where, channel));
   return channel;
 }
 

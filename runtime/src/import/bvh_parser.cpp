@@ -169,8 +169,34 @@ class Parser {
     return {};
   }
 
+  // Open blocks while the hierarchy is read: a joint, or an End Site of that joint.
+  struct Block {
+    int joint;
+    bool end_site;
+    int open_line;
+    bool has_offset;
+    bool keep_end_site;
+  };
+
   Status parse_hierarchy() {
     int line = 0;
+    MMVK_TRY(parse_root(line));
+    std::vector<Block> open{{0, false, line, false, false}};
+    while (!open.empty()) {
+      const std::string owner =
+          open.back().end_site ? "End Site of " + describe(open.back().joint) : describe(open.back().joint);
+      const std::string_view token = cursor_.next_token(&line);
+      if (token.empty()) {
+        return fail(line, "unexpected end of file: missing '}' to close " + owner + " (opened at line " +
+                              std::to_string(open.back().open_line) + ")");
+      }
+      MMVK_TRY(parse_block_token(open, token, line, owner));
+    }
+    return number_channels(line);
+  }
+
+  // "HIERARCHY", then "ROOT name {".
+  Status parse_root(int& line) {
     std::string_view token = cursor_.next_token(&line);
     if (token.empty()) return fail(line, "file is empty (expected HIERARCHY)");
     // Nothing of a file is echoed before it is known to be BVH: a manifest
@@ -186,75 +212,81 @@ class Parser {
     if (!root_name) return root_name.status();
     file_.joints.emplace_back();
     file_.joints.back().name = root_name->first;
-    MMVK_TRY(expect_open_brace(root_name->second, "ROOT " + root_name->first));
+    return expect_open_brace(root_name->second, "ROOT " + root_name->first);
+  }
 
-    // Open blocks: a joint, or an End Site of that joint.
-    struct Block {
-      int joint;
-      bool end_site;
-      int open_line;
-      bool has_offset;
-      bool keep_end_site;
-    };
-    std::vector<Block> open{{0, false, line, false, false}};
-    while (!open.empty()) {
-      Block& block = open.back();
-      const std::string owner = block.end_site ? "End Site of " + describe(block.joint) : describe(block.joint);
-      token = cursor_.next_token(&line);
-      if (token.empty()) {
-        return fail(line, "unexpected end of file: missing '}' to close " + owner + " (opened at line " +
-                              std::to_string(block.open_line) + ")");
+  // One token inside the innermost open block (`owner` names it).
+  Status parse_block_token(std::vector<Block>& open, std::string_view token, int line, const std::string& owner) {
+    Block& block = open.back();
+    BvhJoint& joint = file_.joints[static_cast<std::size_t>(block.joint)];
+    if (iequals(token, "OFFSET")) {
+      if (block.has_offset) return fail(line, "second OFFSET in " + owner);
+      glm::vec3 ignored{0.0f};
+      glm::vec3& target = !block.end_site ? joint.offset : block.keep_end_site ? joint.end_site_offset : ignored;
+      MMVK_TRY(read_offset(line, target, owner));
+      block.has_offset = true;
+    } else if (iequals(token, "CHANNELS")) {
+      if (block.end_site) return fail(line, "an End Site has no CHANNELS (" + owner + ")");
+      MMVK_TRY(read_channels(line, joint, owner));
+    } else if (iequals(token, "JOINT")) {
+      MMVK_TRY(open_joint(open, line, owner));
+    } else if (iequals(token, "End")) {
+      MMVK_TRY(open_end_site(open, line, owner));
+    } else if (token == "}") {
+      if (!block.has_offset) {
+        return fail(line, owner + " (opened at line " + std::to_string(block.open_line) + ") has no OFFSET");
       }
-      BvhJoint& joint = file_.joints[static_cast<std::size_t>(block.joint)];
-      if (iequals(token, "OFFSET")) {
-        if (block.has_offset) return fail(line, "second OFFSET in " + owner);
-        glm::vec3 ignored{0.0f};
-        glm::vec3& target = !block.end_site ? joint.offset : block.keep_end_site ? joint.end_site_offset : ignored;
-        MMVK_TRY(read_offset(line, target, owner));
-        block.has_offset = true;
-      } else if (iequals(token, "CHANNELS")) {
-        if (block.end_site) return fail(line, "an End Site has no CHANNELS (" + owner + ")");
-        MMVK_TRY(read_channels(line, joint, owner));
-      } else if (iequals(token, "JOINT")) {
-        if (block.end_site) return fail(line, "JOINT inside an End Site (" + owner + ")");
-        if (!block.has_offset) return fail(line, owner + " has no OFFSET before its first child");
-        if (file_.joints.size() >= kMaxJoints) return fail(line, "more than " + std::to_string(kMaxJoints) + " joints");
-        auto name = read_name(line, "JOINT");
-        if (!name) return name.status();
-        const int parent = block.joint;
-        file_.joints.emplace_back();
-        file_.joints.back().name = name->first;
-        file_.joints.back().parent = parent;
-        MMVK_TRY(expect_open_brace(name->second, "JOINT " + name->first));
-        open.push_back({static_cast<int>(file_.joints.size()) - 1, false, line, false, false});
-      } else if (iequals(token, "End")) {
-        if (block.end_site) return fail(line, "End Site inside an End Site (" + owner + ")");
-        const std::string_view site = cursor_.next_token_on_line();
-        bool brace = false;
-        if (iequals(site, "Site{")) {
-          brace = true;
-        } else if (!iequals(site, "Site")) {
-          return fail(line, "expected 'End Site', got 'End' followed by " + (site.empty() ? "nothing" : quote(site)));
-        }
-        // A second End Site (some exporters write one per tip) is parsed and
-        // checked but not kept: BvhJoint holds one.
-        const bool keep = !joint.has_end_site;
-        joint.has_end_site = true;
-        MMVK_TRY(expect_open_brace(brace, "End Site of " + describe(block.joint)));
-        open.push_back({block.joint, true, line, false, keep});
-      } else if (token == "}") {
-        if (!block.has_offset) {
-          return fail(line, owner + " (opened at line " + std::to_string(block.open_line) + ") has no OFFSET");
-        }
-        open.pop_back();
-      } else if (iequals(token, "MOTION")) {
-        return fail(line, "missing '}' to close " + owner + " (opened at line " + std::to_string(block.open_line) +
-                              ") before MOTION");
-      } else {
-        return fail(line, "unexpected " + quote(token) + " in " + owner);
-      }
+      open.pop_back();
+    } else if (iequals(token, "MOTION")) {
+      return fail(line, "missing '}' to close " + owner + " (opened at line " + std::to_string(block.open_line) +
+                            ") before MOTION");
+    } else {
+      return fail(line, "unexpected " + quote(token) + " in " + owner);
     }
+    return {};
+  }
 
+  // "JOINT name {" inside a joint: the child joint's block opens.
+  Status open_joint(std::vector<Block>& open, int line, const std::string& owner) {
+    const Block& block = open.back();
+    if (block.end_site) return fail(line, "JOINT inside an End Site (" + owner + ")");
+    if (!block.has_offset) return fail(line, owner + " has no OFFSET before its first child");
+    if (file_.joints.size() >= kMaxJoints) return fail(line, "more than " + std::to_string(kMaxJoints) + " joints");
+    auto name = read_name(line, "JOINT");
+    if (!name) return name.status();
+    const int parent = block.joint;
+    file_.joints.emplace_back();
+    file_.joints.back().name = name->first;
+    file_.joints.back().parent = parent;
+    MMVK_TRY(expect_open_brace(name->second, "JOINT " + name->first));
+    open.push_back({static_cast<int>(file_.joints.size()) - 1, false, line, false, false});
+    return {};
+  }
+
+  // "End Site {" inside a joint.
+  Status open_end_site(std::vector<Block>& open, int line, const std::string& owner) {
+    const Block& block = open.back();
+    if (block.end_site) return fail(line, "End Site inside an End Site (" + owner + ")");
+    const std::string_view site = cursor_.next_token_on_line();
+    bool brace = false;
+    if (iequals(site, "Site{")) {
+      brace = true;
+    } else if (!iequals(site, "Site")) {
+      return fail(line, "expected 'End Site', got 'End' followed by " + (site.empty() ? "nothing" : quote(site)));
+    }
+    // A second End Site (some exporters write one per tip) is parsed and
+    // checked but not kept: BvhJoint holds one.
+    BvhJoint& joint = file_.joints[static_cast<std::size_t>(block.joint)];
+    const bool keep = !joint.has_end_site;
+    joint.has_end_site = true;
+    const int owner_joint = block.joint;
+    MMVK_TRY(expect_open_brace(brace, "End Site of " + describe(owner_joint)));
+    open.push_back({owner_joint, true, line, false, keep});
+    return {};
+  }
+
+  // Each joint's first channel in a frame's values, and their count.
+  Status number_channels(int line) {
     int channel_count = 0;
     for (BvhJoint& joint : file_.joints) {
       joint.first_channel = channel_count;

@@ -100,21 +100,16 @@ struct ClusterSearch::Layout {
   std::vector<Scratch> scratch;              // [pool threads]
 };
 
-Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& database, const ClusterTable& table,
-                                                            ThreadPool& pool, ClusterSearchOptions options) {
-  MMVK_TRY(validate_cluster_table(table, database));
-  auto layout = std::make_unique<Layout>();
-  Layout& l = *layout;
-  l.table = table;
-  l.dims = database.dims();
-  if (!detail::select_kernels(options.kernels, l.kernels)) {
-    return make_error("cluster search: this CPU cannot run the requested kernels (ClusterSearchOptions::kernels)");
-  }
+namespace {
+
+// The steps of ClusterSearch::create, in order.
+// Each cluster's members in its own run of whole tiles; pads are kNoFrame.
+void place_clusters(ClusterSearch::Layout& l, const ClusterTable& table, std::uint32_t& tile_packs) {
   const std::uint32_t k = table.cluster_count;
   l.tile_offsets.assign(k + 1, 0);
   l.tile_box_pack.assign(k, 0);
   l.never_candidate.resize(k);
-  std::uint32_t tile_packs = 0;
+  tile_packs = 0;
   for (std::uint32_t c = 0; c < k; ++c) {
     const std::uint32_t size = table.offsets[c + 1] - table.offsets[c];
     const std::uint32_t tiles_c = (size + kLanes - 1) / kLanes;
@@ -125,15 +120,18 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     tile_packs += static_cast<std::uint32_t>(packs_of(tiles_c));
     l.max_cluster_tiles = std::max(l.max_cluster_tiles, tiles_c);
   }
-  const std::size_t tiles = l.tile_offsets[k];
-  l.frame.assign(tiles * kLanes, kNoFrame);
+  l.frame.assign(std::size_t{l.tile_offsets[k]} * kLanes, kNoFrame);
   for (std::uint32_t c = 0; c < k; ++c) {
     std::copy(table.members.begin() + table.offsets[c], table.members.begin() + table.offsets[c + 1],
               l.frame.begin() + std::ptrdiff_t{l.tile_offsets[c]} * kLanes);
   }
-  l.rows = detail::TileStore::build(database, l.frame);
+}
+
+// A box per tile, and the rows each tile holds.
+void build_tile_boxes(ClusterSearch::Layout& l, const Database& database, std::uint32_t tile_packs) {
+  const std::uint32_t k = l.table.cluster_count;
   l.tile_boxes = detail::BoxPacks(tile_packs, l.dims);
-  l.tile_rows.assign(tiles, 0);
+  l.tile_rows.assign(l.tile_offsets[k], 0);
   for (std::uint32_t c = 0; c < k; ++c) {
     for (std::uint32_t tile = l.tile_offsets[c]; tile < l.tile_offsets[c + 1]; ++tile) {
       detail::BoxAccumulator box(l.dims);
@@ -146,6 +144,11 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
       l.tile_boxes.set(std::size_t{l.tile_box_pack[c]} * kLanes + (tile - l.tile_offsets[c]), box);
     }
   }
+}
+
+// A box per span of 16 tiles, for clusters of more than one span.
+void build_span_boxes(ClusterSearch::Layout& l, const Database& database) {
+  const std::uint32_t k = l.table.cluster_count;
   l.span_box_pack.assign(k, kNoCluster);
   std::uint32_t span_packs = 0;
   for (std::uint32_t c = 0; c < k; ++c) {
@@ -169,6 +172,11 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
       l.span_boxes.set(std::size_t{l.span_box_pack[c]} * kLanes + span, box);
     }
   }
+}
+
+// The clusters' boxes and centroids, from the table.
+void build_cluster_boxes(ClusterSearch::Layout& l, const ClusterTable& table) {
+  const std::uint32_t k = table.cluster_count;
   const std::size_t cluster_packs = packs_of(k);
   l.cluster_boxes = detail::BoxPacks(cluster_packs, l.dims);
   l.centroids = detail::BoxPacks(cluster_packs, l.dims);
@@ -178,7 +186,13 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
                         table.min_bias[c]);
     l.centroids.set(c, table.centroids.data() + at, table.centroids.data() + at, 1.0f, 0.0f);
   }
-  l.scratch.resize(pool.thread_count());
+}
+
+// Per-thread scratch, sized once so that searches allocate nothing.
+void size_scratch(ClusterSearch::Layout& l, unsigned threads) {
+  const std::uint32_t k = l.table.cluster_count;
+  const std::size_t cluster_packs = packs_of(k);
+  l.scratch.resize(threads);
   for (Scratch& s : l.scratch) {
     s.order.reserve(k);
     s.bound.resize(cluster_packs * kLanes);
@@ -192,6 +206,27 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.cursor.resize(kSubBatch);
     s.candidate_end.resize(kSubBatch);
   }
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& database, const ClusterTable& table,
+                                                            ThreadPool& pool, ClusterSearchOptions options) {
+  MMVK_TRY(validate_cluster_table(table, database));
+  auto layout = std::make_unique<Layout>();
+  Layout& l = *layout;
+  l.table = table;
+  l.dims = database.dims();
+  if (!detail::select_kernels(options.kernels, l.kernels)) {
+    return make_error("cluster search: this CPU cannot run the requested kernels (ClusterSearchOptions::kernels)");
+  }
+  std::uint32_t tile_packs = 0;
+  place_clusters(l, table, tile_packs);
+  l.rows = detail::TileStore::build(database, l.frame);
+  build_tile_boxes(l, database, tile_packs);
+  build_span_boxes(l, database);
+  build_cluster_boxes(l, table);
+  size_scratch(l, pool.thread_count());
   return std::unique_ptr<ClusterSearch>(new ClusterSearch(database, pool, options, std::move(layout)));
 }
 

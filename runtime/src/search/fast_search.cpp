@@ -69,143 +69,202 @@ SearchStats FastSearch::stats() const { return stats_; }
 std::string_view FastSearch::kernel_name() const { return layout_->kernels.name; }
 void FastSearch::reset_stats() { stats_ = {}; }
 
-void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
-                              std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best,
-                              unsigned thread) {
-  const Database& db = *database_;
-  const Layout& l = *layout_;
-  Workspace::Thread& scratch = workspace_->threads[thread];
-  const QueryParams default_params;
-  const std::uint32_t dims = l.dims;
-  const std::uint32_t first_row = first_group * kGroupRows;
-  const std::uint32_t end_row = std::min<std::uint64_t>(std::uint64_t{end_group} * kGroupRows, l.frames);
-  auto params_of = [&](std::size_t q) -> const QueryParams& {
-    return batch.params.empty() ? default_params : batch.params[q];
-  };
-  auto best_of = [&](std::size_t q) { return best.subspan((q - first_query) * k, k); };
-  auto query_of = [&](std::size_t q) { return batch.features.subspan(q * dims, dims); };
-  // Tiles hold the frames in order: a hit's slot is its frame.
-  auto offer = [&](const detail::LaneHit& hit, std::size_t q) {
-    detail::offer_tile_row(db, params_of(q), best_of(q), Match{hit.slot, hit.cost});
-  };
-  std::uint64_t rows = 0;
+namespace {
+
+// One thread's pass of FastSearch::search_range over queries
+// [first_query, end_query) and the rows of groups [first_group, end_group),
+// in its steps: the continuing frames, then brute force or pruning.
+class RangePass {
+ public:
+  RangePass(const Database& db, const FastSearch::Layout& layout, FastSearch::Workspace::Thread& scratch,
+            const QueryBatch& batch, const QueryParams& default_params, std::uint32_t k, std::size_t first_query,
+            std::size_t end_query, std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best)
+      : db_(db), l_(layout), scratch_(scratch), batch_(batch), default_params_(default_params), k_(k),
+        first_query_(first_query), end_query_(end_query), first_group_(first_group), end_group_(end_group),
+        best_(best) {}
+
+  std::uint64_t rows() const { return rows_; }
 
   // The continuing frame first: its cost carries continuing_bias (possibly
   // negative), so the tile pass, which knows no such bias, skips it.
-  for (std::size_t q = first_query; q < end_query; ++q) {
-    const std::span<Match> list = best_of(q);
-    std::fill(list.begin(), list.end(), Match{});
-    const QueryParams& params = params_of(q);
-    const std::uint32_t cont = params.continuing_frame;
-    if (cont != kNoFrame && cont >= first_row && cont < end_row && is_candidate(db, cont, params)) {
-      detail::insert_sorted(list, Match{cont, frame_cost(db, cont, query_of(q), params)});
-      ++rows;
+  void seed_continuing_frames() {
+    const std::uint32_t first_row = first_group_ * kGroupRows;
+    const std::uint32_t end_row = std::min<std::uint64_t>(std::uint64_t{end_group_} * kGroupRows, l_.frames);
+    for (std::size_t q = first_query_; q < end_query_; ++q) {
+      const std::span<Match> list = best_of(q);
+      std::fill(list.begin(), list.end(), Match{});
+      const QueryParams& params = params_of(q);
+      const std::uint32_t cont = params.continuing_frame;
+      if (cont != kNoFrame && cont >= first_row && cont < end_row && is_candidate(db_, cont, params)) {
+        detail::insert_sorted(list, Match{cont, frame_cost(db_, cont, query_of(q), params)});
+        ++rows_;
+      }
     }
   }
 
-  const detail::TileArrays tiles = l.tile_arrays();
-  auto tile_rows = [&](std::uint32_t tile) { return std::min(kFastTileRows, l.frames - tile * kFastTileRows); };
-
-  if (!options_.prune) {
-    const std::uint32_t block_groups = std::max<std::uint32_t>(1, (options_.rows_per_block + kGroupRows - 1) / kGroupRows);
-    for (std::uint32_t block = first_group; block < end_group; block += block_groups) {
-      const std::uint32_t block_end = std::min(end_group, block + block_groups);
-      for (std::size_t q = first_query; q < end_query;) {
+  // Every candidate row, blocks of rows_per_block at a time, up to
+  // Kernels::brute_queries queries sharing each pass over a block.
+  void brute(std::uint32_t rows_per_block) {
+    const detail::TileArrays tiles = l_.tile_arrays();
+    const std::uint32_t block_groups = std::max<std::uint32_t>(1, (rows_per_block + kGroupRows - 1) / kGroupRows);
+    for (std::uint32_t block = first_group_; block < end_group_; block += block_groups) {
+      const std::uint32_t block_end = std::min(end_group_, block + block_groups);
+      for (std::size_t q = first_query_; q < end_query_;) {
         std::uint32_t count = 1;
-        while (count * 2 <= l.kernels.brute_queries && q + count * 2 <= end_query) count *= 2;
-        std::array<detail::KernelQuery, kBruteQueries> queries{};
-        for (std::uint32_t i = 0; i < count; ++i) {
-          queries[i].features = query_of(q + i).data();
-          queries[i].weights = params_of(q + i).channel_weights.data();
-        }
-        auto any_query_may_match = [&](const detail::BlockSummary& summary) {
-          for (std::uint32_t i = 0; i < count; ++i) {
-            if (detail::block_may_match(summary, params_of(q + i))) return true;
-          }
-          return false;
-        };
-        for (std::uint32_t group = block; group < block_end; ++group) {
-          if (!any_query_may_match(l.group_summary[group])) continue;
-          std::size_t tile_count = 0;
-          std::uint32_t group_rows = 0;
-          const std::uint32_t end_tile = std::min(l.tiles, (group + 1) * kFastGroupTiles);
-          for (std::uint32_t tile = group * kFastGroupTiles; tile < end_tile; ++tile) {
-            if (!any_query_may_match(l.tile_summary[tile])) continue;
-            scratch.tile_ids[tile_count++] = tile;
-            group_rows += tile_rows(tile);
-          }
-          for (std::uint32_t i = 0; i < count; ++i) queries[i].threshold = best_of(q + i)[k - 1].cost;
-          const std::size_t hits =
-              l.kernels.evaluate_tiles(tiles, queries.data(), count, scratch.tile_ids.data(), tile_count, scratch.hits.data());
-          rows += std::uint64_t{group_rows} * count;
-          for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q + scratch.hits[h].query);
-        }
+        while (count * 2 <= l_.kernels.brute_queries && q + count * 2 <= end_query_) count *= 2;
+        brute_block(tiles, block, block_end, q, count);
         q += count;
       }
     }
-    thread_rows_[thread] += rows;
-    return;
   }
 
   // Pruned: visit groups by ascending lower bound, stop at the first bound
   // above the k-th best (strictly: an equal cost may still win on frame id).
-  const detail::BoxArrays group_boxes = l.group_boxes();
-  const detail::BoxArrays tile_boxes = l.tile_boxes();
-  std::array<float, detail::kLanes> bounds{};
-  for (std::size_t q = first_query; q < end_query; ++q) {
-    const QueryParams& params = params_of(q);
-    const float* query = query_of(q).data();
-    const float* weights = params.channel_weights.data();
-    const std::span<Match> list = best_of(q);
-    scratch.group_order.clear();
-    for (std::uint32_t pack = first_group / detail::kLanes; pack * detail::kLanes < end_group; ++pack) {
-      l.kernels.box_bounds(group_boxes, pack, 1, query, weights, bounds.data());
-      for (std::uint32_t lane = 0; lane < detail::kLanes; ++lane) {
-        const std::uint32_t group = pack * detail::kLanes + lane;
-        if (group < first_group || group >= end_group || !detail::block_may_match(l.group_summary[group], params)) continue;
-        // A NaN bound (0 x inf on overflow) proves nothing: visit first.
-        const float bound = std::isnan(bounds[lane]) ? -std::numeric_limits<float>::infinity() : bounds[lane];
-        scratch.group_order.emplace_back(bound, group);
+  void pruned() {
+    const detail::TileArrays tiles = l_.tile_arrays();
+    const detail::BoxArrays group_boxes = l_.group_boxes();
+    const detail::BoxArrays tile_boxes = l_.tile_boxes();
+    for (std::size_t q = first_query_; q < end_query_; ++q) {
+      order_groups(group_boxes, q);
+      std::vector<std::pair<float, std::uint32_t>>& order = scratch_.group_order;
+      if (order.empty()) continue;
+      const std::span<Match> list = best_of(q);
+      // Visit the most promising group first: its rows usually set a k-th
+      // best that rules out most groups, so only the rest need sorting.
+      const auto seed = std::min_element(order.begin(), order.end());
+      const std::uint32_t seed_group = seed->second;
+      *seed = order.back();
+      order.pop_back();
+      visit_group(tiles, tile_boxes, q, seed_group);
+      const float worst = list[k_ - 1].cost;
+      order.erase(std::remove_if(order.begin(), order.end(), [&](const auto& entry) { return entry.first > worst; }),
+                  order.end());
+      std::sort(order.begin(), order.end());
+      for (const auto& [group_bound, group] : order) {
+        if (group_bound > list[k_ - 1].cost) break;
+        visit_group(tiles, tile_boxes, q, group);
       }
-    }
-    detail::KernelQuery kernel_query{query, weights, 0.0f};
-    auto visit = [&](std::uint32_t group) {
-      l.kernels.box_bounds(tile_boxes, group, 1, query, weights, bounds.data());
-      std::size_t tile_count = 0;
-      std::uint32_t group_rows = 0;
-      const std::uint32_t first_tile = group * kFastGroupTiles;
-      const std::uint32_t end_tile = std::min(l.tiles, first_tile + kFastGroupTiles);
-      for (std::uint32_t tile = first_tile; tile < end_tile; ++tile) {
-        if (bounds[tile - first_tile] > list[k - 1].cost || !detail::block_may_match(l.tile_summary[tile], params)) continue;
-        scratch.tile_ids[tile_count++] = tile;
-        group_rows += tile_rows(tile);
-      }
-      if (tile_count == 0) return;
-      kernel_query.threshold = list[k - 1].cost;
-      const std::size_t hits =
-          l.kernels.evaluate_tiles(tiles, &kernel_query, 1, scratch.tile_ids.data(), tile_count, scratch.hits.data());
-      rows += group_rows;
-      for (std::size_t h = 0; h < hits; ++h) offer(scratch.hits[h], q);
-    };
-    std::vector<std::pair<float, std::uint32_t>>& order = scratch.group_order;
-    if (order.empty()) continue;
-    // Visit the most promising group first: its rows usually set a k-th
-    // best that rules out most groups, so only the rest need sorting.
-    const auto seed = std::min_element(order.begin(), order.end());
-    const std::uint32_t seed_group = seed->second;
-    *seed = order.back();
-    order.pop_back();
-    visit(seed_group);
-    const float worst = list[k - 1].cost;
-    order.erase(std::remove_if(order.begin(), order.end(), [&](const auto& entry) { return entry.first > worst; }),
-                order.end());
-    std::sort(order.begin(), order.end());
-    for (const auto& [group_bound, group] : order) {
-      if (group_bound > list[k - 1].cost) break;
-      visit(group);
     }
   }
-  thread_rows_[thread] += rows;
+
+ private:
+  const QueryParams& params_of(std::size_t q) const { return batch_.params.empty() ? default_params_ : batch_.params[q]; }
+  std::span<Match> best_of(std::size_t q) const { return best_.subspan((q - first_query_) * k_, k_); }
+  std::span<const float> query_of(std::size_t q) const { return batch_.features.subspan(q * l_.dims, l_.dims); }
+  std::uint32_t tile_rows(std::uint32_t tile) const { return std::min(kFastTileRows, l_.frames - tile * kFastTileRows); }
+  // Tiles hold the frames in order: a hit's slot is its frame.
+  void offer(const detail::LaneHit& hit, std::size_t q) {
+    detail::offer_tile_row(db_, params_of(q), best_of(q), Match{hit.slot, hit.cost});
+  }
+
+  // Queries [q, q + count) over the groups [block, block_end), skipping the
+  // groups and tiles that none of them may match.
+  void brute_block(const detail::TileArrays& tiles, std::uint32_t block, std::uint32_t block_end, std::size_t q,
+                   std::uint32_t count) {
+    std::array<detail::KernelQuery, kBruteQueries> queries{};
+    for (std::uint32_t i = 0; i < count; ++i) {
+      queries[i].features = query_of(q + i).data();
+      queries[i].weights = params_of(q + i).channel_weights.data();
+    }
+    auto any_query_may_match = [&](const detail::BlockSummary& summary) {
+      for (std::uint32_t i = 0; i < count; ++i) {
+        if (detail::block_may_match(summary, params_of(q + i))) return true;
+      }
+      return false;
+    };
+    for (std::uint32_t group = block; group < block_end; ++group) {
+      if (!any_query_may_match(l_.group_summary[group])) continue;
+      std::size_t tile_count = 0;
+      std::uint32_t group_rows = 0;
+      const std::uint32_t end_tile = std::min(l_.tiles, (group + 1) * kFastGroupTiles);
+      for (std::uint32_t tile = group * kFastGroupTiles; tile < end_tile; ++tile) {
+        if (!any_query_may_match(l_.tile_summary[tile])) continue;
+        scratch_.tile_ids[tile_count++] = tile;
+        group_rows += tile_rows(tile);
+      }
+      for (std::uint32_t i = 0; i < count; ++i) queries[i].threshold = best_of(q + i)[k_ - 1].cost;
+      const std::size_t hits = l_.kernels.evaluate_tiles(tiles, queries.data(), count, scratch_.tile_ids.data(),
+                                                         tile_count, scratch_.hits.data());
+      rows_ += std::uint64_t{group_rows} * count;
+      for (std::size_t h = 0; h < hits; ++h) offer(scratch_.hits[h], q + scratch_.hits[h].query);
+    }
+  }
+
+  // scratch_.group_order = (lower bound, group) for the groups query q may match.
+  void order_groups(const detail::BoxArrays& group_boxes, std::size_t q) {
+    const QueryParams& params = params_of(q);
+    std::array<float, detail::kLanes> bounds{};
+    scratch_.group_order.clear();
+    for (std::uint32_t pack = first_group_ / detail::kLanes; pack * detail::kLanes < end_group_; ++pack) {
+      l_.kernels.box_bounds(group_boxes, pack, 1, query_of(q).data(), params.channel_weights.data(), bounds.data());
+      for (std::uint32_t lane = 0; lane < detail::kLanes; ++lane) {
+        const std::uint32_t group = pack * detail::kLanes + lane;
+        if (group < first_group_ || group >= end_group_ || !detail::block_may_match(l_.group_summary[group], params)) {
+          continue;
+        }
+        // A NaN bound (0 x inf on overflow) proves nothing: visit first.
+        const float bound = std::isnan(bounds[lane]) ? -std::numeric_limits<float>::infinity() : bounds[lane];
+        scratch_.group_order.emplace_back(bound, group);
+      }
+    }
+  }
+
+  // Query q over the tiles of one group whose bounds may beat its k-th best.
+  void visit_group(const detail::TileArrays& tiles, const detail::BoxArrays& tile_boxes, std::size_t q,
+                   std::uint32_t group) {
+    const QueryParams& params = params_of(q);
+    const std::span<Match> list = best_of(q);
+    detail::KernelQuery kernel_query{query_of(q).data(), params.channel_weights.data(), 0.0f};
+    std::array<float, detail::kLanes> bounds{};
+    l_.kernels.box_bounds(tile_boxes, group, 1, kernel_query.features, kernel_query.weights, bounds.data());
+    std::size_t tile_count = 0;
+    std::uint32_t group_rows = 0;
+    const std::uint32_t first_tile = group * kFastGroupTiles;
+    const std::uint32_t end_tile = std::min(l_.tiles, first_tile + kFastGroupTiles);
+    for (std::uint32_t tile = first_tile; tile < end_tile; ++tile) {
+      if (bounds[tile - first_tile] > list[k_ - 1].cost || !detail::block_may_match(l_.tile_summary[tile], params)) {
+        continue;
+      }
+      scratch_.tile_ids[tile_count++] = tile;
+      group_rows += tile_rows(tile);
+    }
+    if (tile_count == 0) return;
+    kernel_query.threshold = list[k_ - 1].cost;
+    const std::size_t hits =
+        l_.kernels.evaluate_tiles(tiles, &kernel_query, 1, scratch_.tile_ids.data(), tile_count, scratch_.hits.data());
+    rows_ += group_rows;
+    for (std::size_t h = 0; h < hits; ++h) offer(scratch_.hits[h], q);
+  }
+
+  const Database& db_;
+  const FastSearch::Layout& l_;
+  FastSearch::Workspace::Thread& scratch_;
+  const QueryBatch& batch_;
+  // Kept outside the pass, like every array the kernels are given: no
+  // pointer into the pass escapes to them, so its fields stay in registers.
+  const QueryParams& default_params_;
+  const std::uint32_t k_;
+  const std::size_t first_query_, end_query_;
+  const std::uint32_t first_group_, end_group_;
+  const std::span<Match> best_;
+  std::uint64_t rows_ = 0;
+};
+
+}  // namespace
+
+void FastSearch::search_range(const QueryBatch& batch, std::uint32_t k, std::size_t first_query, std::size_t end_query,
+                              std::uint32_t first_group, std::uint32_t end_group, std::span<Match> best,
+                              unsigned thread) {
+  const QueryParams default_params;
+  RangePass pass(*database_, *layout_, workspace_->threads[thread], batch, default_params, k, first_query, end_query,
+                 first_group, end_group, best);
+  pass.seed_continuing_frames();
+  if (options_.prune) {
+    pass.pruned();
+  } else {
+    pass.brute(options_.rows_per_block);
+  }
+  thread_rows_[thread] += pass.rows();
 }
 
 Status FastSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) {

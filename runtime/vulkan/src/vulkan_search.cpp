@@ -153,7 +153,13 @@ struct VulkanSearch::Impl {
     if (chunk >= 16) chunk -= chunk % 16;  // whole query tiles per chunk
     return static_cast<std::uint32_t>(chunk);
   }
+  // submit() in steps: a free slot for a valid batch, the queries written
+  // into its mapped buffers, its commands recorded.
   Result<Ticket> submit(const QueryBatch& batch, std::uint32_t k, std::uint32_t forced_tile);
+  Result<Slot*> slot_for(const QueryBatch& batch, std::uint32_t k);
+  void stage_queries(Slot& slot, const QueryBatch& batch);
+  Status record_search(Slot& slot, std::uint32_t count, std::uint32_t k, std::uint32_t chunk,
+                       std::uint32_t forced_tile);
   Result<Slot*> find_ticket(const Ticket& ticket, const char* caller);
   Status wait(const Ticket& ticket, std::span<Match> out);
   // Starts paging `batch` (its first pages, up to the free slots).
@@ -366,7 +372,7 @@ std::vector<std::string_view> VulkanSearch::kernels() const {
 
 Result<Ticket> VulkanSearch::submit(const QueryBatch& batch, std::uint32_t k) { return impl_->submit(batch, k, 0); }
 
-Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t k, std::uint32_t forced_tile) {
+Result<Slot*> VulkanSearch::Impl::slot_for(const QueryBatch& batch, std::uint32_t k) {
   if (context->device_lost()) return context->device_lost_error();
   if (batch.size > options.max_batch) {
     return make_error("VulkanSearch: batch of " + std::to_string(batch.size) + " queries is over max_batch = " +
@@ -380,10 +386,12 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
     return make_error("VulkanSearch: all " + std::to_string(slots.size()) +
                       " submission slots are in flight; wait() for a ticket first");
   }
-  Slot& slot = *free_slot;
-  const std::span<const Match> validation_out(slot.validation_out.data(), batch.size * std::size_t{k});
+  const std::span<const Match> validation_out(free_slot->validation_out.data(), batch.size * std::size_t{k});
   MMVK_TRY(validate_search(*database, batch, k, validation_out));
+  return &*free_slot;
+}
 
+void VulkanSearch::Impl::stage_queries(Slot& slot, const QueryBatch& batch) {
   const std::uint32_t count = static_cast<std::uint32_t>(batch.size);
   const std::uint32_t dims = shape.dims;
   const std::uint32_t padded = shape.dim_vec4s * 4;
@@ -417,17 +425,10 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
       weights[std::size_t{q} * shape.channels + c] = p.channel_weights[channel_of_weight[c]];
     }
   }
+}
 
-  slot.serial = next_serial++;
-  slot.batch = count;
-  slot.k = k;
-  if (count == 0) {
-    slot.in_flight = true;  // nothing to run; wait() returns at once
-    return Ticket{static_cast<std::uint32_t>(&slot - slots.data()), slot.serial};
-  }
-
-  const std::uint32_t chunk = chunk_for(k);
-  if (chunk == 0) return make_error("VulkanSearch: the scratch buffer cannot hold one query for k = " + std::to_string(k));
+Status VulkanSearch::Impl::record_search(Slot& slot, std::uint32_t count, std::uint32_t k, std::uint32_t chunk,
+                                         std::uint32_t forced_tile) {
   const VkCommandBuffer commands = slot.commands;
   const std::uint32_t slot_index = static_cast<std::uint32_t>(&slot - slots.data());
   MMVK_VK_CHECK(vkResetCommandBuffer(commands, 0));
@@ -452,10 +453,29 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
     vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps.get(), 2 * slot_index + 1);
   }
   MMVK_VK_CHECK(vkEndCommandBuffer(commands));
+  return {};
+}
 
+Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t k, std::uint32_t forced_tile) {
+  MMVK_ASSIGN_OR_RETURN(Slot* const found, slot_for(batch, k));
+  Slot& slot = *found;
+  stage_queries(slot, batch);
+  const std::uint32_t count = static_cast<std::uint32_t>(batch.size);
+  const std::uint32_t slot_index = static_cast<std::uint32_t>(&slot - slots.data());
+  slot.serial = next_serial++;
+  slot.batch = count;
+  slot.k = k;
+  if (count == 0) {
+    slot.in_flight = true;  // nothing to run; wait() returns at once
+    return Ticket{slot_index, slot.serial};
+  }
+
+  const std::uint32_t chunk = chunk_for(k);
+  if (chunk == 0) return make_error("VulkanSearch: the scratch buffer cannot hold one query for k = " + std::to_string(k));
+  MMVK_TRY(record_search(slot, count, k, chunk, forced_tile));
   const VkFence fence = slot.fence.get();
   MMVK_VK_CHECK(vkResetFences(context->device(), 1, &fence));
-  MMVK_TRY(detail::submit(*context, commands, fence));
+  MMVK_TRY(detail::submit(*context, slot.commands, fence));
   slot.in_flight = true;
   stats.queries += count;
   // Cluster modes count their rows on the GPU (added in wait()).

@@ -1,0 +1,115 @@
+#include "tick_observers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "mmvk/trajectory.hpp"
+
+namespace mmvk::crowd {
+
+namespace {
+
+// The 1 s horizon of the trajectory error, as the controller would predict it.
+constexpr float kErrorHorizon[1] = {1.0f};
+
+MotionMeterParams motion_params(const CrowdController& controller, const ControllerParams& params,
+                                const ClipQuality& clips, double dt, double rate_hz, double fps) {
+  MotionMeterParams p;
+  p.legs = find_leg_joints(controller.animation());
+  p.planted_height = clips.planted_height;
+  p.dt = dt;
+  // The spacing of the pose acceleration samples: the database's frame
+  // interval in ticks (motion_meter.hpp).
+  p.acceleration_step = std::uint32_t(std::clamp(std::lround(rate_hz / fps), 1L, 16L));
+  // Three half-lives: the inertialization's blend has done 90% of its work.
+  p.jump_window_s = 3.0 * params.inertialization_half_life;
+  return p;
+}
+
+}  // namespace
+
+void TickFigures::reserve(std::uint64_t ticks) { search_ms_.reserve(ticks), tick_ms_.reserve(ticks); }
+
+void TickFigures::record(std::uint64_t tick, double tick_ms, double search_ms, std::span<const Match> matches,
+                         std::uint64_t searches) {
+  tick_ms_.push_back(tick_ms);
+  search_ms_.push_back(search_ms);
+  chosen_.add_u32(std::uint32_t(tick));
+  chosen_.add_u32(std::uint32_t(matches.size()));
+  for (const Match& m : matches) chosen_.add_u32(m.frame);
+  searches_ += searches;
+}
+
+void TickFigures::summarize(CrowdSummary& s, double wall_seconds) const {
+  s.searches = searches_;
+  s.queries_per_tick = s.ticks ? double(searches_) / double(s.ticks) : 0.0;
+  s.search_ms_p50 = percentile(search_ms_, 0.5);
+  s.search_ms_p99 = percentile(search_ms_, 0.99);
+  s.tick_ms_p50 = percentile(tick_ms_, 0.5);
+  s.tick_ms_p99 = percentile(tick_ms_, 0.99);
+  s.wall_seconds = wall_seconds;
+  s.realtime_factor = wall_seconds > 0.0 ? s.seconds / wall_seconds : 0.0;
+  s.chosen_frames_hash = chosen_.digest();
+}
+
+QualityObserver::QualityObserver(const CrowdController& controller, const ControllerParams& params,
+                                 const ClipQuality& clips, double dt, double rate_hz, double fps)
+    : spring_(params.spring),
+      meter_(controller.size(), dt),
+      motion_(controller.size(), controller.animation().joint_count(),
+              motion_params(controller, params, clips, dt, rate_hz, fps)),
+      desired_xz_(2 * std::size_t{controller.size()}),
+      root_xz_(2 * std::size_t{controller.size()}),
+      animated_(std::size_t{controller.size()} * controller.animation().joint_count()) {}
+
+void QualityObserver::observe(const CrowdController& controller, const TickView& view, ThreadPool& pool) {
+  // Where the controller wants each character 1 s from now, and where it is.
+  const auto sim = controller.simulation();
+  const auto roots = controller.root_positions();
+  glm::vec3 horizon_pos[1];
+  float horizon_yaw[1];
+  for (std::size_t b = 0; b < view.desired.size(); ++b) {
+    const float yaw = view.desired_yaw.empty() ? yaw_of_velocity(view.desired[b], sim[b].yaw) : view.desired_yaw[b];
+    predict_trajectory(sim[b], view.desired[b], yaw, spring_, kErrorHorizon, horizon_pos, horizon_yaw);
+    desired_xz_[2 * b] = horizon_pos[0].x, desired_xz_[2 * b + 1] = horizon_pos[0].z;
+    root_xz_[2 * b] = roots[b].x, root_xz_[2 * b + 1] = roots[b].z;
+  }
+  meter_.record_trajectory(desired_xz_, root_xz_);
+  meter_.add_transitions(controller.last_tick().jumps);
+  meter_.end_tick();
+  // The pose as displayed (after foot IK) and as animated (before).
+  controller.animated_world_positions(animated_, pool);
+  motion_.record({view.world, animated_, controller.contacts(), controller.foot_locked(),
+                  controller.ik_reach_clamped(), controller.jumped()});
+}
+
+void QualityObserver::summarize(CrowdSummary& s) const {
+  s.trajectory_error_m_1s = meter_.trajectory_error_m_median();
+  s.motion = motion_.figures();
+  s.transitions_per_agent_s = meter_.transitions_per_agent_s();
+}
+
+RecordingObserver::RecordingObserver(const CrowdController& controller, const Scenario& scenario, std::string title,
+                                     float dt, std::uint32_t ticks_per_sample)
+    : recorder_(controller, scenario, std::move(title), dt, ticks_per_sample),
+      frames_before_(controller.size()),
+      kinds_before_(controller.size(), 0) {
+  searched_before_.reserve(controller.size());
+  searched_now_.reserve(controller.size());
+}
+
+void RecordingObserver::observe(const CrowdController& controller, const TickView& view) {
+  recorder_.record_tick(view.tick, view.matches, searched_before_, kinds_before_, frames_before_, view.world);
+  searched_now_.clear();
+  const auto kinds = controller.searched();
+  for (std::uint32_t b = 0; b < kinds.size(); ++b) {
+    if (kinds[b] != 0) searched_now_.push_back(b);
+  }
+  searched_before_.swap(searched_now_);
+  std::copy(kinds.begin(), kinds.end(), kinds_before_.begin());
+  const auto frames = controller.frames();
+  std::copy(frames.begin(), frames.end(), frames_before_.begin());
+}
+
+}  // namespace mmvk::crowd

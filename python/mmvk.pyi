@@ -125,7 +125,7 @@ class Crowd:
                  rate: float = 30.0, seed: int = 1, device: Optional[int] = None,
                  scenario: Union[None, PathLike, Mapping[str, Any]] = None,
                  search_interval: float = 0.1, foot_ik: bool = True, record: bool = False,
-                 title: str = "") -> None: ...
+                 title: str = "", correction_half_life: Optional[float] = None) -> None: ...
     def step(self, desired_velocity: Optional[FloatArray] = None,
              desired_facing: Optional[FloatArray] = None) -> None:
         """One tick: own steering, or desired_velocity float32 [agents x 2|3] m/s and

@@ -13,6 +13,7 @@
 
 #include "clip_quality.hpp"
 #include "crowd_backend.hpp"
+#include "crowd_defaults.hpp"
 #include "crowd_limits.hpp"
 #include "crowd_paths.hpp"
 #include "default_data.hpp"
@@ -24,6 +25,7 @@
 #include "observed_search.hpp"
 #include "progress_line.hpp"
 #include "quality_meter.hpp"
+#include "run_summary.hpp"
 #include "scenario.hpp"
 #include "steering.hpp"
 #include "tick_observers.hpp"
@@ -83,33 +85,6 @@ Result<Scenario> make_scenario(const CrowdOptions& options, bool can_run) {
 }
 
 
-// Added to the cost of the frame a character would play anyway: a jump must
-// win by this much. Queries measure the pose the character shows, which
-// (blended) lies further from every stored row than the row of the frame
-// it plays did, so the bias that holds jumps to the same rate is larger.
-// Measured with clusters, 200 characters, 10 s, seed 1, 30 Hz (trajectory
-// error at 1 s, foot sliding before IK, transitions per character per s):
-//   CMU 131:  -1: 0.046 m, 19.3 cm/s, 1.70;  -2: 0.050 m, 19.5, 1.27;  -3: 0.051 m, 20.2, 1.09
-//   Bandai:   -1: 0.042 m, 24.9 cm/s, 2.50;  -2: 0.045 m, 24.8, 1.90
-// (queries copied from the played frame's row, bias -1: CMU 0.055 m, 18.5,
-// 1.32; Bandai 0.045 m, 25.8, 2.05). With foot IK and 1,000 characters for
-// 20 s, Bandai jumped 2.04 times a second at -2, 1.86 at -2.5 and 1.74 at
-// -3, following its paths 0.046, 0.047 and 0.048 m off (CMU: 1.30, 1.23,
-// 1.17; 0.049, 0.050, 0.050 m). Feature costs are sums of squared z-scores,
-// so the scale carries over to other databases.
-constexpr float kContinuingBias = -2.5f;
-
-// The root correction's half-life (ControllerParams::correction_half_life,
-// 0.2 s by default). Foot locking holds planted feet against the correction,
-// so the crowd can pull characters onto their paths harder than the
-// animation alone could hide. 1,000 characters x 20 s (trajectory error at
-// 1 s, sliding after IK, transitions per second):
-//   CMU 131, 60 Hz:  0.2 s: 0.051 m, 0.38 cm/s, 1.23;  0.15 s: 0.042, 0.34, 1.18;  0.1 s: 0.031, 0.31, 1.11
-//   Bandai, 60 Hz:   0.2 s: 0.048 m, 0.95 cm/s, 1.93;  0.15 s: 0.043, 0.89, 1.88;  0.1 s: 0.036, 0.87, 1.87
-// 0.1 s clamps the legs' reach more often (7.1% of foot-ticks on CMU against
-// 5.4%), so 0.15 s, for data of the user's; a shipped set carries its own
-// (default_data.cpp).
-constexpr float kCorrectionHalfLife = 0.15f;
 
 // --weights on every character's query options; errors name --weights.
 Status apply_weights(const CrowdOptions& options, const Database& database, std::span<QueryParams> params) {
@@ -275,32 +250,6 @@ class TickLoop {
   double wall_seconds_ = 0.0;
 };
 
-// The run's settings and the figures measured before and after the loop.
-CrowdSummary summarize_run(const CrowdOptions& options, const OpenedDatabase& opened, const std::string& db_name,
-                           const Scenario& scenario, const GaitSpeeds& speeds, const CrowdSearch& search,
-                           const CrowdController& controller, std::uint64_t ticks) {
-  const Database& db = opened.database;
-  CrowdSummary s;
-  s.agents = controller.size();
-  s.ticks = ticks;
-  s.seconds = double(ticks) / options.rate_hz;
-  s.rate_hz = options.rate_hz;
-  s.search_interval_s = options.search_interval_s;
-  s.seed = options.seed;
-  s.scenario = scenario.source;
-  s.database = opened.path.empty() ? db_name : opened.path.string();
-  s.database_frames = db.frame_count();
-  s.walk_mps = speeds.walk_mps;
-  s.run_mps = speeds.has_run ? speeds.run_mps : std::nan("");  // null in the JSON
-  s.runners = count_runners(scenario);
-  if (!speeds.has_run) s.notes.push_back("run_mps is null: the data has no run (" + speeds.no_run_reason + ")");
-  s.backend = std::string(search.backend->name());
-  s.device = search.device;
-  s.forced_searches = controller.totals().forced;
-  s.no_candidate = controller.totals().no_candidate;
-  s.foot_ik = options.foot_ik;
-  return s;
-}
 
 }  // namespace
 
@@ -340,13 +289,11 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   progress.finish();
 
   // Summary: the figures, then the outputs.
-  CrowdSummary s = summarize_run(options, opened, data.label, scenario, speeds, search, controller, ticks);
-  s.correction_half_life_s = std::round(double(params.correction_half_life) * 1e6) / 1e6;  // 0.07, not 0.0700000003
+  CrowdSummary s =
+      summarize_run({db, scenario, speeds, search, controller, params, quality, clips, steering, ticks, options.rate_hz,
+                     options.search_interval_s, options.seed, options.foot_ik});
+  s.database = opened.path.empty() ? data.label : opened.path.string();
   loop.summarize(s);
-  quality.summarize(s);
-  s.clips = clips.figures;
-  s.planted_height_m = clips.planted_height;
-  s.goals_reached = steering.goals_reached();
   if (Status saved = save_crowd_pipeline_cache(search); !saved && log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }

@@ -6,9 +6,11 @@
 #include <utility>
 
 #include "clip_quality.hpp"
+#include "crowd_defaults.hpp"
 #include "crowd_limits.hpp"
 #include "gait_plan.hpp"
 #include "observed_search.hpp"
+#include "run_summary.hpp"
 #include "viewer/viewer_html.hpp"
 
 namespace mmvk::crowd {
@@ -16,12 +18,6 @@ namespace mmvk::crowd {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// The controller settings `mmvk crowd` runs with (crowd_run.cpp says how
-// they were measured): a jump must beat playing on by 2.5, and the root is
-// pulled onto the simulated path with a 0.15 s half-life.
-constexpr float kContinuingBias = -2.5f;
-constexpr float kCorrectionHalfLife = 0.15f;
 
 Status check_options(const CrowdSessionOptions& o) {
   if (!o.scenario && o.agents == 0) return make_error("agents must be at least 1");
@@ -32,6 +28,9 @@ Status check_options(const CrowdSessionOptions& o) {
   if (!(o.rate_hz > 0.0) || !std::isfinite(o.rate_hz)) return make_error("rate must be a positive number (Hz)");
   if (!(o.search_interval_s > 0.0) || !std::isfinite(o.search_interval_s)) {
     return make_error("search_interval must be a positive number (seconds)");
+  }
+  if (o.correction_half_life && !(std::isfinite(*o.correction_half_life) && *o.correction_half_life > 0.0f)) {
+    return make_error("correction_half_life must be a positive number (seconds)");
   }
   return {};
 }
@@ -72,7 +71,7 @@ Result<std::unique_ptr<CrowdSession>> CrowdSession::create(const Database& datab
   ControllerParams params;
   params.search_interval = float(options.search_interval_s);
   params.continuing_bias = kContinuingBias;
-  params.correction_half_life = kCorrectionHalfLife;
+  params.correction_half_life = options.correction_half_life.value_or(kCorrectionHalfLife);
   params.foot_ik.enabled = options.foot_ik;
   MMVK_ASSIGN_OR_RETURN(CrowdController controller, CrowdController::create(database, agents, params));
   s->controller_.emplace(std::move(controller));
@@ -88,8 +87,8 @@ Result<std::unique_ptr<CrowdSession>> CrowdSession::create(const Database& datab
   s->steering_ = std::make_unique<Steering>(s->scenario_, s->speeds_);
   // The clips first: their planted toe height is the crowd's floor.
   const ClipQuality clips = measure_clip_quality(database, s->pool_);
-  s->clip_figures_ = clips.figures;
-  s->planted_height_ = clips.planted_height;
+  s->clips_ = clips;
+  s->params_ = params;
   s->quality_ = std::make_unique<QualityObserver>(c, params, clips, s->dt_, options.rate_hz, database.fps());
   if (options.record) {
     const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
@@ -150,30 +149,10 @@ Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const fl
 }
 
 CrowdSummary CrowdSession::summary() const {
-  const CrowdController& c = *controller_;
-  CrowdSummary s;
-  s.agents = agents_;
-  s.ticks = ticks_;
-  s.seconds = double(ticks_) * dt_;
-  s.rate_hz = options_.rate_hz;
-  s.search_interval_s = options_.search_interval_s;
-  s.seed = options_.seed;
-  s.scenario = scenario_.source;
-  s.database_frames = database_.frame_count();
-  s.walk_mps = speeds_.walk_mps;
-  s.run_mps = speeds_.has_run ? speeds_.run_mps : std::nan("");
-  s.runners = count_runners(scenario_);
-  if (!speeds_.has_run) s.notes.push_back("run_mps is null: the data has no run (" + speeds_.no_run_reason + ")");
-  s.backend = std::string(search_.backend->name());
-  s.device = search_.device;
-  s.forced_searches = c.totals().forced;
-  s.no_candidate = c.totals().no_candidate;
-  s.foot_ik = options_.foot_ik;
+  CrowdSummary s = summarize_run({database_, scenario_, speeds_, search_, *controller_, params_, *quality_, clips_,
+                                  *steering_, ticks_, options_.rate_hz, options_.search_interval_s, options_.seed,
+                                  options_.foot_ik});
   figures_.summarize(s, wall_s_);
-  quality_->summarize(s);
-  s.clips = clip_figures_;
-  s.planted_height_m = planted_height_;
-  s.goals_reached = steering_->goals_reached();
   return s;
 }
 

@@ -23,6 +23,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "clip_quality.hpp"
 #include "crowd_backend.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
@@ -49,6 +50,9 @@ struct CrowdSessionOptions {
   std::string backend = "clusters"; // a backend registry name (mmvk/backends.hpp)
   std::optional<std::uint32_t> device;  // Vulkan device index; none = the best
   bool foot_ik = true;
+  // The root correction's half-life, seconds (> 0); none: the crowd's
+  // default (crowd_defaults.hpp).
+  std::optional<float> correction_half_life;
   // Keep the viewer's recording, for write_html().
   bool record = false;
   std::string title;                // the viewer page's header; empty: made up
@@ -112,8 +116,8 @@ class CrowdSession {
   TickFigures figures_;
   std::unique_ptr<QualityObserver> quality_;
   std::unique_ptr<RecordingObserver> recording_;
-  MotionFigures clip_figures_;
-  std::array<float, 2> planted_height_{0.0f, 0.0f};
+  ControllerParams params_;
+  ClipQuality clips_;
 
   // Per tick, sized once.
   std::vector<float> x_, z_, vx_, vz_;

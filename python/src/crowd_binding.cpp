@@ -144,19 +144,13 @@ crowd::Scenario scenario_of(const py::object& scenario) {
   return take(crowd::load_scenario(path), kind_for_input(path));
 }
 
-}  // namespace
-
-void bind_crowd(py::module_& m) {
-  py::class_<PyCrowd>(
-      m, "Crowd",
-      "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
-      "figures. Crowd(db, agents=None, backend='clusters', rate=30.0, seed=1, device=None, scenario=None, "
-      "search_interval=0.1, foot_ik=True, record=False, title=''). agents: the number of characters, drawn with "
-      "goals from seed (default 100), or scenario: a scenario JSON file or dict (starts, goals, speeds, tags; "
-      "`mmvk crowd --scenario`), which sets the count. record=True keeps the viewer's recording for write_html().")
+// Crowd(db, ...): the options of `mmvk crowd`.
+void add_construction(py::class_<PyCrowd>& crowd) {
+  crowd
       .def(py::init([](std::shared_ptr<Database> db, const py::object& agents, const std::string& backend,
                        double rate, std::uint64_t seed, const py::object& device, const py::object& scenario,
-                       double search_interval, bool foot_ik, bool record, const std::string& title) {
+                       double search_interval, bool foot_ik, bool record, const std::string& title,
+                       const py::object& correction_half_life) {
              CrowdSessionOptions options;
              options.backend = backend;
              options.rate_hz = rate;
@@ -166,6 +160,7 @@ void bind_crowd(py::module_& m) {
              options.record = record;
              options.title = title;
              if (!device.is_none()) options.device = device.cast<std::uint32_t>();
+             if (!correction_half_life.is_none()) options.correction_half_life = correction_half_life.cast<float>();
              if (!scenario.is_none()) {
                options.scenario = scenario_of(scenario);
                if (!agents.is_none() && agents.cast<std::size_t>() != options.scenario->agents.size()) {
@@ -183,7 +178,12 @@ void bind_crowd(py::module_& m) {
            py::arg("db"), py::arg("agents") = py::none(), py::arg("backend") = "clusters", py::arg("rate") = 30.0,
            py::arg("seed") = 1, py::arg("device") = py::none(), py::arg("scenario") = py::none(),
            py::arg("search_interval") = 0.1, py::arg("foot_ik") = true, py::arg("record") = false,
-           py::arg("title") = "")
+           py::arg("title") = "", py::arg("correction_half_life") = py::none());
+}
+
+// The ticks: the crowd's own steering, or another simulator's.
+void add_stepping(py::class_<PyCrowd>& crowd) {
+  crowd
       .def("step", &PyCrowd::step, py::arg("desired_velocity") = py::none(), py::arg("desired_facing") = py::none(),
            "step() -> None; step(desired_velocity, desired_facing=None) -> None\n\n"
            "One tick of 1/rate seconds. Without arguments the crowd's own steering seeks each character's goals. "
@@ -203,7 +203,12 @@ void bind_crowd(py::module_& m) {
           },
           py::arg("index"), py::arg("x"), py::arg("z"), py::arg("yaw") = 0.0f, py::arg("frame") = 0,
           "Places character `index` at (x, z) metres facing `yaw` radians, playing database frame `frame`; its "
-          "next tick searches.")
+          "next tick searches.");
+}
+
+// The run's settings and the data's speeds.
+void add_settings(py::class_<PyCrowd>& crowd) {
+  crowd
       .def_property_readonly("agents", &PyCrowd::agents, "The number of characters.")
       .def_property_readonly("rate", [](const PyCrowd& c) { return 1.0 / c.session().dt(); }, "Ticks per second.")
       .def_property_readonly("dt", [](const PyCrowd& c) { return c.session().dt(); }, "Seconds per tick.")
@@ -227,7 +232,12 @@ void bind_crowd(py::module_& m) {
             for (const auto& plan : c.session().scenario().agents) goals.push_back(plan.goals);
             return goals;
           },
-          "Each character's goal points [(x, z), ...] (its own steering visits them in turn).")
+          "Each character's goal points [(x, z), ...] (its own steering visits them in turn).");
+}
+
+// Each character's state after the last step, as NumPy arrays (copies).
+void add_state_arrays(py::class_<PyCrowd>& crowd) {
+  crowd
       .def_property_readonly(
           "root_positions",
           [](const PyCrowd& c) {
@@ -272,7 +282,12 @@ void bind_crowd(py::module_& m) {
             return vec3_array(world, {py::ssize_t(c.agents()), joints, 3});
           },
           "The displayed global joint positions after the last step (foot IK included), float32 [agents x joints "
-          "x 3], metres.")
+          "x 3], metres.");
+}
+
+// The summary, the viewer page and the repr.
+void add_outputs(py::class_<PyCrowd>& crowd) {
+  crowd
       .def(
           "summary",
           [](const PyCrowd& c) {
@@ -298,7 +313,26 @@ void bind_crowd(py::module_& m) {
       .def("__repr__", [](const PyCrowd& c) {
         return "<mmvk.Crowd: " + std::to_string(c.agents()) + " agents, " + std::to_string(c.session().ticks()) +
                " ticks>";
-      });
+      });;
+}
+
+}  // namespace
+
+void bind_crowd(py::module_& m) {
+  py::class_<PyCrowd> crowd(
+      m, "Crowd",
+      "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
+      "figures. Crowd(db, agents=None, backend='clusters', rate=30.0, seed=1, device=None, scenario=None, "
+      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None). agents: the number of characters, drawn with "
+      "goals from seed (default 100), or scenario: a scenario JSON file or dict (starts, goals, speeds, tags; "
+      "`mmvk crowd --scenario`), which sets the count. correction_half_life: seconds of the pull of each "
+      "character's animated root towards its simulated position (None: 0.15; `mmvk crowd --correction-half-life`; "
+      "the shipped cmu-walk-run set is tuned for 0.07). record=True keeps the viewer's recording for write_html().");
+  add_construction(crowd);
+  add_stepping(crowd);
+  add_settings(crowd);
+  add_state_arrays(crowd);
+  add_outputs(crowd);
 }
 
 }  // namespace mmvk::python

@@ -237,14 +237,9 @@ void bind_animation(py::module_& m) {
       });
 }
 
-}  // namespace
-
-void bind_database(py::module_& m) {
-  bind_animation(m);
-  py::class_<Database, std::shared_ptr<Database>>(
-      m, "Database",
-      "A motion matching database: the normalized feature matrix, its normalization, clips, tags, per-frame flags "
-      "and (unless built without) the animation. Immutable. Made by mmvk.build() or Database.load().")
+// Database.load and .save.
+void add_files(py::class_<Database, std::shared_ptr<Database>>& database) {
+  database
       .def_static(
           "load",
           [](const py::object& path) {
@@ -268,11 +263,21 @@ void bind_database(py::module_& m) {
             }
             check(saved, ErrorKind::OS);
           },
-          py::arg("path"), "Writes the database to an .mmdb file (atomically: a failed save leaves any old file). Raises OSError.")
+          py::arg("path"), "Writes the database to an .mmdb file (atomically: a failed save leaves any old file). Raises OSError.");
+}
+
+// Frames, dims and fps.
+void add_sizes(py::class_<Database, std::shared_ptr<Database>>& database) {
+  database
       .def_property_readonly("frame_count", &Database::frame_count, "Frames (rows of features).")
       .def_property_readonly("dims", &Database::dims, "Feature dimensions (columns of features).")
       .def_property_readonly("fps", &Database::fps, "Frames per second.")
-      .def("__len__", &Database::frame_count)
+      .def("__len__", &Database::frame_count);
+}
+
+// Per-frame arrays: read-only views of the database's memory.
+void add_frame_arrays(py::class_<Database, std::shared_ptr<Database>>& database) {
+  database
       .def_property_readonly(
           "features",
           [](const py::object& self) {
@@ -300,7 +305,12 @@ void bind_database(py::module_& m) {
             const Database& db = database_of(self);
             return view(self, db.frame_clip().data(), {py::ssize_t(db.frame_count())});
           },
-          "The clip of each frame, uint32 [frames] (an index into clips).")
+          "The clip of each frame, uint32 [frames] (an index into clips).");
+}
+
+// Tags, channels, clips, the schema, the animation, normalization and the repr.
+void add_description(py::class_<Database, std::shared_ptr<Database>>& database) {
+  database
       .def_property_readonly(
           "tags", [](const Database& db) { return std::vector<std::string>(db.tag_names().begin(), db.tag_names().end()); },
           "Tag names; tag t is bit t of frame_tags.")
@@ -341,6 +351,20 @@ void bind_database(py::module_& m) {
         return "<mmvk.Database: " + std::to_string(db.frame_count()) + " frames, " + std::to_string(db.dims()) +
                " dims, " + std::to_string(db.clips().size()) + " clips>";
       });
+}
+
+}  // namespace
+
+void bind_database(py::module_& m) {
+  bind_animation(m);
+  py::class_<Database, std::shared_ptr<Database>> database(
+      m, "Database",
+      "A motion matching database: the normalized feature matrix, its normalization, clips, tags, per-frame flags "
+      "and (unless built without) the animation. Immutable. Made by mmvk.build() or Database.load().");
+  add_files(database);
+  add_sizes(database);
+  add_frame_arrays(database);
+  add_description(database);
 
   m.def("build", &build, py::arg("source"), py::arg("schema") = py::none(),
         "build(source, schema=None, **manifest_fields) -> Database\n\n"

@@ -23,19 +23,22 @@ def builtin(db):
     return crowd.summary()
 
 
-def test_own_steering_is_the_command_lines_run(db, cli, tmp_path):
-    crowd = mmvk.Crowd(db, agents=12, backend="clusters", seed=5)
+@pytest.mark.parametrize("half_life", [None, 0.07])
+def test_own_steering_is_the_command_lines_run(db, cli, tmp_path, half_life):
+    crowd = mmvk.Crowd(db, agents=12, backend="clusters", seed=5, correction_half_life=half_life)
     for _ in range(90):
         crowd.step()
     summary = crowd.summary()
     out = tmp_path / "crowd.json"
     env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))
     subprocess.run([str(cli), "crowd", "--data", str(CMU131), "--agents", "12", "--seconds", "3", "--backend",
-                    "clusters", "--seed", "5", "--summary", str(out)], check=True, capture_output=True, env=env)
+                    "clusters", "--seed", "5", "--summary", str(out)]
+                   + ([] if half_life is None else ["--correction-half-life", str(half_life)]),
+                   check=True, capture_output=True, env=env)
     want = json.loads(out.read_text())
     # The same chosen frames, in order, and the same figures (summed in
     # floating point over characters, so to a relative 1e-6).
-    for key in ["agents", "ticks", "searches", "chosen_frames_hash", "goals_reached"]:
+    for key in ["agents", "ticks", "searches", "chosen_frames_hash", "goals_reached", "correction_half_life_s"]:
         assert summary[key] == want[key], key
     for key in ["trajectory_error_m_1s", "foot_sliding_cm_s", "transitions_per_agent_s", "walk_mps"]:
         assert summary[key] == pytest.approx(want[key], rel=1e-6), key
@@ -121,3 +124,5 @@ def test_arrays_and_errors(db, tmp_path):
     assert crowd.write_html(tmp_path / "crowd.html") > 1000
     with pytest.raises(ValueError, match="unknown backend"):
         mmvk.Crowd(db, agents=2, backend="nope")
+    with pytest.raises(ValueError, match="correction_half_life must be a positive number"):
+        mmvk.Crowd(db, agents=2, correction_half_life=0.0)

@@ -1,0 +1,41 @@
+// The summary figures that both hosts of the crowd fill the same way:
+// `mmvk crowd` (crowd_run.cpp) and the stepped crowd (crowd_session.hpp,
+// the Python module's mmvk.Crowd). Each adds what only it knows: the
+// database's name, the ticks' timings (TickFigures) and the outputs written.
+#pragma once
+
+#include <cstdint>
+
+#include "clip_quality.hpp"
+#include "crowd_backend.hpp"
+#include "gait_speeds.hpp"
+#include "mmvk/crowd_controller.hpp"
+#include "mmvk/database.hpp"
+#include "scenario.hpp"
+#include "steering.hpp"
+#include "summary.hpp"
+#include "tick_observers.hpp"
+
+namespace mmvk::crowd {
+
+// What the run is made of, after its ticks, and how it was set up.
+struct RunParts {
+  const Database& database;
+  const Scenario& scenario;
+  const GaitSpeeds& speeds;
+  const CrowdSearch& search;
+  const CrowdController& controller;
+  const ControllerParams& params;
+  const QualityObserver& quality;
+  const ClipQuality& clips;
+  const Steering& steering;
+  std::uint64_t ticks;
+  double rate_hz;
+  double search_interval_s;
+  std::uint64_t seed;
+  bool foot_ik;
+};
+
+CrowdSummary summarize_run(const RunParts& run);
+
+}  // namespace mmvk::crowd

@@ -33,6 +33,12 @@
 //     of the two legs, at most max_hip_drop, followed by a critically
 //     damped spring (hip_half_life) that moves with the wanted drop up to
 //     max_hip_goal_rate.
+//   - knees: a solved leg bends toward its knee's kept direction: the
+//     animated knee's when the animated leg is clearly bent (10% of its
+//     length off the hip-ankle line), held while it is nearly straight (under
+//     2%), turned toward it in between; so lowering the hips, which bends
+//     legs the animation holds straight, never flips a knee to the side its
+//     noise points.
 // A foot without correction, with the hips not lowered, is left exactly as
 // animated (no solve).
 //
@@ -180,6 +186,7 @@ class FootLocker {
   // Per foot [B x 2].
   std::vector<std::uint8_t> locked_, clamped_, point_, drifted_;
   std::vector<glm::vec3> anchor_, offset_, offset_rate_;
+  std::vector<glm::vec3> knee_direction_;  // the knee's kept bend direction, character space (zero: none yet)
   std::vector<float> anchor_yaw_, yaw_offset_, yaw_rate_;
   // Per character [B].
   std::vector<float> hip_drop_, hip_drop_rate_, hip_goal_;  // hip_goal_: the last tick's wanted drop

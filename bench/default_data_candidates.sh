@@ -58,13 +58,13 @@ walk16=$(manifest walk16 "$walks" "$wide" "")
 # settings (cmu-walk-run: correction half-life 0.07 s; cmu-walks 0.15 s) and
 # a manifest with the crowd's (0.15 s) unless the row sets one.
 candidates=(
-  "cmu-walk-run (CMU 16 walks, jogs, a run; gait tags)|cmu-walk-run|"
+  "cmu-walk-run, the default (CMU 16 walks, jogs, a run; gait tags)|cmu-walk-run|"
   "cmu-walk-run, correction 0.15 s|cmu-walk-run|--correction-half-life 0.15"
   "cmu-walk-run, correction 0.1 s|cmu-walk-run|--correction-half-life 0.1"
   "cmu-walk-run, default contact thresholds|$all_default|--correction-half-life 0.07"
   "cmu-walk-run, runners also search the jogs|$jogs_run|--correction-half-life 0.07"
   "CMU 16 walks only (16_23, 16_27)|$walk16|--correction-half-life 0.07"
-  "cmu-walks (CMU 131, the default)|cmu-walks|"
+  "cmu-walks (CMU 131, the default before)|cmu-walks|"
   "60 Hz: cmu-walk-run|cmu-walk-run|--rate 60"
   "60 Hz: cmu-walk-run, correction 0.15 s|cmu-walk-run|--correction-half-life 0.15 --rate 60"
   "60 Hz: CMU 16 walks only|$walk16|--correction-half-life 0.07 --rate 60"

@@ -1,7 +1,7 @@
 // The database `mmvk crowd` animates: an .mmdb as it is, or a manifest or a
 // folder of BVH built once and cached, or one of the motion sets shipped in
 // host/crowd/data by name (--data cmu-walks). Without --data, the default
-// set: the trimmed CMU subject 131 walks (cmu-walks).
+// set: the trimmed CMU subject 16 walks and runs (cmu-walk-run).
 // A shipped set carries the crowd settings it was tuned with; each flag
 // overrides its setting (bench/RESULTS.md, "The default data").
 //

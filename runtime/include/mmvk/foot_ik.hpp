@@ -6,8 +6,10 @@
 // The knee bends in the plane of the animated leg: the pole is the animated
 // knee's offset from the animated hip-to-ankle line, so a target in that
 // plane keeps the knee in it, and a target off it turns the plane about the
-// hip-to-target axis as little as the pole allows. Near full extension the
-// reach is softened (soft_reach) so the knee never snaps straight.
+// hip-to-target axis as little as the pole allows (solve_two_bone_ik_toward
+// takes the pole from its caller instead: the foot locker keeps each knee's
+// direction while the animated leg is nearly straight). Near full extension
+// the reach is softened (soft_reach) so the knee never snaps straight.
 #pragma once
 
 #include <glm/gtc/quaternion.hpp>
@@ -61,5 +63,14 @@ struct TwoBoneIkSolution {
 // soft_start in (0, 1] (FootIkParams::soft_reach_start).
 TwoBoneIkSolution solve_two_bone_ik(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle,
                                     const glm::vec3& target, const glm::vec3& pole_hint, float soft_start);
+
+// As solve_two_bone_ik, with the knee bent toward `pole` (any length; its
+// part perpendicular to the hip-to-target line counts) instead of the
+// animated knee's plane: for a caller that keeps the bend direction of a
+// nearly straight animated leg, whose own plane is noise (FootLocker). A
+// pole along the target line, or zero, bends toward the animated knee's
+// offset, then any perpendicular.
+TwoBoneIkSolution solve_two_bone_ik_toward(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle,
+                                           const glm::vec3& target, const glm::vec3& pole, float soft_start);
 
 }  // namespace mmvk

@@ -33,6 +33,12 @@
 //     of the two legs, at most max_hip_drop, followed by a critically
 //     damped spring (hip_half_life) that moves with the wanted drop up to
 //     max_hip_goal_rate.
+//   - knees: a solved leg bends toward its knee's kept direction: the
+//     animated knee's when the animated leg is clearly bent (10% of its
+//     length off the hip-ankle line), held while it is nearly straight (under
+//     2%), turned toward it in between; so lowering the hips, which bends
+//     legs the animation holds straight, never flips a knee to the side its
+//     noise points.
 // A foot without correction, with the hips not lowered, is left exactly as
 // animated (no solve).
 //
@@ -87,12 +93,17 @@ struct FootIkParams {
   // "The default data"): chasing a still goal (before) gave CMU 16
   // (cmu-walk-run) 0.60 / 0.74 cm/s, CMU 131 0.51 / 0.34, Bandai 0.86 / 0.89;
   // following it at up to 1 m/s 0.35 / 0.45, 0.42 / 0.23, 0.63 / 0.65 (0.5
-  // m/s: 0.38 / 0.49, 0.42 / 0.23, 0.68 / 0.68). A 0.2 m drop would take CMU
-  // 16 to 0.19 / 0.26, but bends near-straight legs so far that their knees
-  // flip sides in a tick (tests/data/crowd_controller_test.cpp: a knee moved
-  // 0.46 m in one tick against 0.37 at 0.1 m); a faster hip spring (0.03 s)
-  // shakes the pose (its acceleration p99 up 8%).
-  float max_hip_drop = 0.1f;
+  // m/s: 0.38 / 0.49, 0.42 / 0.23, 0.68 / 0.68), all with a 0.1 m drop.
+  // The drop (same runs, each knee keeping its direction while its leg is
+  // nearly straight): 0.1 m 0.35 / 0.45, 0.42 / 0.23, 0.63 / 0.65; 0.15 m
+  // 0.25 / 0.33, 0.42 / 0.23, 0.49 / 0.51; 0.2 m 0.19 / 0.26, 0.42 / 0.23,
+  // 0.42 / 0.44; 0.3 m 0.16 / 0.22, 0.42 / 0.23, 0.39 / 0.41; no other
+  // figure moved, and the worst displayed joint step of
+  // tests/data/crowd_controller_test.cpp was 0.22 m up to 0.2 m, 0.23 at 0.3
+  // (before the knees kept their direction, 0.2 m flipped a knee: 0.46 m in
+  // one tick). 0.2 m: most of the gain without a deeper crouch. A faster hip
+  // spring (0.03 s) shakes the pose (its acceleration p99 up 8%).
+  float max_hip_drop = 0.2f;
   float hip_half_life = 0.1f;
   float max_hip_goal_rate = 1.0f;
   // Keep the ankle and toe joints at or above the floor: floor_height
@@ -194,8 +205,9 @@ class FootLocker {
   inline float wanted_hip_drop(std::size_t side, const FootTarget& target, const glm::vec3* world) const;
   inline float lower_hips(std::uint32_t b, float dt, float wanted_drop, const glm::quat& root, const glm::quat* global,
                           glm::vec3* translations, glm::vec3* world);
-  inline void solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::quat& root,
-                        glm::quat* global, glm::quat* rotations, const glm::vec3* translations, glm::vec3* world);
+  inline void solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::vec3& pole,
+                        const glm::quat& root, glm::quat* global, glm::quat* rotations,
+                        const glm::vec3* translations, glm::vec3* world);
 
   std::uint32_t characters_ = 0;
   FootIkParams params_;
@@ -210,6 +222,7 @@ class FootLocker {
   // Per foot [B x 2].
   std::vector<std::uint8_t> locked_, clamped_, point_, drifted_;
   std::vector<glm::vec3> anchor_, offset_, offset_rate_;
+  std::vector<glm::vec3> knee_direction_;  // the knee's kept bend direction, character space (zero: none yet)
   std::vector<float> anchor_yaw_, yaw_offset_, yaw_rate_;
   // Per character [B].
   std::vector<float> hip_drop_, hip_drop_rate_, hip_goal_;  // hip_goal_: the last tick's wanted drop

@@ -43,6 +43,17 @@ constexpr std::uint8_t kToeBit[2] = {kContactLeftToe, kContactRightToe};
 constexpr std::uint8_t kHeel = 0;
 constexpr std::uint8_t kToe = 1;
 
+// The knee's bend direction: an animated leg bent less than kBentFrom of
+// its length (the knee's offset from the hip-ankle line; 2%: a knee flexed
+// about 5 degrees) says nothing about where its knee points, as motion
+// capture's noise turns that offset about the leg, even behind it; one bent
+// kBentAt (10%, about 23 degrees) says it exactly. In between the kept
+// direction turns toward the animated one, the faster the more it is bent:
+// by the fraction w = smoothstep of the bend in kKneeFollowTime.
+constexpr float kBentFrom = 0.02f;
+constexpr float kBentAt = 0.1f;
+constexpr float kKneeFollowTime = 1.0f / 30.0f;
+
 glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
 
 glm::vec3 horizontal(const glm::vec3& v) { return {v.x, 0.0f, v.z}; }
@@ -80,6 +91,42 @@ glm::vec3 foot_heading(const AnimationData& animation, const FootLocker::Leg& le
     global = animation.local_rotations[static_cast<std::size_t>(j)] * global;
   }
   return glm::normalize(glm::inverse(global) * glm::vec3(0.0f, 0.0f, 1.0f));
+}
+
+// The direction a leg's knee bends toward (world, unit) this tick, from the
+// kept one (character space; zero: none yet, the character's forward) and
+// the animated leg; the kept one is updated. Continuous in time for any
+// animation: a nearly straight leg keeps the direction its knee had. A leg
+// shown as animated (`solved` false) takes its animated knee's direction as
+// soon as it is bent at all (past kBentFrom): that is where its knee is
+// shown, so a solve that starts next tick starts from it.
+glm::vec3 follow_knee(glm::vec3& kept, const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle,
+                      const glm::quat& root, float dt, bool solved) {
+  const glm::vec3 previous = kept == glm::vec3(0.0f) ? root * glm::vec3(0.0f, 0.0f, 1.0f) : root * kept;
+  const glm::vec3 hip_ankle = ankle - hip;
+  const float extension = glm::length(hip_ankle);
+  const float leg = glm::length(knee - hip) + glm::length(ankle - knee);
+  if (!(extension > 1e-6f)) return previous;
+  const glm::vec3 axis = hip_ankle / extension;
+  const glm::vec3 animated = (knee - hip) - axis * glm::dot(knee - hip, axis);
+  const float animated_length = glm::length(animated);
+  const float x = std::clamp((animated_length / leg - kBentFrom) / (kBentAt - kBentFrom), 0.0f, 1.0f);
+  const float w = x * x * (3.0f - 2.0f * x);
+  glm::vec3 direction = previous;
+  if (w >= 1.0f || (!solved && w > 0.0f)) {
+    direction = animated / animated_length;
+  } else if (w > 0.0f && dt > 0.0f) {
+    // Turned about the axis between them (through the side when they are
+    // opposite), never through zero as a blend of the two would.
+    const float fraction = 1.0f - std::pow(1.0f - w, dt / kKneeFollowTime);
+    direction = glm::slerp(kIdentity, rotation_between(previous, animated), fraction) * previous;
+  }
+  direction -= axis * glm::dot(direction, axis);
+  const float length = glm::length(direction);
+  if (!(length > 1e-6f)) return previous;  // along the leg: the animated leg turned onto it; keep the last
+  direction /= length;
+  kept = glm::conjugate(root) * direction;
+  return direction;
 }
 
 }  // namespace
@@ -174,6 +221,7 @@ Result<FootLocker> FootLocker::create(const AnimationData& animation, std::uint3
   locker.anchor_.assign(feet, glm::vec3(0.0f));
   locker.offset_.assign(feet, glm::vec3(0.0f));
   locker.offset_rate_.assign(feet, glm::vec3(0.0f));
+  locker.knee_direction_.assign(feet, glm::vec3(0.0f));
   locker.anchor_yaw_.assign(feet, 0.0f);
   locker.yaw_offset_.assign(feet, 0.0f);
   locker.yaw_rate_.assign(feet, 0.0f);
@@ -193,7 +241,7 @@ void FootLocker::clear(std::uint32_t b) {
   for (std::size_t f = std::size_t{b} * 2; f < std::size_t{b} * 2 + 2; ++f) {
     locked_[f] = clamped_[f] = drifted_[f] = 0;
     point_[f] = kHeel;
-    anchor_[f] = offset_[f] = offset_rate_[f] = glm::vec3(0.0f);
+    anchor_[f] = offset_[f] = offset_rate_[f] = knee_direction_[f] = glm::vec3(0.0f);
     anchor_yaw_[f] = yaw_offset_[f] = yaw_rate_[f] = 0.0f;
   }
   hip_drop_[b] = hip_drop_rate_[b] = hip_goal_[b] = 0.0f;
@@ -248,12 +296,18 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
   const float drop = lower_hips(b, dt, wanted_drop, root, global, translations, world);
 
   // Two-bone IK on each leg that has a correction (both when the hips are
-  // lowered: the other foot must stay where it was animated).
+  // lowered: the other foot must stay where it was animated). The knee bends
+  // toward its kept direction (follow_knee), kept on every tick so that it
+  // is current when a solve starts.
   for (std::size_t side = 0; side < 2; ++side) {
     const std::size_t f = std::size_t{b} * 2 + side;
     clamped_[f] = 0;
-    if (!targets[side].solve && drop <= 0.0f) continue;
-    solve_leg(f, side, targets[side], root, global, rotations, translations, world);
+    const Leg& leg = legs_[side];
+    const bool solve = targets[side].solve || drop > 0.0f;
+    const glm::vec3 pole =
+        follow_knee(knee_direction_[f], world[leg.upper], world[leg.lower], world[leg.foot], root, dt, solve);
+    if (!solve) continue;
+    solve_leg(f, side, targets[side], pole, root, global, rotations, translations, world);
   }
 }
 
@@ -439,12 +493,12 @@ float FootLocker::lower_hips(std::uint32_t b, float dt, float wanted_drop, const
 }
 
 // Two-bone IK on one leg, then the leg's joints again from the upper leg down.
-void FootLocker::solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::quat& root,
-                           glm::quat* global, glm::quat* rotations, const glm::vec3* translations, glm::vec3* world) {
+void FootLocker::solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::vec3& pole,
+                           const glm::quat& root, glm::quat* global, glm::quat* rotations,
+                           const glm::vec3* translations, glm::vec3* world) {
   const Leg& leg = legs_[side];
-  const glm::vec3 forward = root * glm::vec3(0.0f, 0.0f, 1.0f);
-  const TwoBoneIkSolution solution = solve_two_bone_ik(world[leg.upper], world[leg.lower], world[leg.foot],
-                                                       target.ankle, forward, params_.soft_reach_start);
+  const TwoBoneIkSolution solution = solve_two_bone_ik_toward(world[leg.upper], world[leg.lower], world[leg.foot],
+                                                              target.ankle, pole, params_.soft_reach_start);
   clamped_[f] = solution.clamped ? 1 : 0;
   for (const int joint : leg_joints_[side]) {
     const std::size_t j = static_cast<std::size_t>(joint);

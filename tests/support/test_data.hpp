@@ -21,7 +21,9 @@ std::filesystem::path test_source_dir();
 // programs (MMVK_BUILD_HOST=OFF).
 std::optional<std::filesystem::path> cli_binary();
 
-// A fresh, empty temporary directory unique to the running test.
+// A fresh, empty temporary directory unique to the running test, removed
+// when the test ends unless it failed (made outside a test: when the
+// program ends).
 std::filesystem::path make_temp_dir();
 
 }  // namespace mmvk::test

@@ -126,23 +126,33 @@ const Variant kExactVariants[] = {
     {"generic kernels, no nearest seed", {.nprobe = 0, .seed_nearest = false, .kernels = CpuKernels::Generic}},
 };
 
+// 200 clusters: several groups of 32 (the level above the clusters, whose
+// bounds decide which cluster bounds are computed at all); both walks.
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
   const Database db = make_database();
-  const ClusterTable table = make_table(db, 30);
   ThreadPool pool(2);
   ReferenceSearch reference(db);
   const ConstrainedQueries queries = constrained_queries(db, 240, 11);
   const std::size_t count = queries.count;
   const QueryBatch batch = queries.batch();
-  for (std::uint32_t k : {1u, 3u, 16u}) {
-    std::vector<Match> expected(count * k);
-    ASSERT_TRUE(reference.search(batch, k, expected).ok());
-    for (const Variant& variant : kExactVariants) {
-      auto backend = ClusterSearch::create(db, table, pool, variant.options);
-      ASSERT_TRUE(backend.ok()) << backend.message();
-      std::vector<Match> actual(count * k);
-      ASSERT_TRUE((*backend)->search(batch, k, actual).ok());
-      expect_identical(expected, actual, k, std::string(variant.name) + " k=" + std::to_string(k));
+  for (const std::uint32_t clusters : {30u, 200u}) {
+    const ClusterTable table = make_table(db, clusters);
+    for (std::uint32_t k : {1u, 3u, 16u}) {
+      std::vector<Match> expected(count * k);
+      ASSERT_TRUE(reference.search(batch, k, expected).ok());
+      for (const bool grouped : {true, false}) {
+        for (const Variant& variant : kExactVariants) {
+          ClusterSearchOptions options = variant.options;
+          options.batch_by_cluster = grouped;
+          auto backend = ClusterSearch::create(db, table, pool, options);
+          ASSERT_TRUE(backend.ok()) << backend.message();
+          std::vector<Match> actual(count * k);
+          ASSERT_TRUE((*backend)->search(batch, k, actual).ok());
+          expect_identical(expected, actual, k,
+                           std::string(variant.name) + " clusters=" + std::to_string(clusters) +
+                               (grouped ? " grouped" : " walk") + " k=" + std::to_string(k));
+        }
+      }
     }
   }
 }
@@ -342,7 +352,8 @@ TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
       {"all off", {.span_bound = false, .batch_by_cluster = false}},
       {"all on, no seed", {.seed_nearest = false}},
   };
-  for (const std::uint32_t clusters : {3u, 40u}) {
+  // 150 clusters: five groups of 32 in the group level above the clusters.
+  for (const std::uint32_t clusters : {3u, 40u, 150u}) {
     const ClusterTable table = make_table(db, clusters);
     for (const unsigned threads : {1u, 2u, 3u}) {
       ThreadPool pool(threads);
@@ -379,19 +390,25 @@ TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
 // clusters, so the same lists as the one-query walk, under every constraint.
 TEST(ClusterSearch, GroupedNprobeEqualsTheOneQueryWalk) {
   const Database db = make_database();
-  const ClusterTable table = make_table(db, 30);
   ThreadPool pool(2);
   const ConstrainedQueries queries = constrained_queries(db, 700, 41);
-  for (const std::uint32_t nprobe : {1u, 3u, 7u, 29u}) {
-    for (const std::uint32_t k : {1u, 5u}) {
-      auto grouped = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
-      auto walk = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .batch_by_cluster = false});
-      ASSERT_TRUE(grouped.ok() && walk.ok());
-      std::vector<Match> expected(queries.count * k);
-      std::vector<Match> actual(queries.count * k);
-      ASSERT_TRUE((*walk)->search(queries.batch(), k, expected).ok());
-      ASSERT_TRUE((*grouped)->search(queries.batch(), k, actual).ok());
-      expect_identical(expected, actual, k, "nprobe=" + std::to_string(nprobe) + " k=" + std::to_string(k));
+  // 150 clusters: the clusters are reordered into groups of 32 inside the
+  // backend, which must not change the probed set.
+  for (const std::uint32_t clusters : {30u, 150u}) {
+    const ClusterTable table = make_table(db, clusters);
+    for (const std::uint32_t nprobe : {1u, 3u, 7u, 29u}) {
+      for (const std::uint32_t k : {1u, 5u}) {
+        auto grouped = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
+        auto walk = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .batch_by_cluster = false});
+        ASSERT_TRUE(grouped.ok() && walk.ok());
+        std::vector<Match> expected(queries.count * k);
+        std::vector<Match> actual(queries.count * k);
+        ASSERT_TRUE((*walk)->search(queries.batch(), k, expected).ok());
+        ASSERT_TRUE((*grouped)->search(queries.batch(), k, actual).ok());
+        expect_identical(expected, actual, k,
+                         "clusters=" + std::to_string(clusters) + " nprobe=" + std::to_string(nprobe) +
+                             " k=" + std::to_string(k));
+      }
     }
   }
 }

@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "search/cluster_groups.hpp"
 #include "search/tile_store.hpp"
 #include "search/top_k.hpp"
 
@@ -26,6 +27,17 @@ constexpr std::size_t kSubBatch = 512;
 constexpr std::uint32_t kRankedRounds = 1;
 // Tiles of one cluster handed to the kernel at once.
 constexpr std::uint32_t kTileChunk = 4;
+// The group level above the clusters: runs of kGroupPacks cluster packs
+// (32 clusters) whose centroids lie near each other. Exact mode computes the
+// group bounds first and the cluster bounds only of the groups whose bound
+// can still pass the k-th best after the seed cluster (about sqrt(K) groups
+// for the usual K of 400-1000).
+constexpr std::uint32_t kGroupPacks = 2;
+constexpr std::uint32_t kGroupClusters = kGroupPacks * kLanes;
+// A thread's share of a batch up to this many queries takes the one-query
+// walk: the grouped walk's sub-batch bookkeeping buys nothing without other
+// queries to share the clusters with.
+constexpr std::size_t kOneQueryShare = 1;
 
 // Ordered by (bound, cluster); in nprobe mode `bound` is the centroid
 // distance and `lower` the lower bound.
@@ -50,13 +62,18 @@ struct VisitPair {
 struct Scratch {
   std::vector<ClusterBound> order;
   std::vector<float> bound, distance;            // [clusters, padded to 16]
+  std::vector<float> group_bound, group_distance;  // [groups, padded to 16]
+  std::vector<std::uint8_t> group_done;            // [groups]: its cluster bounds are computed
   std::vector<float> tile_bound;                 // [tiles of the largest cluster, padded to 16]
   std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
   std::vector<std::uint32_t> passing;            // [tiles of the largest cluster]
   std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
   // The grouped walk (batch_by_cluster).
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
-  std::vector<std::uint32_t> seed, cursor, candidate_end;      // [kSubBatch]
+  std::vector<float> batch_group_bound;                        // [kSubBatch][groups, padded to 16]
+  std::vector<std::uint8_t> batch_group_done;                 // [kSubBatch][groups]
+  std::vector<std::uint8_t> partial;                          // [kSubBatch]: bounds left to complete_bounds()
+  std::vector<std::uint32_t> seed, cursor, candidate_end;     // [kSubBatch]
   std::vector<ClusterBound> candidates;                        // each query's, sorted, one after another
   std::vector<ClusterBound> staging;                           // [clusters]: collect_candidates'
   std::vector<VisitPair> pairs, bucketed;                      // to visit; the same grouped by cluster
@@ -68,7 +85,20 @@ struct Scratch {
 }  // namespace
 
 struct ClusterSearch::Layout {
+  // The table with its clusters reordered so that each group (a run of
+  // kGroupClusters) holds nearby centroids; cluster ids below are these.
   ClusterTable table;
+  // [clusters]: the id in the caller's table of each cluster, and back. The
+  // nprobe set breaks centroid-distance ties on the caller's id, so the
+  // reordering never changes which clusters nprobe searches.
+  std::vector<std::uint32_t> table_id, internal_id;
+  // [groups]: the box of the candidate members of group g's clusters (min
+  // multiplier and bias), and the box of their centroids (multiplier 1,
+  // bias 0: its bound is at most the distance to any of them).
+  std::uint32_t group_count = 0;
+  detail::BoxPacks group_boxes;
+  detail::BoxPacks group_centroids;
+  std::vector<std::uint8_t> group_has_candidate;  // [groups]
   std::uint32_t dims = 0;
   detail::Kernels kernels{};
   std::vector<std::uint32_t> tile_offsets;   // [clusters + 1]
@@ -105,20 +135,24 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   MMVK_TRY(validate_cluster_table(table, database));
   auto layout = std::make_unique<Layout>();
   Layout& l = *layout;
-  l.table = table;
+  l.table_id = detail::group_order(table, kGroupClusters);
+  l.internal_id.resize(table.cluster_count);
+  for (std::uint32_t c = 0; c < table.cluster_count; ++c) l.internal_id[l.table_id[c]] = c;
+  l.table = detail::reorder_clusters(table, l.table_id);
   l.dims = database.dims();
+  const ClusterTable& t = l.table;
   if (!detail::select_kernels(options.kernels, l.kernels)) {
     return make_error("cluster search: this CPU cannot run the requested kernels (ClusterSearchOptions::kernels)");
   }
-  const std::uint32_t k = table.cluster_count;
+  const std::uint32_t k = t.cluster_count;
   l.tile_offsets.assign(k + 1, 0);
   l.tile_box_pack.assign(k, 0);
   l.never_candidate.resize(k);
   std::uint32_t tile_packs = 0;
   for (std::uint32_t c = 0; c < k; ++c) {
-    const std::uint32_t size = table.offsets[c + 1] - table.offsets[c];
+    const std::uint32_t size = t.offsets[c + 1] - t.offsets[c];
     const std::uint32_t tiles_c = (size + kLanes - 1) / kLanes;
-    l.never_candidate[c] = size == 0 || (table.flags_intersection[c] & detail::kNeverCandidate) != 0;
+    l.never_candidate[c] = size == 0 || (t.flags_intersection[c] & detail::kNeverCandidate) != 0;
     l.candidate_clusters += l.never_candidate[c] == 0 ? 1u : 0u;
     l.tile_offsets[c + 1] = l.tile_offsets[c] + tiles_c;
     l.tile_box_pack[c] = tile_packs;
@@ -128,7 +162,7 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   const std::size_t tiles = l.tile_offsets[k];
   l.frame.assign(tiles * kLanes, kNoFrame);
   for (std::uint32_t c = 0; c < k; ++c) {
-    std::copy(table.members.begin() + table.offsets[c], table.members.begin() + table.offsets[c + 1],
+    std::copy(t.members.begin() + t.offsets[c], t.members.begin() + t.offsets[c + 1],
               l.frame.begin() + std::ptrdiff_t{l.tile_offsets[c]} * kLanes);
   }
   l.rows = detail::TileStore::build(database, l.frame);
@@ -174,9 +208,26 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   l.centroids = detail::BoxPacks(cluster_packs, l.dims);
   for (std::uint32_t c = 0; c < k; ++c) {
     const std::size_t at = std::size_t{c} * l.dims;
-    l.cluster_boxes.set(c, table.box_min.data() + at, table.box_max.data() + at, table.min_multiplier[c],
-                        table.min_bias[c]);
-    l.centroids.set(c, table.centroids.data() + at, table.centroids.data() + at, 1.0f, 0.0f);
+    l.cluster_boxes.set(c, t.box_min.data() + at, t.box_max.data() + at, t.min_multiplier[c],
+                        t.min_bias[c]);
+    l.centroids.set(c, t.centroids.data() + at, t.centroids.data() + at, 1.0f, 0.0f);
+  }
+  l.group_count = static_cast<std::uint32_t>((k + kGroupClusters - 1) / kGroupClusters);
+  l.group_boxes = detail::BoxPacks(packs_of(l.group_count), l.dims);
+  l.group_centroids = detail::BoxPacks(packs_of(l.group_count), l.dims);
+  l.group_has_candidate.assign(l.group_count, 0);
+  for (std::uint32_t g = 0; g < l.group_count; ++g) {
+    detail::BoxAccumulator box(l.dims);
+    detail::BoxAccumulator centres(l.dims);
+    for (std::uint32_t c = g * kGroupClusters; c < std::min(k, (g + 1) * kGroupClusters); ++c) {
+      if (l.never_candidate[c]) continue;
+      const std::size_t at = std::size_t{c} * l.dims;
+      box.add(t.box_min.data() + at, t.box_max.data() + at, t.min_multiplier[c], t.min_bias[c]);
+      centres.add(t.centroids.data() + at, t.centroids.data() + at, 1.0f, 0.0f);
+    }
+    l.group_has_candidate[g] = box.empty ? 0 : 1;
+    l.group_boxes.set(g, box);
+    l.group_centroids.set(g, centres);
   }
   l.scratch.resize(pool.thread_count());
   for (Scratch& s : l.scratch) {
@@ -188,7 +239,13 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
     s.passing.resize(l.max_cluster_tiles);
     s.staging.resize(k);
     s.batch_bound.resize(kSubBatch * cluster_packs * kLanes);
+    s.group_bound.resize(packs_of(l.group_count) * kLanes);
+    s.group_distance.resize(packs_of(l.group_count) * kLanes);
+    s.batch_group_bound.resize(kSubBatch * packs_of(l.group_count) * kLanes);
     s.seed.resize(kSubBatch);
+    s.group_done.resize(l.group_count);
+    s.batch_group_done.resize(kSubBatch * l.group_count);
+    s.partial.resize(kSubBatch);
     s.cursor.resize(kSubBatch);
     s.candidate_end.resize(kSubBatch);
   }
@@ -308,33 +365,35 @@ void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
   }
 }
 
-// Rules out (NaN: never <= any threshold) each cluster of bound[] that
-// query `params` cannot take a frame from, and turns a bound that overflowed
-// to NaN into -inf (it proves nothing: visited first). Returns the number
-// of eligible clusters. It runs for every query over every cluster, so the
-// common case (no tag rules) is a branch-free loop that vectorizes; queries
-// with tag rules take cluster_eligible() per cluster.
-std::uint32_t mark_ineligible(const ClusterSearch::Layout& l, const QueryParams& params, float* bound) {
-  const ClusterTable& t = l.table;
-  const std::uint32_t n = t.cluster_count;
+// Rules out (NaN: never <= any threshold) each cluster of bound[first,
+// last) that query `params` cannot take a frame from, and turns a bound that
+// overflowed to NaN into -inf (it proves nothing: visited first). Returns
+// the number of eligible clusters of the range. It runs for every query
+// over every cluster, so the common case (no tag rules) is a branch-free
+// loop that vectorizes; queries with tag rules take cluster_eligible() per
+// cluster.
+std::uint32_t mark_ineligible(const ClusterSearch::Layout& l, const QueryParams& params, float* bound,
+                              std::uint32_t first, std::uint32_t last) {
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   constexpr float kMinusInfinity = -std::numeric_limits<float>::infinity();
   // A tag both required and excluded rules out every frame.
   if ((params.require_all & params.exclude_any) != 0) {
-    std::fill_n(bound, n, kNaN);
+    std::fill(bound + first, bound + last, kNaN);
     return 0;
   }
   const std::uint8_t* never = l.never_candidate.data();
   if (params.require_all == 0 && params.exclude_any == 0) {
     // No tag rules (most queries): the table's own eligibility.
-    for (std::uint32_t c = 0; c < n; ++c) {
+    std::uint32_t eligible = 0;
+    for (std::uint32_t c = first; c < last; ++c) {
       const float b = std::isnan(bound[c]) ? kMinusInfinity : bound[c];
       bound[c] = never[c] != 0 ? kNaN : b;
+      eligible += never[c] == 0 ? 1u : 0u;
     }
-    return l.candidate_clusters;
+    return eligible;
   }
   std::uint32_t eligible = 0;
-  for (std::uint32_t c = 0; c < n; ++c) {
+  for (std::uint32_t c = first; c < last; ++c) {
     const bool ok = cluster_eligible(l, params, c);
     const float b = std::isnan(bound[c]) ? kMinusInfinity : bound[c];
     bound[c] = ok ? b : kNaN;
@@ -370,7 +429,7 @@ std::uint32_t nearest_centroid(const float* distance, const float* bound, std::u
 // Returns the eligible cluster with the nearest centroid when seeding
 // (ties: the lower cluster id), else kNoCluster. In nprobe mode the clusters
 // beyond the nprobe nearest centroids are ruled out (NaN) as well.
-std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v, float* bound) {
+std::uint32_t all_bounds(const WalkContext& x, Scratch& s, const QueryView& v, float* bound) {
   const ClusterSearch::Layout& l = x.l;
   const ClusterTable& t = l.table;
   const std::size_t cluster_packs = packs_of(t.cluster_count);
@@ -379,7 +438,7 @@ std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v,
   } else {
     std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
   }
-  const std::uint32_t eligible = mark_ineligible(l, *v.params, bound);
+  const std::uint32_t eligible = mark_ineligible(l, *v.params, bound, 0, t.cluster_count);
   const bool probing = x.options.nprobe != 0 && x.options.nprobe < eligible;
   if (!probing && (!x.options.seed_nearest || eligible < 2)) return kNoCluster;
   l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
@@ -389,14 +448,103 @@ std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v,
     // the exact best over them, as in the one-query walk.
     s.order.clear();
     for (std::uint32_t c = 0; c < t.cluster_count; ++c) {
-      if (!std::isnan(bound[c])) s.order.push_back({s.distance[c], c, 0.0f});
+      if (!std::isnan(bound[c])) s.order.push_back({s.distance[c], l.table_id[c], 0.0f});
     }
     std::nth_element(s.order.begin(), s.order.begin() + x.options.nprobe, s.order.end());
     for (auto it = s.order.begin() + x.options.nprobe; it != s.order.end(); ++it) {
-      bound[it->cluster] = std::numeric_limits<float>::quiet_NaN();
+      bound[l.internal_id[it->cluster]] = std::numeric_limits<float>::quiet_NaN();
     }
   }
   return nearest_centroid(s.distance.data(), bound, t.cluster_count);
+}
+
+// The clusters [first, last) of group g.
+std::uint32_t group_first(std::uint32_t g) { return g * kGroupClusters; }
+std::uint32_t group_last(const ClusterSearch::Layout& l, std::uint32_t g) {
+  return std::min(l.table.cluster_count, (g + 1) * kGroupClusters);
+}
+
+// The cluster bounds of group g into bound[], ineligible ones ruled out.
+// Returns the number of eligible clusters.
+std::uint32_t group_cluster_bounds(const WalkContext& x, const QueryView& v, std::uint32_t g, float* bound) {
+  const ClusterSearch::Layout& l = x.l;
+  const std::uint32_t first = group_first(g);
+  const std::uint32_t last = group_last(l, g);
+  const std::size_t first_pack = first / kLanes;
+  l.kernels.box_bounds(l.cluster_boxes.arrays(l.rows.channel_end), first_pack, packs_of(last) - first_pack, v.q, v.w,
+                       bound + first);
+  return mark_ineligible(l, *v.params, bound, first, last);
+}
+
+// Exact mode's bounds before the seed is visited. With the group level (box
+// bounds and seeding on, more than one group; partial = true): the group
+// bounds into group_bound[], and the seed, the eligible cluster with the
+// nearest centroid (as all_bounds(), up to ties), found by visiting the
+// groups in order of the bound of their centroids' box until that bound is
+// above the nearest centroid found; the cluster bounds of those groups are
+// computed (done[g] = 1), the rest is left to complete_bounds(), once the
+// seed has tightened the k-th best. Otherwise every bound, as all_bounds()
+// (partial = false).
+std::uint32_t exact_bounds(const WalkContext& x, Scratch& s, const QueryView& v, float* bound, float* group_bound,
+                           std::uint8_t* done, bool& partial) {
+  const ClusterSearch::Layout& l = x.l;
+  partial = false;
+  if (x.options.nprobe != 0 || !x.options.box_bound || !x.options.seed_nearest || l.group_count < 2) {
+    return all_bounds(x, s, v, bound);
+  }
+  partial = true;
+  const std::size_t group_packs = packs_of(l.group_count);
+  l.kernels.box_bounds(l.group_boxes.arrays(l.rows.channel_end), 0, group_packs, v.q, v.w, group_bound);
+  float* group_distance = s.group_distance.data();
+  l.kernels.box_bounds(l.group_centroids.arrays(l.rows.channel_end), 0, group_packs, v.q, v.w, group_distance);
+  for (std::uint32_t g = 0; g < l.group_count; ++g) done[g] = l.group_has_candidate[g] ? 0 : 1;
+  std::uint32_t seed = kNoCluster;
+  float nearest = std::numeric_limits<float>::infinity();
+  for (;;) {
+    std::uint32_t next = kNoCluster;
+    for (std::uint32_t g = 0; g < l.group_count; ++g) {
+      if (!done[g] && (next == kNoCluster || group_distance[g] < group_distance[next])) next = g;
+    }
+    // A distance (or its group's lower bound) may be +inf or NaN: such
+    // groups are only examined while no seed is found.
+    if (next == kNoCluster || (seed != kNoCluster && !(group_distance[next] < nearest))) break;
+    done[next] = 1;
+    const std::uint32_t first = group_first(next);
+    const std::uint32_t last = group_last(l, next);
+    if (group_cluster_bounds(x, v, next, bound) == 0) continue;
+    const std::size_t first_pack = first / kLanes;
+    l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), first_pack, packs_of(last) - first_pack, v.q, v.w,
+                         s.distance.data() + first);
+    const std::uint32_t in_group = nearest_centroid(s.distance.data() + first, bound + first, last - first);
+    if (seed == kNoCluster || s.distance[first + in_group] < nearest) {
+      seed = first + in_group;
+      nearest = s.distance[seed];
+    }
+  }
+  return seed;
+}
+
+// Exact mode after the seed: the bounds of the clusters of the groups not
+// done whose group bound is at most the k-th best; +inf for the rest (never
+// visited: a skipped group's bound is above a finite k-th best, which only
+// falls), NaN for a group without candidates.
+void complete_bounds(const WalkContext& x, const QueryView& v, const float* group_bound, const std::uint8_t* done,
+                     bool partial, float* bound) {
+  const ClusterSearch::Layout& l = x.l;
+  if (!partial) return;
+  const float threshold = v.best.back().cost;
+  for (std::uint32_t g = 0; g < l.group_count; ++g) {
+    if (!l.group_has_candidate[g]) {
+      std::fill(bound + group_first(g), bound + group_last(l, g), std::numeric_limits<float>::quiet_NaN());
+      continue;
+    }
+    if (done[g]) continue;
+    if (group_bound[g] > threshold) {
+      std::fill(bound + group_first(g), bound + group_last(l, g), std::numeric_limits<float>::infinity());
+      continue;
+    }
+    group_cluster_bounds(x, v, g, bound);
+  }
 }
 
 // Appends the clusters other than `skip` whose bound is at most `threshold`,
@@ -415,78 +563,62 @@ void collect_candidates(const float* bound, std::uint32_t clusters, std::uint32_
   out.insert(out.end(), passing, passing + count);
 }
 
-// The per-query walk (nprobe mode, and exact mode's fallback).
+// The per-query walk: one query's clusters in order, with no batch
+// bookkeeping (batch_by_cluster off, and a thread's share of a small batch).
 void walk_one(const WalkContext& x, Scratch& s, const QueryView& v) {
   const ClusterSearch::Layout& l = x.l;
   const ClusterTable& t = l.table;
   const ClusterSearchOptions& options = x.options;
   const std::span<Match> best = v.best;
   const std::size_t k = best.size();
-  s.order.clear();
-  // A tag both required and excluded rules out every frame.
-  const bool contradictory = (v.params->require_all & v.params->exclude_any) != 0;
-  for (std::uint32_t c = 0; c < t.cluster_count && !contradictory; ++c) {
-    if (cluster_eligible(l, *v.params, c)) s.order.push_back({0.0f, c, 0.0f});
-  }
-  const bool probing = options.nprobe != 0 && options.nprobe < s.order.size();
-  // Nearest-centroid seed (exact mode) or probe order (nprobe mode):
-  // channel-weighted squared centroid distances, a box bound of the
-  // zero-size boxes [centroid, centroid] with unit multipliers.
-  const bool seeding = !probing && options.seed_nearest && s.order.size() > 1;
-  const std::size_t cluster_packs = packs_of(t.cluster_count);
-  if (probing || seeding) {
-    l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
-  }
   float* bound = s.bound.data();
-  if (!s.order.empty()) {
-    if (options.box_bound) {
-      l.kernels.box_bounds(l.cluster_boxes.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, bound);
-    } else {
-      std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
+  if (options.nprobe != 0) {
+    s.order.clear();
+    // A tag both required and excluded rules out every frame.
+    const bool contradictory = (v.params->require_all & v.params->exclude_any) != 0;
+    for (std::uint32_t c = 0; c < t.cluster_count && !contradictory; ++c) {
+      if (cluster_eligible(l, *v.params, c)) s.order.push_back({0.0f, c, 0.0f});
     }
-    for (ClusterBound& b : s.order) b.bound = bound[b.cluster];
+    if (options.nprobe < s.order.size()) {
+      // The nprobe nearest centroids (channel-weighted squared distances, a
+      // box bound of the zero-size boxes [centroid, centroid] with unit
+      // multipliers), nearest first (the most likely home of the answer, so
+      // the k-th best tightens early; ties: the caller's cluster id); a
+      // probed cluster whose lower bound is above the k-th best is skipped,
+      // which never changes the result.
+      const std::size_t cluster_packs = packs_of(t.cluster_count);
+      l.kernels.box_bounds(l.centroids.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, s.distance.data());
+      if (options.box_bound) {
+        l.kernels.box_bounds(l.cluster_boxes.arrays(l.rows.channel_end), 0, cluster_packs, v.q, v.w, bound);
+      } else {
+        std::copy(t.min_bias.begin(), t.min_bias.end(), bound);
+      }
+      for (ClusterBound& b : s.order) {
+        b.lower = bound[b.cluster];
+        b.bound = s.distance[b.cluster];
+        b.cluster = l.table_id[b.cluster];
+      }
+      std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
+      s.order.resize(options.nprobe);
+      std::sort(s.order.begin(), s.order.end());
+      for (const ClusterBound& b : s.order) {
+        if (b.lower > best[k - 1].cost) continue;
+        visit_cluster(x, s, v, l.internal_id[b.cluster]);
+      }
+      return;
+    }
   }
-
-  if (probing) {
-    // The nprobe nearest centroids, nearest first (the most likely home
-    // of the answer, so the k-th best tightens early); a probed cluster
-    // whose lower bound is above the k-th best is skipped, which never
-    // changes the result.
-    for (ClusterBound& b : s.order) {
-      b.lower = b.bound;
-      b.bound = s.distance[b.cluster];
-    }
-    std::nth_element(s.order.begin(), s.order.begin() + options.nprobe, s.order.end());
-    s.order.resize(options.nprobe);
-    std::sort(s.order.begin(), s.order.end());
-    for (const ClusterBound& b : s.order) {
-      if (b.lower > best[k - 1].cost) continue;
-      visit_cluster(x, s, v, b.cluster);
-    }
-    return;
-  }
-
-  // Exact: first the cluster of the nearest centroid (when seeding), to
-  // tighten the k-th best early, then every cluster in lower-bound order
-  // until the next bound is above the k-th best.
-  std::uint32_t seeded = kNoCluster;
-  if (seeding) {
-    const ClusterBound* nearest = &s.order.front();
-    for (const ClusterBound& b : s.order) {
-      if (s.distance[b.cluster] < s.distance[nearest->cluster]) nearest = &b;
-    }
-    seeded = nearest->cluster;
-    if (nearest->bound <= best[k - 1].cost) visit_cluster(x, s, v, seeded);
-  }
-  // A min-heap: usually only a few clusters are visited, so popping them
-  // in order beats sorting all of them.
-  const auto heap_order = [](const ClusterBound& a, const ClusterBound& b) { return b < a; };
-  std::make_heap(s.order.begin(), s.order.end(), heap_order);
-  for (auto heap_end = s.order.end(); heap_end != s.order.begin(); --heap_end) {
-    std::pop_heap(s.order.begin(), heap_end, heap_order);
-    const ClusterBound& b = *(heap_end - 1);
+  // Exact (or nprobe covering every eligible cluster): the seed cluster
+  // first, to tighten the k-th best early, then every cluster in
+  // lower-bound order until the next bound is above the k-th best.
+  bool partial = false;
+  const std::uint32_t seed = exact_bounds(x, s, v, bound, s.group_bound.data(), s.group_done.data(), partial);
+  if (seed != kNoCluster && bound[seed] <= best[k - 1].cost) visit_cluster(x, s, v, seed);
+  complete_bounds(x, v, s.group_bound.data(), s.group_done.data(), partial, bound);
+  s.order.clear();
+  collect_candidates(bound, t.cluster_count, seed, best[k - 1].cost, s.staging, s.order);
+  for (const ClusterBound& b : s.order) {
     if (b.bound > best[k - 1].cost) break;
-    if (b.cluster == seeded) continue;
     visit_cluster(x, s, v, b.cluster);
   }
 }
@@ -511,8 +643,9 @@ void visit_grouped(const WalkContext& x, Scratch& s, const ViewOf& view_of) {
 }
 
 // Exact mode over queries [first, last), in sub-batches: bounds and seeds per
-// query, then the seed clusters grouped by cluster, then each query's
-// remaining candidates (bound <= its k-th best after the seed) in rounds:
+// query (exact_bounds), then the seed clusters grouped by cluster, then the
+// rest of each query's bounds (complete_bounds) and its remaining
+// candidates (bound <= its k-th best after the seed) in rounds:
 // the next candidate of every query per round for the first rounds (the
 // most promising cluster first, as in the one-query walk), then all the
 // rest at once, each round grouped by cluster.
@@ -520,6 +653,7 @@ template <class ViewOf>
 void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::size_t first, std::size_t last) {
   const std::uint32_t clusters = x.l.table.cluster_count;
   const std::size_t stride = packs_of(clusters) * kLanes;
+  const std::size_t group_stride = packs_of(x.l.group_count) * kLanes;
   for (std::size_t base = first; base < last; base += kSubBatch) {
     const std::uint32_t n = static_cast<std::uint32_t>(std::min(kSubBatch, last - base));
     const auto local = [&](std::uint32_t i) { return view_of(base + i); };
@@ -528,7 +662,10 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
       const QueryView v = local(i);
       start_query(x, s, v);
       float* bound = s.batch_bound.data() + i * stride;
-      s.seed[i] = exact_bounds(x, s, v, bound);
+      bool partial = false;
+      s.seed[i] = exact_bounds(x, s, v, bound, s.batch_group_bound.data() + i * group_stride,
+                               s.batch_group_done.data() + std::size_t{i} * x.l.group_count, partial);
+      s.partial[i] = partial ? 1 : 0;
       if (s.seed[i] != kNoCluster && bound[s.seed[i]] <= v.best.back().cost) {
         s.pairs.push_back({s.seed[i], i, bound[s.seed[i]]});
       }
@@ -538,6 +675,9 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
     s.candidates.clear();
     for (std::uint32_t i = 0; i < n; ++i) {
       s.candidate_end[i] = static_cast<std::uint32_t>(s.candidates.size());  // this query's begin, for now
+      complete_bounds(x, local(i), s.batch_group_bound.data() + i * group_stride,
+                      s.batch_group_done.data() + std::size_t{i} * x.l.group_count, s.partial[i] != 0,
+                      s.batch_bound.data() + i * stride);
       collect_candidates(s.batch_bound.data() + i * stride, clusters, s.seed[i], local(i).best.back().cost,
                          s.staging, s.candidates);
     }
@@ -584,7 +724,7 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   };
   pool_->parallel_for(batch.size, [&](std::size_t first, std::size_t last, unsigned thread) {
     Scratch& s = l.scratch[thread];
-    if (options.batch_by_cluster) {
+    if (options.batch_by_cluster && last - first > kOneQueryShare) {
       walk_batched(x, s, view_of, first, last);
       return;
     }

@@ -41,7 +41,11 @@
 // mode's cluster and tile bounds against the current k-th best (a probed
 // cluster whose bound is above it is skipped); nprobe >= cluster_count gives
 // the exact results. Batches visit the probed clusters grouped by cluster,
-// like exact mode (see batch_by_cluster), with the same results.
+// like exact mode (see batch_by_cluster), with the same results. Up to 32
+// probes (with box_bound), the probed set is found through the group level
+// (the groups in order of their centroid box's bound, until that bound is
+// above the nprobe-th nearest distance found) rather than by ranking every
+// centroid; the set is the same.
 #pragma once
 
 #include <cstdint>

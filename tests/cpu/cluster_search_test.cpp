@@ -126,23 +126,33 @@ const Variant kExactVariants[] = {
     {"generic kernels, no nearest seed", {.nprobe = 0, .seed_nearest = false, .kernels = CpuKernels::Generic}},
 };
 
+// 200 clusters: several groups of 32 (the level above the clusters, whose
+// bounds decide which cluster bounds are computed at all); both walks.
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
   const Database db = make_database();
-  const ClusterTable table = make_table(db, 30);
   ThreadPool pool(2);
   ReferenceSearch reference(db);
   const ConstrainedQueries queries = constrained_queries(db, 240, 11);
   const std::size_t count = queries.count;
   const QueryBatch batch = queries.batch();
-  for (std::uint32_t k : {1u, 3u, 16u}) {
-    std::vector<Match> expected(count * k);
-    ASSERT_TRUE(reference.search(batch, k, expected).ok());
-    for (const Variant& variant : kExactVariants) {
-      auto backend = ClusterSearch::create(db, table, pool, variant.options);
-      ASSERT_TRUE(backend.ok()) << backend.message();
-      std::vector<Match> actual(count * k);
-      ASSERT_TRUE((*backend)->search(batch, k, actual).ok());
-      expect_identical(expected, actual, k, std::string(variant.name) + " k=" + std::to_string(k));
+  for (const std::uint32_t clusters : {30u, 200u}) {
+    const ClusterTable table = make_table(db, clusters);
+    for (std::uint32_t k : {1u, 3u, 16u}) {
+      std::vector<Match> expected(count * k);
+      ASSERT_TRUE(reference.search(batch, k, expected).ok());
+      for (const bool grouped : {true, false}) {
+        for (const Variant& variant : kExactVariants) {
+          ClusterSearchOptions options = variant.options;
+          options.batch_by_cluster = grouped;
+          auto backend = ClusterSearch::create(db, table, pool, options);
+          ASSERT_TRUE(backend.ok()) << backend.message();
+          std::vector<Match> actual(count * k);
+          ASSERT_TRUE((*backend)->search(batch, k, actual).ok());
+          expect_identical(expected, actual, k,
+                           std::string(variant.name) + " clusters=" + std::to_string(clusters) +
+                               (grouped ? " grouped" : " walk") + " k=" + std::to_string(k));
+        }
+      }
     }
   }
 }
@@ -173,15 +183,19 @@ TEST(ClusterSearch, UniqueMinimaAreFoundWithDefaultParams) {
   EXPECT_LT((*backend)->stats().rows_fraction(db.frame_count()), 0.25);
 }
 
-TEST(ClusterSearch, TiesGoToTheLowerFrameId) {
-  // Blobs of zero spread: every blob's rows are identical, so costs tie in
-  // large groups spread over clusters and tiles.
+// Blobs of zero spread: every blob's rows are identical.
+Database zero_spread_database(std::uint32_t frames, std::uint32_t blobs) {
   test::ClusteredDataSpec spec;
-  spec.frames = 600;
-  spec.blobs = 4;
+  spec.frames = frames;
+  spec.blobs = blobs;
   spec.blob_spread = 0.0f;
   spec.varied_clips = false;
-  const Database db = make_database(spec);
+  return make_database(spec);
+}
+
+TEST(ClusterSearch, TiesGoToTheLowerFrameId) {
+  // Costs tie in large groups spread over clusters and tiles.
+  const Database db = zero_spread_database(600, 4);
   ThreadPool pool(2);
   ReferenceSearch reference(db);
   const ClusterTable table = make_table(db, 9);
@@ -342,7 +356,8 @@ TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
       {"all off", {.span_bound = false, .batch_by_cluster = false}},
       {"all on, no seed", {.seed_nearest = false}},
   };
-  for (const std::uint32_t clusters : {3u, 40u}) {
+  // 150 clusters: five groups of 32 in the group level above the clusters.
+  for (const std::uint32_t clusters : {3u, 40u, 150u}) {
     const ClusterTable table = make_table(db, clusters);
     for (const unsigned threads : {1u, 2u, 3u}) {
       ThreadPool pool(threads);
@@ -379,20 +394,54 @@ TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
 // clusters, so the same lists as the one-query walk, under every constraint.
 TEST(ClusterSearch, GroupedNprobeEqualsTheOneQueryWalk) {
   const Database db = make_database();
-  const ClusterTable table = make_table(db, 30);
   ThreadPool pool(2);
   const ConstrainedQueries queries = constrained_queries(db, 700, 41);
-  for (const std::uint32_t nprobe : {1u, 3u, 7u, 29u}) {
-    for (const std::uint32_t k : {1u, 5u}) {
-      auto grouped = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
-      auto walk = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .batch_by_cluster = false});
-      ASSERT_TRUE(grouped.ok() && walk.ok());
-      std::vector<Match> expected(queries.count * k);
-      std::vector<Match> actual(queries.count * k);
-      ASSERT_TRUE((*walk)->search(queries.batch(), k, expected).ok());
-      ASSERT_TRUE((*grouped)->search(queries.batch(), k, actual).ok());
-      expect_identical(expected, actual, k, "nprobe=" + std::to_string(nprobe) + " k=" + std::to_string(k));
+  // 150 clusters: the clusters are reordered into groups of 32 inside the
+  // backend and the probed set is found group by group; without box bounds
+  // the group level is off and every centroid is ranked, so equal lists
+  // show the same probed set.
+  for (const std::uint32_t clusters : {30u, 150u}) {
+    const ClusterTable table = make_table(db, clusters);
+    for (const std::uint32_t nprobe : {1u, 3u, 7u, 29u, 40u}) {
+      for (const std::uint32_t k : {1u, 5u}) {
+        auto grouped = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
+        auto walk = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .batch_by_cluster = false});
+        auto ranked = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .box_bound = false});
+        ASSERT_TRUE(grouped.ok() && walk.ok() && ranked.ok());
+        std::vector<Match> expected(queries.count * k);
+        std::vector<Match> actual(queries.count * k);
+        std::vector<Match> by_rank(queries.count * k);
+        ASSERT_TRUE((*walk)->search(queries.batch(), k, expected).ok());
+        ASSERT_TRUE((*grouped)->search(queries.batch(), k, actual).ok());
+        ASSERT_TRUE((*ranked)->search(queries.batch(), k, by_rank).ok());
+        const std::string what =
+            "clusters=" + std::to_string(clusters) + " nprobe=" + std::to_string(nprobe) + " k=" + std::to_string(k);
+        expect_identical(expected, actual, k, what);
+        expect_identical(expected, by_rank, k, what + " against every centroid ranked");
+      }
     }
+  }
+}
+
+// Blobs of zero spread: many clusters share a centroid, so nprobe's
+// distances tie and the probed set rests on the tie rule (the caller's lower
+// cluster id), with and without the group level.
+TEST(ClusterSearch, NprobeTiesGoToTheLowerClusterId) {
+  const Database db = zero_spread_database(1200, 6);
+  const ClusterTable table = make_table(db, 70);
+  ThreadPool pool(2);
+  const std::size_t count = 60;
+  const std::vector<float> features = make_queries(db, count, 9);
+  for (const std::uint32_t nprobe : {1u, 2u, 5u, 20u}) {
+    const std::uint32_t k = 4;
+    auto grouped = ClusterSearch::create(db, table, pool, {.nprobe = nprobe});
+    auto ranked = ClusterSearch::create(db, table, pool, {.nprobe = nprobe, .box_bound = false});
+    ASSERT_TRUE(grouped.ok() && ranked.ok());
+    std::vector<Match> expected(count * k);
+    std::vector<Match> actual(count * k);
+    ASSERT_TRUE((*ranked)->search({features, {}, count}, k, expected).ok());
+    ASSERT_TRUE((*grouped)->search({features, {}, count}, k, actual).ok());
+    expect_identical(expected, actual, k, "ties nprobe=" + std::to_string(nprobe));
   }
 }
 

@@ -27,6 +27,13 @@
 // Exact mode first visits the cluster whose centroid is nearest to the query
 // (option seed_nearest), so the k-th best is tight before the bound-ordered
 // walk starts; that never changes the results, only the work.
+// With seed_nearest and box_bound, a level above the clusters spares most
+// cluster bounds: the backend orders the clusters (internally; the caller's
+// ids are kept for nprobe's ties) so that each run of 32 holds nearby
+// centroids, a group with the box of its members and the box of its
+// centroids. The seed is found group by group in order of the centroid
+// box's bound, and after the seed only the groups whose own bound is at most
+// the k-th best get their cluster bounds computed.
 //
 // Approximate mode (nprobe > 0): only the nprobe eligible clusters whose
 // centroids are nearest to the query (channel-weighted squared distance) are
@@ -34,7 +41,11 @@
 // mode's cluster and tile bounds against the current k-th best (a probed
 // cluster whose bound is above it is skipped); nprobe >= cluster_count gives
 // the exact results. Batches visit the probed clusters grouped by cluster,
-// like exact mode (see batch_by_cluster), with the same results.
+// like exact mode (see batch_by_cluster), with the same results. Up to 32
+// probes (with box_bound), the probed set is found through the group level
+// (the groups in order of their centroid box's bound, until that bound is
+// above the nprobe-th nearest distance found) rather than by ranking every
+// centroid; the set is the same.
 #pragma once
 
 #include <cstdint>
@@ -65,7 +76,8 @@ struct ClusterSearchOptions {
   // Each thread takes its queries in sub-batches and visits their clusters
   // (in nprobe mode, the probed ones) grouped by cluster, so the rows of a
   // cluster are loaded once for all the sub-batch's queries that visit it
-  // (see cluster_search.cpp). Off: the one-query walk, query by query.
+  // (see cluster_search.cpp). Off: the one-query walk, query by query. A
+  // thread's share of one query takes the one-query walk either way.
   bool batch_by_cluster = true;
   // As FastSearchOptions::kernels.
   CpuKernels kernels = CpuKernels::Widest;

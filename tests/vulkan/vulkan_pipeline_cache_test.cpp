@@ -16,13 +16,7 @@
 #include "vulkan_test_env.hpp"
 
 namespace mmvk::test {
-
 namespace {
-
-using vulkan::Context;
-using vulkan::ContextOptions;
-using vulkan::VulkanSearch;
-using vulkan::VulkanSearchOptions;
 
 // Small variants (tile <= 4, k <= 4) so the kernels compile quickly.
 VulkanSearchOptions small_options(bool warm_up) { return search_options(16, 4, 4, warm_up); }

@@ -15,13 +15,7 @@
 #include "vulkan_test_env.hpp"
 
 namespace mmvk::test {
-
 namespace {
-
-using vulkan::Context;
-using vulkan::ContextOptions;
-using vulkan::VulkanSearch;
-using vulkan::VulkanSearchOptions;
 
 ContextOptions validation_options() {
   ContextOptions options;

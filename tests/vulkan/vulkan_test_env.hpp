@@ -17,6 +17,12 @@
 
 namespace mmvk::test {
 
+// The Vulkan types every Vulkan test names.
+using vulkan::Context;
+using vulkan::ContextOptions;
+using vulkan::VulkanSearch;
+using vulkan::VulkanSearchOptions;
+
 inline bool vulkan_required() {
   const char* value = std::getenv("MMVK_REQUIRE_VULKAN");
   return value != nullptr && *value != '\0' && std::string(value) != "0";

@@ -32,6 +32,7 @@ HEADER_LAYERS = {
     "status": "common",
     "hash": "common",
     "json_check": "common",
+    "number_text": "common",
     "bvh": "import",
     "character": "import",
     "cluster_table": "clusters",

@@ -9,11 +9,11 @@
 //
 // Exit status: 0 when at least one device exists; 1 with one line saying
 // why when there is none (no loader, no driver, no device).
-#include <vulkan/vulkan.h>
-
-#include <cstdint>
+#include <cstddef>
 #include <cstdio>
 #include <vector>
+
+#include "mmvk/vulkan/context.hpp"
 
 namespace {
 
@@ -27,61 +27,24 @@ const char* type_name(VkPhysicalDeviceType type) {
   }
 }
 
-// The largest device-local heap, MiB.
-std::uint64_t device_local_mib(VkPhysicalDevice device) {
-  VkPhysicalDeviceMemoryProperties memory{};
-  vkGetPhysicalDeviceMemoryProperties(device, &memory);
-  std::uint64_t largest = 0;
-  for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
-    if ((memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0 && memory.memoryHeaps[h].size > largest) {
-      largest = memory.memoryHeaps[h].size;
-    }
-  }
-  return largest >> 20;
-}
-
 }  // namespace
 
 int main() {
-  VkApplicationInfo app{};
-  app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
-  app.pApplicationName = "mmvk_vulkan_devices";
-  app.apiVersion = VK_API_VERSION_1_2;
-  VkInstanceCreateInfo info{};
-  info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
-  info.pApplicationInfo = &app;
-  VkInstance instance = VK_NULL_HANDLE;
-  if (const VkResult result = vkCreateInstance(&info, nullptr, &instance); result != VK_SUCCESS) {
-    std::printf("no Vulkan device: vkCreateInstance failed (VkResult %d: no driver the loader can use)\n", int(result));
+  const mmvk::Result<std::vector<mmvk::vulkan::DeviceInfo>> devices = mmvk::vulkan::Context::enumerate_devices();
+  if (!devices) {
+    std::printf("no Vulkan device: %s\n", devices.message().c_str());
     return 1;
   }
-  std::uint32_t count = 0;
-  VkResult result = vkEnumeratePhysicalDevices(instance, &count, nullptr);
-  std::vector<VkPhysicalDevice> devices(count);
-  if (result == VK_SUCCESS && count > 0) result = vkEnumeratePhysicalDevices(instance, &count, devices.data());
-  if (result != VK_SUCCESS || count == 0) {
-    std::printf("no Vulkan device: the loader found a driver but %s\n",
-                result != VK_SUCCESS ? "vkEnumeratePhysicalDevices failed" : "no physical device");
-    vkDestroyInstance(instance, nullptr);
+  if (devices->empty()) {
+    std::printf("no Vulkan device: the loader found a driver but no physical device\n");
     return 1;
   }
-  for (std::uint32_t i = 0; i < count; ++i) {
-    VkPhysicalDeviceDriverProperties driver{};
-    driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
-    VkPhysicalDeviceSubgroupProperties subgroup{};
-    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
-    subgroup.pNext = &driver;
-    VkPhysicalDeviceProperties2 properties{};
-    properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-    properties.pNext = &subgroup;
-    vkGetPhysicalDeviceProperties2(devices[i], &properties);
-    const VkPhysicalDeviceProperties& p = properties.properties;
-    std::printf("device %u: %s | %s | %s %s | Vulkan %u.%u.%u | subgroup %u | %llu MiB device-local\n", i,
-                p.deviceName, type_name(p.deviceType), driver.driverName, driver.driverInfo,
-                VK_API_VERSION_MAJOR(p.apiVersion), VK_API_VERSION_MINOR(p.apiVersion),
-                VK_API_VERSION_PATCH(p.apiVersion), subgroup.subgroupSize,
-                static_cast<unsigned long long>(device_local_mib(devices[i])));
+  for (std::size_t i = 0; i < devices->size(); ++i) {
+    const mmvk::vulkan::DeviceInfo& d = (*devices)[i];
+    std::printf("device %zu: %s | %s | %s | Vulkan %u.%u.%u | subgroup %u | %llu MiB device-local\n", i,
+                d.name.c_str(), type_name(d.type), d.driver.c_str(), VK_API_VERSION_MAJOR(d.api_version),
+                VK_API_VERSION_MINOR(d.api_version), VK_API_VERSION_PATCH(d.api_version), d.subgroup_size,
+                static_cast<unsigned long long>(d.device_local_bytes >> 20));
   }
-  vkDestroyInstance(instance, nullptr);
   return 0;
 }

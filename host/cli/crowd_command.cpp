@@ -13,6 +13,7 @@
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "help_format.hpp"
+#include "mmvk/number_text.hpp"
 #include "crowd_backend.hpp"
 #include "crowd_run.hpp"
 #include "default_data.hpp"
@@ -33,20 +34,13 @@ constexpr const char* kCrowdFiles =
     "and a run that would need more memory than this machine allows is refused\n"
     "with its estimate (docs/files-and-limits.md).\n";
 
-// "0.1", "30": a default as the help shows it.
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
-
 // The sections after the options: files, the shipped motion sets (one entry
 // each, wrapped like the options) and the backends.
 std::string crowd_footer() {
   std::string out = kCrowdFiles;
   out += "\nshipped motion sets (--data NAME; the first is the default):\n";
   for (const crowd::ShippedData& data : crowd::shipped_data()) {
-    const std::string settings = ". Crowd settings: --correction-half-life " + number(data.correction_half_life);
+    const std::string settings = ". Crowd settings: --correction-half-life " + number_text(data.correction_half_life);
     out += help_entry(data.name, std::string(data.description) + settings, 22);
   }
   return out + "\nbackends:\n" + crowd::crowd_backend_help();
@@ -66,12 +60,12 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
                default_data_name());
   cli.integer("--agents", options.agents, "N",
               "characters (default 1000, at most 10,000,000; with --scenario, its count)", 1, 10'000'000);
-  cli.positive("--seconds", options.seconds, "S", "simulated time (default " + number(options.seconds) + "; 1 to 10,000,000 ticks)");
+  cli.positive("--seconds", options.seconds, "S", "simulated time (default " + number_text(options.seconds) + "; 1 to 10,000,000 ticks)");
   cli.positive("--rate", options.rate_hz, "HZ",
-               "simulation ticks per second (default " + number(options.rate_hz) +
+               "simulation ticks per second (default " + number_text(options.rate_hz) +
                    "; 1 to 1000: poses are interpolated between database frames)");
   cli.positive("--search-interval", options.search_interval_s, "S",
-               "seconds between a character's regular searches (default " + number(options.search_interval_s) +
+               "seconds between a character's regular searches (default " + number_text(options.search_interval_s) +
                    "; 0.001 to 3600)");
   cli.text("--backend", options.backend, "NAME",
            "the search backend (default " + options.backend + ", on the best device)");

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "mmvk/file_io.hpp"
+#include "mmvk/number_text.hpp"
 #include "mmvk/query_assembly.hpp"
 #include "mmvk/search.hpp"
 #include "mmvk/trajectory.hpp"
@@ -18,12 +19,6 @@
 namespace mmvk::crowd {
 
 namespace {
-
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
 
 std::string gib(std::uint64_t bytes) {
   char text[32];
@@ -65,20 +60,20 @@ std::uint64_t trajectory_points(const Database& database) {
 
 Status check_time_options(const CrowdOptions& o) {
   if (!std::isfinite(o.rate_hz) || o.rate_hz < kMinRateHz || o.rate_hz > kMaxRateHz) {
-    return make_error("--rate " + number(o.rate_hz) + ": expected " + number(kMinRateHz) + " to " +
-                      number(kMaxRateHz) + " ticks per second (a tick of at most 1 s and at least 1 ms)");
+    return make_error("--rate " + number_text(o.rate_hz) + ": expected " + number_text(kMinRateHz) + " to " +
+                      number_text(kMaxRateHz) + " ticks per second (a tick of at most 1 s and at least 1 ms)");
   }
   if (!std::isfinite(o.search_interval_s) || o.search_interval_s < kMinSearchIntervalS ||
       o.search_interval_s > kMaxSearchIntervalS) {
-    return make_error("--search-interval " + number(o.search_interval_s) + ": expected " +
-                      number(kMinSearchIntervalS) + " to " + number(kMaxSearchIntervalS) + " seconds");
+    return make_error("--search-interval " + number_text(o.search_interval_s) + ": expected " +
+                      number_text(kMinSearchIntervalS) + " to " + number_text(kMaxSearchIntervalS) + " seconds");
   }
   if (!std::isfinite(o.seconds) || !(o.seconds > 0.0) || o.seconds * o.rate_hz > double(kMaxTicks) + 0.5) {
-    return make_error("--seconds " + number(o.seconds) + " at --rate " + number(o.rate_hz) + ": over " +
+    return make_error("--seconds " + number_text(o.seconds) + " at --rate " + number_text(o.rate_hz) + ": over " +
                       std::to_string(kMaxTicks) + " ticks (--seconds x --rate)");
   }
   if (std::llround(o.seconds * o.rate_hz) < 1) {
-    return make_error("--seconds " + number(o.seconds) + " at --rate " + number(o.rate_hz) +
+    return make_error("--seconds " + number_text(o.seconds) + " at --rate " + number_text(o.rate_hz) +
                       " Hz is 0 ticks; simulate at least one tick (1 / rate seconds)");
   }
   return {};
@@ -168,9 +163,9 @@ Status check_crowd_memory(const CrowdOptions& options, const Database& database,
   const std::uint64_t estimate = estimate_crowd_bytes(options, database, agents, goals);
   const std::uint64_t limit = memory_limit_bytes();
   if (double(estimate) <= kMemoryShare * double(limit)) return {};
-  return make_error(std::to_string(agents) + " agents for " + number(options.seconds) + " s" +
+  return make_error(std::to_string(agents) + " agents for " + number_text(options.seconds) + " s" +
                     (options.html ? " with --html" : "") + " would need about " + gib(estimate) + ", over " +
-                    number(kMemoryShare * 100.0) + "% of the " + gib(limit) +
+                    number_text(kMemoryShare * 100.0) + "% of the " + gib(limit) +
                     " this process may use (physical memory, cgroup and ulimit); lower --agents" +
                     (options.html ? ", --seconds or leave out --html" : " or --seconds"));
 }

@@ -5,11 +5,10 @@
 
 #include <set>
 
-#include <glm/gtc/quaternion.hpp>
-
 #include "mmvk/channel_kinds.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/features.hpp"
+#include "support/motion_fixtures.hpp"
 
 namespace mmvk {
 namespace {
@@ -174,30 +173,9 @@ TEST(ChannelKinds, MissingFieldsAreNamed) {
   }
 }
 
-// A two-legged walker with role-resolvable (Bandai-style) names.
-Motion walker(std::uint32_t frames) {
-  Motion m;
-  m.skeleton.names = {"Hips", "UpperLeg_L", "Foot_L", "UpperLeg_R", "Foot_R"};
-  m.skeleton.parents = {-1, 0, 1, 0, 3};
-  m.skeleton.rest_offsets = {glm::vec3(0, 1, 0), glm::vec3(0.1f, -0.05f, 0), glm::vec3(0, -0.9f, 0),
-                             glm::vec3(-0.1f, -0.05f, 0), glm::vec3(0, -0.9f, 0)};
-  m.fps = 30.0f;
-  m.frame_count = frames;
-  for (std::uint32_t f = 0; f < frames; ++f) {
-    const float swing = 0.4f * std::sin(0.3f * float(f));
-    const glm::quat rotations[] = {glm::angleAxis(0.02f * float(f), glm::vec3(0, 1, 0)),
-                                   glm::angleAxis(swing, glm::vec3(1, 0, 0)), glm::quat(1, 0, 0, 0),
-                                   glm::angleAxis(-swing, glm::vec3(1, 0, 0)), glm::quat(1, 0, 0, 0)};
-    for (std::size_t j = 0; j < 5; ++j) {
-      m.local_positions.push_back(j == 0 ? glm::vec3(0.0f, 1.0f, 0.05f * float(f)) : m.skeleton.rest_offsets[j]);
-      m.local_rotations.push_back(rotations[j]);
-    }
-  }
-  return m;
-}
-
 TEST(ChannelKinds, EveryKindExtractsFiniteValuesInItsColumns) {
-  const Motion motion = walker(40);
+  // Walking 1.5 m/s, turning 0.6 rad/s, legs swinging 0.4 rad.
+  const Motion motion = test::walker(40, 1.5f, 0.0f, 0.6f, 0.4f);
   Result<CharacterRoot> root = compute_character_root(motion, {});
   ASSERT_TRUE(root.ok()) << root.message();
   for (const ChannelKindInfo& info : channel_kinds()) {

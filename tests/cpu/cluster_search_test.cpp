@@ -16,11 +16,7 @@
 namespace mmvk {
 namespace {
 
-Database make_database(test::ClusteredDataSpec spec = {}) {
-  Result<Database> db = Database::create(test::clustered_parts(spec));
-  EXPECT_TRUE(db.ok()) << db.message();
-  return std::move(db).value();
-}
+using test::clustered_database;
 
 ClusterTable make_table(const Database& db, std::uint32_t clusters) {
   KMeansParams params;
@@ -129,7 +125,7 @@ const Variant kExactVariants[] = {
 // 200 clusters: several groups of 32 (the level above the clusters, whose
 // bounds decide which cluster bounds are computed at all); both walks.
 TEST(ClusterSearch, MatchesReferenceBitForBitUnderEveryConstraint) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   ThreadPool pool(2);
   ReferenceSearch reference(db);
   const ConstrainedQueries queries = constrained_queries(db, 240, 11);
@@ -162,7 +158,7 @@ TEST(ClusterSearch, UniqueMinimaAreFoundWithDefaultParams) {
   // reference decides; plain clips keep multiplier 1 and bias 0.
   test::ClusteredDataSpec spec;
   spec.varied_clips = false;
-  const Database db = make_database(spec);
+  const Database db = clustered_database(spec);
   const ClusterTable table = make_table(db, 40);
   ThreadPool pool(2);
   auto backend = ClusterSearch::create(db, table, pool);
@@ -190,7 +186,7 @@ Database zero_spread_database(std::uint32_t frames, std::uint32_t blobs) {
   spec.blobs = blobs;
   spec.blob_spread = 0.0f;
   spec.varied_clips = false;
-  return make_database(spec);
+  return clustered_database(spec);
 }
 
 TEST(ClusterSearch, TiesGoToTheLowerFrameId) {
@@ -215,7 +211,7 @@ TEST(ClusterSearch, TiesGoToTheLowerFrameId) {
 }
 
 TEST(ClusterSearch, AllCandidatesExcludedGivesNone) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   const ClusterTable table = make_table(db, 20);
   ThreadPool pool(1);
   auto backend = ClusterSearch::create(db, table, pool);
@@ -231,7 +227,7 @@ TEST(ClusterSearch, AllCandidatesExcludedGivesNone) {
 }
 
 TEST(ClusterSearch, NprobeResultsAreRealCandidatesWithTrueCosts) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   const ClusterTable table = make_table(db, 30);
   ThreadPool pool(2);
   const std::size_t count = 120;
@@ -260,7 +256,7 @@ TEST(ClusterSearch, NprobeResultsAreRealCandidatesWithTrueCosts) {
 }
 
 TEST(ClusterSearch, CountsRowsAndPrunes) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   const ClusterTable table = make_table(db, 45);
   ThreadPool pool(2);
   auto backend = ClusterSearch::create(db, table, pool);
@@ -280,7 +276,7 @@ TEST(ClusterSearch, CountsRowsAndPrunes) {
 // One tile module serves both CPU backends: they pick the same kernels, the
 // widest this CPU runs, and the baseline when asked.
 TEST(ClusterSearch, PicksTheSameKernelsAsFastSearch) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   const ClusterTable table = make_table(db, 10);
   ThreadPool pool(1);
   for (bool baseline : {false, true}) {
@@ -304,7 +300,7 @@ TEST(ClusterSearch, PicksTheSameKernelsAsFastSearch) {
 }
 
 TEST(ClusterSearch, BadInputIsAnError) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   const ClusterTable table = make_table(db, 10);
   ThreadPool pool(1);
   auto backend = ClusterSearch::create(db, table, pool);
@@ -329,7 +325,7 @@ TEST(ClusterSearch, BadInputIsAnError) {
   // A table from another database.
   test::ClusteredDataSpec spec;
   spec.seed = 99;
-  const Database other = make_database(spec);
+  const Database other = clustered_database(spec);
   auto mismatched = ClusterSearch::create(other, table, pool);
   ASSERT_FALSE(mismatched.ok());
   EXPECT_NE(mismatched.message().find("another database"), std::string::npos) << mismatched.message();
@@ -343,7 +339,7 @@ TEST(ClusterSearch, BadInputIsAnError) {
 TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
   test::ClusteredDataSpec spec;
   spec.frames = 6000;
-  const Database db = make_database(spec);
+  const Database db = clustered_database(spec);
   ReferenceSearch reference(db);
   const ConstrainedQueries queries = constrained_queries(db, 1100, 21);
   const std::size_t count = queries.count;
@@ -393,7 +389,7 @@ TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
 // nprobe runs the grouped path too: the exact best over the nprobe nearest
 // clusters, so the same lists as the one-query walk, under every constraint.
 TEST(ClusterSearch, GroupedNprobeEqualsTheOneQueryWalk) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   ThreadPool pool(2);
   const ConstrainedQueries queries = constrained_queries(db, 700, 41);
   // 150 clusters: the clusters are reordered into groups of 32 inside the
@@ -448,7 +444,7 @@ TEST(ClusterSearch, NprobeTiesGoToTheLowerClusterId) {
 // Every instruction set this CPU runs, forced, in both CPU backends, against
 // the reference; a set the CPU lacks is refused by create().
 TEST(CpuKernels, EveryInstructionSetTheCpuRunsMatchesTheReference) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   const ClusterTable table = make_table(db, 25);
   ThreadPool pool(2);
   ReferenceSearch reference(db);

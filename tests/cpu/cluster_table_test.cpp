@@ -15,11 +15,7 @@
 namespace mmvk {
 namespace {
 
-Database make_database(test::ClusteredDataSpec spec = {}) {
-  Result<Database> db = Database::create(test::clustered_parts(spec));
-  EXPECT_TRUE(db.ok()) << db.message();
-  return std::move(db).value();
-}
+using test::clustered_database;
 
 void expect_same_table(const ClusterTable& a, const ClusterTable& b) {
   EXPECT_EQ(a.database_hash, b.database_hash);
@@ -40,7 +36,7 @@ void expect_same_table(const ClusterTable& a, const ClusterTable& b) {
 }
 
 TEST(ClusterTable, TrainingIsDeterministicAcrossRunsAndThreadCounts) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   KMeansParams params;
   params.clusters = 24;
   params.max_training_frames = 1000;  // exercise the subsample
@@ -57,7 +53,7 @@ TEST(ClusterTable, TrainingIsDeterministicAcrossRunsAndThreadCounts) {
 }
 
 TEST(ClusterTable, EveryFrameInExactlyOneClusterAndBoundsCoverMembers) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   KMeansParams params;  // default cluster count: round(sqrt(2000)) = 45
   Result<ClusterTable> table = train_cluster_table(db, params);
   ASSERT_TRUE(table.ok()) << table.message();
@@ -90,7 +86,7 @@ TEST(ClusterTable, EveryFrameInExactlyOneClusterAndBoundsCoverMembers) {
 }
 
 TEST(ClusterTable, FramesGoToTheirNearestCentroid) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   KMeansParams params;
   params.clusters = 16;
   Result<ClusterTable> table = train_cluster_table(db, params);
@@ -127,7 +123,7 @@ TEST(ClusterTable, DegenerateDataKeepsEmptyClustersValid) {
   spec.blobs = 3;
   spec.blob_spread = 0.0f;
   spec.clip_frames = 100;
-  const Database db = make_database(spec);
+  const Database db = clustered_database(spec);
   KMeansParams params;
   params.clusters = 8;
   Result<ClusterTable> table = train_cluster_table(db, params);
@@ -138,7 +134,7 @@ TEST(ClusterTable, DegenerateDataKeepsEmptyClustersValid) {
 TEST(ClusterTable, BadParameters) {
   test::ClusteredDataSpec spec;
   spec.frames = 50;
-  const Database db = make_database(spec);
+  const Database db = clustered_database(spec);
   KMeansParams params;
   params.clusters = 51;
   Result<ClusterTable> table = train_cluster_table(db, params);
@@ -171,7 +167,7 @@ class ClusterTableFile : public ::testing::Test {
     return loaded.ok() ? std::string() : loaded.message();
   }
 
-  Database db_ = make_database();
+  Database db_ = clustered_database();
   ClusterTable table_;
   std::filesystem::path path_;
   std::string bytes_;
@@ -219,10 +215,10 @@ TEST_F(ClusterTableFile, MissingFileIsAnError) {
 }
 
 TEST(ClusterTableValidation, TableFromAnotherDatabaseIsRejected) {
-  const Database a = make_database();
+  const Database a = clustered_database();
   test::ClusteredDataSpec spec;
   spec.seed = 8;
-  const Database b = make_database(spec);
+  const Database b = clustered_database(spec);
   KMeansParams params;
   params.clusters = 10;
   Result<ClusterTable> table = train_cluster_table(a, params);
@@ -233,7 +229,7 @@ TEST(ClusterTableValidation, TableFromAnotherDatabaseIsRejected) {
 
   spec.seed = 7;
   spec.frames = 1500;
-  const Database smaller = make_database(spec);
+  const Database smaller = clustered_database(spec);
   ClusterTable forged = *table;
   forged.database_hash = smaller.content_hash();  // same hash, wrong frame count
   const Status frames = validate_cluster_table(forged, smaller);
@@ -242,7 +238,7 @@ TEST(ClusterTableValidation, TableFromAnotherDatabaseIsRejected) {
 }
 
 TEST(ClusterTableValidation, BrokenBoundsAreRejected) {
-  const Database db = make_database();
+  const Database db = clustered_database();
   KMeansParams params;
   params.clusters = 10;
   const ClusterTable table = *train_cluster_table(db, params);

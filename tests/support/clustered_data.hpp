@@ -7,7 +7,10 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <gtest/gtest.h>
 
 #include "mmvk/database.hpp"
 #include "mmvk/feature_schema.hpp"
@@ -89,6 +92,13 @@ inline DatabaseParts clustered_parts(const ClusteredDataSpec& spec) {
     parts.clips.push_back(clip);
   }
   return parts;
+}
+
+// The database of clustered_parts(spec); a test failure if it is refused.
+inline Database clustered_database(const ClusteredDataSpec& spec = {}) {
+  Result<Database> db = Database::create(clustered_parts(spec));
+  EXPECT_TRUE(db.ok()) << db.message();
+  return std::move(db).value();
 }
 
 }  // namespace mmvk::test

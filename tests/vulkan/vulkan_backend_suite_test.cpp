@@ -13,19 +13,8 @@ namespace mmvk::test {
 namespace {
 
 template <bool Validation>
-struct VulkanFactory {
-  std::unique_ptr<vulkan::Context> context;
-  BackendRegistry registry;  // made through the backend registry
-  std::string error;
-
-  VulkanFactory() {
-    vulkan::ContextOptions options;
-    options.validation = Validation;
-    context = make_test_context(error, options);
-    if (context) {
-      if (Status added = vulkan::add_backends(registry, *context); !added) error = added.message();
-    }
-  }
+struct VulkanFactory : VulkanRegistryFactory {
+  VulkanFactory() : VulkanRegistryFactory(options()) {}
   ~VulkanFactory() {
     if (context && Validation) {
       const std::vector<std::string> messages = context->validation_messages();
@@ -33,13 +22,10 @@ struct VulkanFactory {
     }
   }
 
-  std::string skip_reason() {
-    if (context) return {};
-    if (vulkan_required()) {
-      ADD_FAILURE() << error;
-      return {};
-    }
-    return error;
+  static vulkan::ContextOptions options() {
+    vulkan::ContextOptions options;
+    options.validation = Validation;
+    return options;
   }
 
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {

@@ -23,27 +23,8 @@ namespace {
 // Made through the backend registry (mmvk::vulkan::add_backends); the
 // cache keeps one table per database alive with the context.
 template <bool Exact, std::uint32_t NProbe>
-struct VulkanClusterFactory {
+struct VulkanClusterFactory : VulkanRegistryFactory {
   ClusterTableCache tables;
-  std::unique_ptr<vulkan::Context> context;
-  BackendRegistry registry;
-  std::string error;
-
-  VulkanClusterFactory() {
-    context = make_test_context(error);
-    if (context) {
-      if (Status added = vulkan::add_backends(registry, *context); !added) error = added.message();
-    }
-  }
-
-  std::string skip_reason() {
-    if (context) return {};
-    if (vulkan_required()) {
-      ADD_FAILURE() << error;
-      return {};
-    }
-    return error;
-  }
 
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
     if (!context) return make_error(error);

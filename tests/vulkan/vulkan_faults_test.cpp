@@ -18,11 +18,6 @@
 namespace mmvk::test {
 namespace {
 
-using vulkan::Context;
-using vulkan::ContextOptions;
-using vulkan::VulkanSearch;
-using vulkan::VulkanSearchOptions;
-
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 ContextOptions capped(std::uint32_t storage_range, std::uint32_t texels, VkDeviceSize heap) {

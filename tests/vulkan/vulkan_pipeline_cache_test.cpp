@@ -10,33 +10,16 @@
 #include "mmvk/reference_search.hpp"
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
-#include "support/backend_suite.hpp"
 #include "support/device_nodes.hpp"
+#include "support/search_test_data.hpp"
 #include "support/test_data.hpp"
 #include "vulkan_test_env.hpp"
 
 namespace mmvk::test {
-
-// This file uses the suite's data helpers; the suite itself runs in
-// vulkan_backend_suite_test.cpp.
-GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BackendSuite);
-
 namespace {
 
-using vulkan::Context;
-using vulkan::ContextOptions;
-using vulkan::VulkanSearch;
-using vulkan::VulkanSearchOptions;
-
 // Small variants (tile <= 4, k <= 4) so the kernels compile quickly.
-VulkanSearchOptions small_options(bool warm_up) {
-  VulkanSearchOptions options;
-  options.max_batch = 16;
-  options.max_k = 4;
-  options.max_tile = 4;
-  options.warm_up = warm_up;
-  return options;
-}
+VulkanSearchOptions small_options(bool warm_up) { return search_options(16, 4, 4, warm_up); }
 
 ContextOptions with_blob(std::vector<std::byte> blob) {
   ContextOptions options;

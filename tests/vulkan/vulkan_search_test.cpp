@@ -10,34 +10,12 @@
 
 #include "mmvk/reference_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
-#include "support/backend_suite.hpp"
+#include "support/search_test_data.hpp"
 #include "support/test_data.hpp"
 #include "vulkan_test_env.hpp"
 
 namespace mmvk::test {
-
-// This file uses the suite's data helpers; the suite itself runs in
-// vulkan_backend_suite_test.cpp.
-GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BackendSuite);
-
 namespace {
-
-using vulkan::Context;
-using vulkan::ContextOptions;
-using vulkan::VulkanSearch;
-using vulkan::VulkanSearchOptions;
-
-// Options without designated initializers (GCC warns about the members
-// they leave out).
-VulkanSearchOptions search_options(std::uint32_t max_batch, std::uint32_t max_k, std::uint32_t max_tile = 16,
-                                   bool warm_up = true) {
-  VulkanSearchOptions options;
-  options.max_batch = max_batch;
-  options.max_k = max_k;
-  options.max_tile = max_tile;
-  options.warm_up = warm_up;
-  return options;
-}
 
 ContextOptions validation_options() {
   ContextOptions options;

@@ -3,15 +3,25 @@
 // it and pins lavapipe), so a missing driver never passes silently.
 #pragma once
 
+#include <cstdint>
 #include <cstdlib>
 #include <memory>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "mmvk/backends.hpp"
+#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/context.hpp"
+#include "mmvk/vulkan/vulkan_search.hpp"
 
 namespace mmvk::test {
+
+// The Vulkan types every Vulkan test names.
+using vulkan::Context;
+using vulkan::ContextOptions;
+using vulkan::VulkanSearch;
+using vulkan::VulkanSearchOptions;
 
 inline bool vulkan_required() {
   const char* value = std::getenv("MMVK_REQUIRE_VULKAN");
@@ -25,6 +35,44 @@ inline std::unique_ptr<vulkan::Context> make_test_context(std::string& reason,
   if (context.ok()) return std::move(context).value();
   reason = "no usable Vulkan device: " + context.message();
   return nullptr;
+}
+
+// The Vulkan backends in a registry over one test Context, for the typed
+// backend suites' factories: `error` says why there is no context (or why
+// the backends could not be added); skip_reason() turns that into a skip,
+// or a failure when MMVK_REQUIRE_VULKAN is set.
+struct VulkanRegistryFactory {
+  std::unique_ptr<vulkan::Context> context;
+  BackendRegistry registry;
+  std::string error;
+
+  explicit VulkanRegistryFactory(const vulkan::ContextOptions& options = {}) {
+    context = make_test_context(error, options);
+    if (context) {
+      if (Status added = vulkan::add_backends(registry, *context); !added) error = added.message();
+    }
+  }
+
+  std::string skip_reason() {
+    if (context) return {};
+    if (vulkan_required()) {
+      ADD_FAILURE() << error;
+      return {};
+    }
+    return error;
+  }
+};
+
+// VulkanSearch options without designated initializers (GCC warns about
+// the members they leave out).
+inline vulkan::VulkanSearchOptions search_options(std::uint32_t max_batch, std::uint32_t max_k,
+                                                  std::uint32_t max_tile = 16, bool warm_up = true) {
+  vulkan::VulkanSearchOptions options;
+  options.max_batch = max_batch;
+  options.max_k = max_k;
+  options.max_tile = max_tile;
+  options.warm_up = warm_up;
+  return options;
 }
 
 }  // namespace mmvk::test

@@ -1,21 +1,11 @@
 #include "database/cost_overflow.hpp"
 
 #include <cmath>
-#include <cstdio>
 
 #include "database/cost_bound.hpp"
+#include "mmvk/number_text.hpp"
 
 namespace mmvk::detail {
-
-namespace {
-
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
-
-}  // namespace
 
 Status check_cost_overflow(const Database& database, const std::string& source) {
   const FeatureSchema& schema = database.schema();
@@ -26,7 +16,7 @@ Status check_cost_overflow(const Database& database, const std::string& source) 
     const double channel = channel_distance_bound(database, corner, c);
     if (!(channel <= kMaxCostBound)) {
       return make_error(source + ": schema channel '" + schema.channels[c].name + "': weight " +
-                        number(schema.channels[c].weight) +
+                        number_text(schema.channels[c].weight) +
                         " makes its costs overflow float (the weight scales the normalized features); lower it");
     }
     total += channel;
@@ -34,14 +24,16 @@ Status check_cost_overflow(const Database& database, const std::string& source) 
   if (!(total <= kMaxCostBound)) {
     return make_error(source + ": the schema's weights together make the costs overflow float; lower them");
   }
-  const std::string overflow = " would make costs overflow float (the features' costs reach " + number(total) + ")";
+  const std::string overflow =
+      " would make costs overflow float (the features' costs reach " + number_text(total) + ")";
   for (const Clip& clip : database.clips()) {
     const std::string where = source + ": clip '" + clip.name + "' (" + clip.source + "): ";
     if (!(std::fabs(double(clip.cost_bias)) <= kMaxCostBound)) {
-      return make_error(where + "cost_bias " + number(clip.cost_bias) + " would make costs overflow float; lower it");
+      return make_error(where + "cost_bias " + number_text(clip.cost_bias) +
+                        " would make costs overflow float; lower it");
     }
     if (!(double(clip.cost_multiplier) * total + std::fabs(double(clip.cost_bias)) <= kMaxCostBound)) {
-      return make_error(where + "cost_multiplier " + number(clip.cost_multiplier) + overflow + "; lower it");
+      return make_error(where + "cost_multiplier " + number_text(clip.cost_multiplier) + overflow + "; lower it");
     }
   }
   // Cost ranges multiply the clip's values frame by frame.
@@ -51,8 +43,8 @@ Status check_cost_overflow(const Database& database, const std::string& source) 
     if (double(multiplier[f]) * total + std::fabs(double(bias[f])) <= kMaxCostBound) continue;
     const Clip& clip = database.clips()[database.frame_clip()[f]];
     return make_error(source + ": clip '" + clip.name + "' (" + clip.source + "): cost_ranges: frame " +
-                      std::to_string(f - clip.first_frame) + " has cost multiplier " + number(multiplier[f]) +
-                      " and bias " + number(bias[f]) + ", which" + overflow + "; lower them");
+                      std::to_string(f - clip.first_frame) + " has cost multiplier " + number_text(multiplier[f]) +
+                      " and bias " + number_text(bias[f]) + ", which" + overflow + "; lower them");
   }
   return {};
 }

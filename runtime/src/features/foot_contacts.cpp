@@ -6,6 +6,7 @@
 #include <string>
 
 #include "mmvk/character.hpp"
+#include "mmvk/number_text.hpp"
 
 namespace mmvk::detail {
 
@@ -130,16 +131,6 @@ ClipContacts detect_foot_contacts(const Skeleton& skeleton, std::span<const glm:
 
 namespace mmvk {
 
-namespace {
-
-std::string number(float value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", double(value));
-  return text;
-}
-
-}  // namespace
-
 Status validate_foot_contact_params(const FootContactParams& params, const std::string& where) {
   std::string error;
   for_each_contact_bone(params, [&](const char* name, const std::string& bone) {
@@ -147,20 +138,20 @@ Status validate_foot_contact_params(const FootContactParams& params, const std::
   });
   for_each_contact_number(params, [&](const char* name, float value) {
     if (error.empty() && (!std::isfinite(value) || value < 0.0f)) {
-      error = where + "." + name + ": must be a finite number >= 0, got " + number(value);
+      error = where + "." + name + ": must be a finite number >= 0, got " + number_text(value);
     }
   });
   if (!error.empty()) return make_error(error);
   if (params.exit_height < params.enter_height) {
-    return make_error(where + ".exit_height: must be >= enter_height (" + number(params.enter_height) +
-                      "), got " + number(params.exit_height));
+    return make_error(where + ".exit_height: must be >= enter_height (" + number_text(params.enter_height) +
+                      "), got " + number_text(params.exit_height));
   }
   if (params.exit_speed < params.enter_speed) {
-    return make_error(where + ".exit_speed: must be >= enter_speed (" + number(params.enter_speed) +
-                      "), got " + number(params.exit_speed));
+    return make_error(where + ".exit_speed: must be >= enter_speed (" + number_text(params.enter_speed) +
+                      "), got " + number_text(params.exit_speed));
   }
   if (params.floor_percentile > 1.0f) {
-    return make_error(where + ".floor_percentile: must be in [0, 1], got " + number(params.floor_percentile));
+    return make_error(where + ".floor_percentile: must be in [0, 1], got " + number_text(params.floor_percentile));
   }
   return {};
 }

@@ -30,6 +30,7 @@ template <> struct MaskOf<V8> { using type = std::int32_t __attribute__((vector_
 template <> struct MaskOf<V16> { using type = std::int32_t __attribute__((vector_size(64))); };
 
 #define MMVK_INLINE inline __attribute__((always_inline))
+#define MMVK_INLINE_LAMBDA __attribute__((always_inline))
 
 // The helpers below take and return vectors but are always inlined into
 // this file's entry points, so the ABI note GCC and Clang give for them is
@@ -87,6 +88,26 @@ MMVK_INLINE V row_cost(const TileArrays& t, std::size_t lane0, const V& total) {
   return load<V>(t.multiplier + lane0) * total + load<V>(t.bias + lane0);
 }
 
+// Visits every vector of a group of T tiles for every query: its first
+// lane, the query, the vector's costs and its passing lanes (rows within
+// the query's threshold). `total` is the weighted channel sums.
+template <class V, int Q, int T, int P, class Visit>
+MMVK_INLINE void visit_costs(const TileArrays& t, const KernelQuery* queries, const std::uint32_t* tile,
+                             const V (&total)[Q][T][P], Visit&& visit) {
+  using M = typename MaskOf<V>::type;
+  constexpr int W = sizeof(V) / sizeof(float);
+  for (int j = 0; j < T; ++j) {
+    for (int p = 0; p < P; ++p) {
+      const std::size_t lane0 = std::size_t{tile[j]} * kLanes + p * W;
+      const M valid = load<M>(t.lane_valid + lane0);
+      for (int q = 0; q < Q; ++q) {
+        const V cost = row_cost(t, lane0, total[q][j][p]);
+        visit(lane0, q, cost, M((cost <= queries[q].threshold) & valid));
+      }
+    }
+  }
+}
+
 // Evaluates T tiles at once: with one 16-lane vector per tile (AVX-512)
 // and one query, a single tile is one chain of dependent adds and runs at
 // the add latency; T independent tiles keep the adder busy. Every lane's
@@ -133,33 +154,17 @@ MMVK_INLINE std::size_t evaluate_tile_group(const TileArrays& t, const KernelQue
   // rather than kept; and the test ORs each vector's any_lane, not the
   // lane masks (either made GCC compare AVX-512 lanes one by one).
   bool any_pass = false;
-  for (int j = 0; j < T; ++j) {
-    for (int p = 0; p < P; ++p) {
-      const std::size_t lane0 = std::size_t{tile[j]} * kLanes + p * W;
-      const M valid = load<M>(t.lane_valid + lane0);
-      for (int q = 0; q < Q; ++q) {
-        const V cost = row_cost(t, lane0, total[q][j][p]);
-        any_pass |= any_lane((cost <= queries[q].threshold) & valid);
-      }
-    }
-  }
+  visit_costs(t, queries, tile, total,
+              [&](std::size_t, int, const V&, const M& pass) MMVK_INLINE_LAMBDA { any_pass |= any_lane(pass); });
   if (!any_pass) return 0;
-  for (int j = 0; j < T; ++j) {
-    for (int p = 0; p < P; ++p) {
-      const std::size_t lane0 = std::size_t{tile[j]} * kLanes + p * W;
-      const M valid = load<M>(t.lane_valid + lane0);
-      for (int q = 0; q < Q; ++q) {
-        const V cost = row_cost(t, lane0, total[q][j][p]);
-        const M pass = (cost <= queries[q].threshold) & valid;
-        if (!any_lane(pass)) continue;
-        for (int lane = 0; lane < W; ++lane) {
-          if (pass[lane] != 0) {
-            hits[hit_count++] = LaneHit{static_cast<std::uint32_t>(lane0) + lane, cost[lane], std::uint32_t(q)};
-          }
-        }
+  visit_costs(t, queries, tile, total, [&](std::size_t lane0, int q, const V& cost, const M& pass) MMVK_INLINE_LAMBDA {
+    if (!any_lane(pass)) return;
+    for (int lane = 0; lane < W; ++lane) {
+      if (pass[lane] != 0) {
+        hits[hit_count++] = LaneHit{static_cast<std::uint32_t>(lane0) + lane, cost[lane], std::uint32_t(q)};
       }
     }
-  }
+  });
   return hit_count;
 }
 

@@ -72,6 +72,42 @@ std::string version_string(std::uint32_t v) {
          std::to_string(VK_API_VERSION_PATCH(v));
 }
 
+// The properties read beyond VkPhysicalDeviceProperties, in one
+// vkGetPhysicalDeviceProperties2 chain (all core in Vulkan 1.2). Filled in
+// place: the chain points into the struct itself.
+struct ChainedProperties {
+  VkPhysicalDeviceDriverProperties driver{};
+  VkPhysicalDeviceMaintenance3Properties maintenance3{};
+  VkPhysicalDeviceSubgroupProperties subgroup{};
+  VkPhysicalDeviceProperties2 properties{};
+
+  explicit ChainedProperties(VkPhysicalDevice device) {
+    driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
+    maintenance3.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES;
+    maintenance3.pNext = &driver;
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    subgroup.pNext = &maintenance3;
+    properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    properties.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(device, &properties);
+  }
+  ChainedProperties(const ChainedProperties&) = delete;
+  ChainedProperties& operator=(const ChainedProperties&) = delete;
+};
+
+// The largest device-local heap, bytes.
+VkDeviceSize device_local_bytes(VkPhysicalDevice device) {
+  VkPhysicalDeviceMemoryProperties memory{};
+  vkGetPhysicalDeviceMemoryProperties(device, &memory);
+  VkDeviceSize largest = 0;
+  for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+    if ((memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0) {
+      largest = std::max(largest, memory.memoryHeaps[h].size);
+    }
+  }
+  return largest;
+}
+
 Result<std::vector<VkPhysicalDevice>> physical_devices(VkInstance instance) {
   std::uint32_t count = 0;
   MMVK_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
@@ -257,17 +293,9 @@ Status Context::init_device_info(const DeviceLimitCaps& caps) {
       memory_properties_.memoryHeaps[h].size = std::min(memory_properties_.memoryHeaps[h].size, caps.heap_bytes);
     }
   }
-  VkPhysicalDeviceMaintenance3Properties maintenance3{};
-  maintenance3.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES;
-  VkPhysicalDeviceSubgroupProperties subgroup{};
-  subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
-  subgroup.pNext = &maintenance3;
-  VkPhysicalDeviceProperties2 props2{};
-  props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-  props2.pNext = &subgroup;
-  vkGetPhysicalDeviceProperties2(physical_device_, &props2);
-  subgroup_size_ = std::max<std::uint32_t>(1, subgroup.subgroupSize);
-  max_allocation_size_ = maintenance3.maxMemoryAllocationSize;
+  const ChainedProperties chained(physical_device_);
+  subgroup_size_ = std::max<std::uint32_t>(1, chained.subgroup.subgroupSize);
+  max_allocation_size_ = chained.maintenance3.maxMemoryAllocationSize;
 
   std::uint32_t count = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &count, nullptr);
@@ -358,9 +386,11 @@ Result<std::vector<DeviceInfo>> Context::enumerate_devices() {
   std::vector<DeviceInfo> infos;
   if (devices) {
     for (VkPhysicalDevice device : *devices) {
-      VkPhysicalDeviceProperties props;
-      vkGetPhysicalDeviceProperties(device, &props);
-      infos.push_back(DeviceInfo{props.deviceName, props.deviceType, props.apiVersion});
+      const ChainedProperties chained(device);
+      const VkPhysicalDeviceProperties& props = chained.properties.properties;
+      infos.push_back(DeviceInfo{props.deviceName, props.deviceType, props.apiVersion,
+                                 std::string(chained.driver.driverName) + " " + chained.driver.driverInfo,
+                                 chained.subgroup.subgroupSize, device_local_bytes(device)});
     }
   }
   vkDestroyInstance(*instance, nullptr);

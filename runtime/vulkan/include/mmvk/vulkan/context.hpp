@@ -77,6 +77,9 @@ struct DeviceInfo {
   std::string name;
   VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
   std::uint32_t api_version = 0;
+  std::string driver;                   // driver name and version text
+  std::uint32_t subgroup_size = 0;      // lanes
+  VkDeviceSize device_local_bytes = 0;  // the largest device-local heap
 };
 
 class Context {

@@ -142,6 +142,7 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.held_.assign(n, 0);
   if (locker.ok()) c.locker_ = std::move(*locker);
   c.world_.resize(n * c.joints_);
+  c.anim_world_.resize(n * c.joints_);
   c.no_feet_flags_.assign(2 * n, 0);
   c.no_feet_anchors_.assign(2 * n, glm::vec3(0.0f));
   c.past_pos_.resize(n * past.size());
@@ -390,11 +391,13 @@ void CrowdController::display(std::uint32_t b, float dt) {
   const std::span<glm::quat> rotations(rotations_.data() + base, joints_);
   const std::span<glm::vec3> translations(translations_.data() + base, joints_);
   const std::span<glm::vec3> world(world_.data() + base, joints_);
+  const std::span<glm::vec3> animated(anim_world_.data() + base, joints_);
   if (locker_) {
-    locker_->update(b, dt, contacts_[b], root_pos_[b], root_yaw_[b], rotations, translations, world);
+    locker_->update(b, dt, contacts_[b], root_pos_[b], root_yaw_[b], rotations, translations, world, animated);
   } else {
     forward_kinematics_batch(animation_->skeleton, rotations, translations, {&root_pos_[b], 1}, {&root_yaw_[b], 1},
                              world);
+    std::copy(world.begin(), world.end(), animated.begin());
   }
 }
 

@@ -370,11 +370,12 @@ void CrowdController::measure_shown(std::uint32_t b, float dt, bool fresh) {
   // Velocities by backward differences of world positions: what the viewer
   // sees, root motion and corrections included.
   const std::span<const int> joints = assembler_.velocity_joints();
+  // One sine and cosine per character (yaw_rotate's, written out).
   const float c = std::cos(root_yaw_[b]);
   const float s = std::sin(root_yaw_[b]);
   for (std::size_t k = 0; k < joints.size(); ++k) {
     const glm::vec3 local = joint_positions_[base + static_cast<std::size_t>(joints[k])];
-    const glm::vec3 world = root_pos_[b] + yaw_rotate(local, root_yaw_[b]);
+    const glm::vec3 world = root_pos_[b] + glm::vec3(local.x * c + local.z * s, local.y, -local.x * s + local.z * c);
     glm::vec3& last = velocity_world_[b * joints.size() + k];
     const glm::vec3 v = fresh || !(dt > 0.0f) ? glm::vec3(0.0f) : (world - last) / dt;
     joint_velocities_[b * joints.size() + k] = {v.x * c - v.z * s, v.y, v.x * s + v.z * c};

@@ -219,7 +219,7 @@ class TickLoop {
     const auto tick_start = Clock::now();
     const auto roots = controller_.root_positions();
     for (std::uint32_t b = 0; b < controller_.size(); ++b) x_[b] = roots[b].x, z_[b] = roots[b].z;
-    steering_.update(x_, z_, vx_, vz_);
+    steering_.update(x_, z_, vx_, vz_, &pool_);
     for (std::uint32_t b = 0; b < controller_.size(); ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
     observed_.begin_tick();
     MMVK_TRY(controller_.tick(dt_, CrowdInput{desired_, {}}, observed_, pool_));
@@ -229,7 +229,7 @@ class TickLoop {
 
     controller_.world_positions(world_, pool_);
     const TickView view{t, desired_, {}, matches, world_};
-    quality_.observe(controller_, view, pool_);
+    quality_.observe(controller_, view);
     if (trace_) trace_->record(world_, controller_.contacts(), controller_.foot_locked());
     if (recording_) recording_->observe(controller_, view);
     return {};

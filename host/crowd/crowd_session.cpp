@@ -110,7 +110,7 @@ Status CrowdSession::place(std::uint32_t b, float x, float z, float yaw, std::ui
 Status CrowdSession::step() {
   const auto roots = controller_->root_positions();
   for (std::uint32_t b = 0; b < agents_; ++b) x_[b] = roots[b].x, z_[b] = roots[b].z;
-  steering_->update(x_, z_, vx_, vz_);
+  steering_->update(x_, z_, vx_, vz_, &pool_);
   for (std::uint32_t b = 0; b < agents_; ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
   return tick(desired_, {});
 }
@@ -141,7 +141,7 @@ Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const fl
 
   c.world_positions(world_, pool_);
   const TickView view{ticks_, desired, desired_yaw, matches, world_};
-  quality_->observe(c, view, pool_);
+  quality_->observe(c, view);
   // The recording ends at the first page written.
   if (recording_ && !html_written_) recording_->observe(c, view);
   ++ticks_;

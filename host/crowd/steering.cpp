@@ -24,19 +24,48 @@ Steering::Steering(const Scenario& scenario, const GaitSpeeds& speeds, const Ste
 
 std::array<float, 2> Steering::goal(std::size_t agent) const { return goals_[goal_begin_[agent] + goal_index_[agent]]; }
 
+namespace {
+
+// Characters below this count are steered on the calling thread: waking the
+// pool costs more than the work.
+constexpr std::size_t kParallelMin = 128;
+
+}  // namespace
+
 void Steering::update(std::span<const float> x, std::span<const float> z, std::span<float> desired_vx,
-                      std::span<float> desired_vz) {
+                      std::span<float> desired_vz, ThreadPool* pool) {
   const std::size_t n = speed_.size();
+  grid_.build(x.first(n), z.first(n), params_.separation_radius_m);
+  if (pool == nullptr || pool->thread_count() == 1 || n < kParallelMin) {
+    steer(0, n, x, z, desired_vx, desired_vz, goals_reached_);
+    return;
+  }
+  // Sized on the first update with this pool: no allocation per tick after it.
+  if (reached_by_thread_.size() < pool->thread_count()) reached_by_thread_.resize(pool->thread_count());
+  std::fill(reached_by_thread_.begin(), reached_by_thread_.end(), std::uint64_t{0});
+  // One pointer to the spans besides `this`: the body fits std::function's
+  // inline storage (no allocation per tick).
+  const struct {
+    std::span<const float> x, z;
+    std::span<float> vx, vz;
+  } io{x, z, desired_vx, desired_vz};
+  pool->parallel_for(n, [this, &io](std::size_t begin, std::size_t end, unsigned thread) {
+    steer(begin, end, io.x, io.z, io.vx, io.vz, reached_by_thread_[thread]);
+  });
+  for (const std::uint64_t reached : reached_by_thread_) goals_reached_ += reached;
+}
+
+void Steering::steer(std::size_t begin, std::size_t end, std::span<const float> x, std::span<const float> z,
+                     std::span<float> desired_vx, std::span<float> desired_vz, std::uint64_t& reached) {
   const float radius = params_.separation_radius_m;
-  grid_.build(x.first(n), z.first(n), radius);
-  for (std::size_t a = 0; a < n; ++a) {
+  for (std::size_t a = begin; a < end; ++a) {
     std::array<float, 2> target = goal(a);
     float gx = target[0] - x[a], gz = target[1] - z[a];
     float distance = std::sqrt(gx * gx + gz * gz);
     if (distance < params_.goal_radius_m) {
       const std::uint32_t count = goal_begin_[a + 1] - goal_begin_[a];
       goal_index_[a] = (goal_index_[a] + 1) % count;
-      ++goals_reached_;
+      ++reached;
       target = goal(a);
       gx = target[0] - x[a], gz = target[1] - z[a];
       distance = std::sqrt(gx * gx + gz * gz);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gait_speeds.hpp"
+#include "mmvk/thread_pool.hpp"
 #include "scenario.hpp"
 #include "spatial_grid.hpp"
 
@@ -37,9 +38,11 @@ class Steering {
 
   // From the characters' current positions (x, z in metres, [N] each):
   // advances the goals of those within goal_radius_m and writes desired
-  // velocities (m/s, [N] each).
+  // velocities (m/s, [N] each). With a pool, the characters are split over
+  // its threads (each one's velocity depends only on the positions, so the
+  // result is the same bit for bit); the grid is built on the calling thread.
   void update(std::span<const float> x, std::span<const float> z, std::span<float> desired_vx,
-              std::span<float> desired_vz);
+              std::span<float> desired_vz, ThreadPool* pool = nullptr);
 
  private:
   SteeringParams params_;
@@ -48,7 +51,11 @@ class Steering {
   std::vector<std::uint32_t> goal_index_;            // [N] current goal within the agent's list
   std::vector<std::array<float, 2>> goals_;
   std::uint64_t goals_reached_ = 0;
+  std::vector<std::uint64_t> reached_by_thread_;  // per pool thread, summed after each update
   SpatialGrid grid_;
+
+  void steer(std::size_t begin, std::size_t end, std::span<const float> x, std::span<const float> z,
+             std::span<float> desired_vx, std::span<float> desired_vz, std::uint64_t& reached);
 };
 
 }  // namespace mmvk::crowd

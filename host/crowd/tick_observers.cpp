@@ -60,10 +60,9 @@ QualityObserver::QualityObserver(const CrowdController& controller, const Contro
       motion_(controller.size(), controller.animation().joint_count(),
               motion_params(controller, params, clips, dt, rate_hz, fps)),
       desired_xz_(2 * std::size_t{controller.size()}),
-      root_xz_(2 * std::size_t{controller.size()}),
-      animated_(std::size_t{controller.size()} * controller.animation().joint_count()) {}
+      root_xz_(2 * std::size_t{controller.size()}) {}
 
-void QualityObserver::observe(const CrowdController& controller, const TickView& view, ThreadPool& pool) {
+void QualityObserver::observe(const CrowdController& controller, const TickView& view) {
   // Where the controller wants each character 1 s from now, and where it is.
   const auto sim = controller.simulation();
   const auto roots = controller.root_positions();
@@ -78,9 +77,9 @@ void QualityObserver::observe(const CrowdController& controller, const TickView&
   meter_.record_trajectory(desired_xz_, root_xz_);
   meter_.add_transitions(controller.last_tick().jumps);
   meter_.end_tick();
-  // The pose as displayed (after foot IK) and as animated (before).
-  controller.animated_world_positions(animated_, pool);
-  motion_.record({view.world, animated_, controller.contacts(), controller.foot_locked(),
+  // The pose as displayed (after foot IK) and as animated (before), the
+  // latter kept by the tick's own FK rather than computed again.
+  motion_.record({view.world, controller.displayed_animated_world(), controller.contacts(), controller.foot_locked(),
                   controller.ik_reach_clamped(), controller.jumped()});
 }
 

@@ -64,7 +64,9 @@ class QualityObserver {
   QualityObserver(const CrowdController& controller, const ControllerParams& params, const ClipQuality& clips,
                   double dt, double rate_hz, double fps);
 
-  void observe(const CrowdController& controller, const TickView& view, ThreadPool& pool);
+  // After the controller's AsyncSearch tick (the pose before foot IK is then
+  // the one the tick displayed: CrowdController::displayed_animated_world).
+  void observe(const CrowdController& controller, const TickView& view);
   // The trajectory, transition and motion figures into `summary`.
   void summarize(CrowdSummary& summary) const;
 
@@ -72,9 +74,8 @@ class QualityObserver {
   SpringParams spring_;
   QualityMeter meter_;
   MotionMeter motion_;
-  // Per tick, sized once: [agents x 2] and [agents x joints].
+  // Per tick, sized once: [agents x 2].
   std::vector<float> desired_xz_, root_xz_;
-  std::vector<glm::vec3> animated_;
 };
 
 // The viewer's recording (crowd_recorder.hpp), fed what each tick searched.

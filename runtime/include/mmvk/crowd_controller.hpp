@@ -177,6 +177,12 @@ class CrowdController {
   std::span<const glm::quat> animated_rotations() const { return anim_rotations_; }
   std::span<const glm::vec3> animated_translations() const { return anim_translations_; }
   void animated_world_positions(std::span<glm::vec3> out, ThreadPool& pool) const;
+  // The same positions as the last display saw them, [B x joints], kept at no
+  // cost (the foot locker's FK): after a tick that took the previous tick's
+  // matches (the AsyncSearch tick) they equal animated_world_positions() bit
+  // for bit; after the synchronous tick a character that jumped shows here
+  // its pose before the jump.
+  std::span<const glm::vec3> displayed_animated_world() const { return anim_world_; }
   // Foot locking (ControllerParams::foot_ik), per character and foot
   // (left, right), [B x 2]: 1 while the foot is held where it was planted;
   // the world position it is held at (metres); 1 when the leg could not
@@ -258,6 +264,7 @@ class CrowdController {
   std::vector<std::uint8_t> held_;            // [B] on a non-looping clip's last frame
   std::optional<FootLocker> locker_;
   std::vector<glm::vec3> world_;              // [B x joints] displayed world joint positions
+  std::vector<glm::vec3> anim_world_;         // [B x joints] the same before foot IK
   std::vector<std::uint8_t> no_feet_flags_;   // [B x 2] zeros, without a locker
   std::vector<glm::vec3> no_feet_anchors_;    // [B x 2]
 

@@ -140,9 +140,13 @@ class FootLocker {
   //     rotations, and the hips' translation when lowered).
   //   world_positions [joints]: out, the world joint positions of the output
   //     pose, world = root + R_y(yaw) * fk(pose) (as forward_kinematics_batch).
+  //   animated_world [joints] or empty: out, the world joint positions of the
+  //     pose as it came in, before IK (the same bits forward_kinematics_batch
+  //     gives; update computes them anyway, so a caller that wants both need
+  //     not run FK again).
   void update(std::uint32_t b, float dt, std::uint8_t contacts, const glm::vec3& root_position, float root_yaw,
               std::span<glm::quat> local_rotations, std::span<glm::vec3> local_translations,
-              std::span<glm::vec3> world_positions);
+              std::span<glm::vec3> world_positions, std::span<glm::vec3> animated_world = {});
 
   // Forgets character b's locks, corrections and hip drop (a teleport: the
   // controller's place()). Its next update locks planted feet afresh.

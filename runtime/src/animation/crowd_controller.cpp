@@ -142,6 +142,7 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.held_.assign(n, 0);
   if (locker.ok()) c.locker_ = std::move(*locker);
   c.world_.resize(n * c.joints_);
+  c.anim_world_.resize(n * c.joints_);
   c.no_feet_flags_.assign(2 * n, 0);
   c.no_feet_anchors_.assign(2 * n, glm::vec3(0.0f));
   c.past_pos_.resize(n * past.size());
@@ -369,11 +370,12 @@ void CrowdController::measure_shown(std::uint32_t b, float dt, bool fresh) {
   // Velocities by backward differences of world positions: what the viewer
   // sees, root motion and corrections included.
   const std::span<const int> joints = assembler_.velocity_joints();
+  // One sine and cosine per character (yaw_rotate's, written out).
   const float c = std::cos(root_yaw_[b]);
   const float s = std::sin(root_yaw_[b]);
   for (std::size_t k = 0; k < joints.size(); ++k) {
     const glm::vec3 local = joint_positions_[base + static_cast<std::size_t>(joints[k])];
-    const glm::vec3 world = root_pos_[b] + yaw_rotate(local, root_yaw_[b]);
+    const glm::vec3 world = root_pos_[b] + glm::vec3(local.x * c + local.z * s, local.y, -local.x * s + local.z * c);
     glm::vec3& last = velocity_world_[b * joints.size() + k];
     const glm::vec3 v = fresh || !(dt > 0.0f) ? glm::vec3(0.0f) : (world - last) / dt;
     joint_velocities_[b * joints.size() + k] = {v.x * c - v.z * s, v.y, v.x * s + v.z * c};
@@ -390,11 +392,13 @@ void CrowdController::display(std::uint32_t b, float dt) {
   const std::span<glm::quat> rotations(rotations_.data() + base, joints_);
   const std::span<glm::vec3> translations(translations_.data() + base, joints_);
   const std::span<glm::vec3> world(world_.data() + base, joints_);
+  const std::span<glm::vec3> animated(anim_world_.data() + base, joints_);
   if (locker_) {
-    locker_->update(b, dt, contacts_[b], root_pos_[b], root_yaw_[b], rotations, translations, world);
+    locker_->update(b, dt, contacts_[b], root_pos_[b], root_yaw_[b], rotations, translations, world, animated);
   } else {
     forward_kinematics_batch(animation_->skeleton, rotations, translations, {&root_pos_[b], 1}, {&root_yaw_[b], 1},
                              world);
+    std::copy(world.begin(), world.end(), animated.begin());
   }
 }
 

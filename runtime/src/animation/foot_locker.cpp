@@ -254,10 +254,12 @@ void FootLocker::reset(std::uint32_t b) {
 
 void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const glm::vec3& root_position,
                         float root_yaw, std::span<glm::quat> local_rotations,
-                        std::span<glm::vec3> local_translations, std::span<glm::vec3> world_positions) {
+                        std::span<glm::vec3> local_translations, std::span<glm::vec3> world_positions,
+                        std::span<glm::vec3> animated_world) {
   const std::size_t joints = parents_.size();
   assert(b < characters_ && local_rotations.size() >= joints && local_translations.size() >= joints &&
-         world_positions.size() >= joints && dt >= 0.0f);
+         world_positions.size() >= joints && (animated_world.empty() || animated_world.size() >= joints) &&
+         dt >= 0.0f);
   glm::quat stack[kStackJoints];
   glm::quat* global = joints <= kStackJoints ? stack : wide_scratch_.data() + std::size_t{b} * joints;
   glm::quat* rotations = local_rotations.data();
@@ -278,6 +280,7 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
       global[j] = global[p] * rotations[j];
     }
   }
+  if (!animated_world.empty()) std::copy(world, world + joints, animated_world.begin());
   if (!params_.enabled) {
     clear(b);
     return;

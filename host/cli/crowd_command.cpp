@@ -16,6 +16,7 @@
 #include "mmvk/number_text.hpp"
 #include "crowd_backend.hpp"
 #include "crowd_run.hpp"
+#include "crowd_defaults.hpp"
 #include "default_data.hpp"
 #include "user_cache_dir.hpp"
 
@@ -59,7 +60,8 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
            "BVH (built once and cached in $XDG_CACHE_HOME/mmvk or ~/.cache/mmvk). Default: " +
                default_data_name());
   cli.integer("--agents", options.agents, "N",
-              "characters (default 1000, at most 10,000,000; with --scenario, its count)", 1, 10'000'000);
+              "characters (default " + std::to_string(crowd::kDefaultAgents) +
+                  ", at most 10,000,000; with --scenario, its count)", 1, 10'000'000);
   cli.positive("--seconds", options.seconds, "S", "simulated time (default " + number_text(options.seconds) + "; 1 to 10,000,000 ticks)");
   cli.positive("--rate", options.rate_hz, "HZ",
                "simulation ticks per second (default " + number_text(options.rate_hz) +
@@ -88,7 +90,9 @@ void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
               return text == "on";
             });
   cli.finite("--continuing-bias", options.continuing_bias, "B",
-             "added to the cost of the frame a character would play anyway (default -2.5: a jump must win by 2.5)");
+             "added to the cost of the frame a character would play anyway (default " +
+                 number_text(crowd::kContinuingBias) + ": a jump must win by " + number_text(-crowd::kContinuingBias) +
+                 ")");
   cli.value("--continuing-multiplier", options.continuing_multiplier, "M",
             "multiplies that frame's cost first (finite, >= 0; default 1)", [](const std::string& text) -> Result<float> {
               MMVK_ASSIGN_OR_RETURN(const float multiplier, parse_float("--continuing-multiplier", text));
@@ -101,7 +105,8 @@ void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
             [](const std::string& text) { return parse_weight_list("--weights", text); });
   cli.positive("--correction-half-life", options.correction_half_life, "S",
                "half-life of the pull of each character's animated root towards its simulated position (default: "
-               "the shipped set's, below; other data 0.15 s; shorter holds the characters closer to their paths, with "
+               "the shipped set's, below; other data " + number_text(crowd::kCorrectionHalfLife) +
+                   " s; shorter holds the characters closer to their paths, with "
                "more root motion that the animation did not make)");
 }
 

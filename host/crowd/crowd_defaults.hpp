@@ -4,7 +4,12 @@
 // measurements that chose them.
 #pragma once
 
+#include <cstdint>
+
 namespace mmvk::crowd {
+
+// Characters in a random scenario when neither --agents nor a scenario says.
+inline constexpr std::uint32_t kDefaultAgents = 1000;
 
 // Added to the cost of the frame a character would play anyway: a jump must
 // win by this much. Queries measure the pose the character shows, which

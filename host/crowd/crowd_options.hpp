@@ -12,7 +12,7 @@ namespace mmvk::crowd {
 
 struct CrowdOptions {
   std::optional<std::filesystem::path> data;  // a shipped set's name, .mmdb, manifest or BVH folder; none = the default set
-  std::optional<std::uint32_t> agents;        // none: 1000, or the scenario's count
+  std::optional<std::uint32_t> agents;        // none: kDefaultAgents, or the scenario's count
   double seconds = 10.0;                      // simulated time
   double rate_hz = 30.0;                      // simulation ticks per second
   double search_interval_s = 0.1;             // regular search period of each character

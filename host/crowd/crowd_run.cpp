@@ -70,7 +70,7 @@ Result<OpenedDatabase> open_crowd_database(const DataChoice& data, const CrowdOp
 Result<Scenario> make_scenario(const CrowdOptions& options, bool can_run) {
   if (!options.scenario) {
     RandomScenarioOptions random;
-    random.agents = options.agents.value_or(1000);
+    random.agents = options.agents.value_or(kDefaultAgents);
     random.seed = options.seed;
     if (!can_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     return make_random_scenario(random);

@@ -23,6 +23,7 @@
 #include "mmvk/file_io.hpp"
 #include "mmvk/query_builder.hpp"
 #include "observed_search.hpp"
+#include "observed_tick.hpp"
 #include "progress_line.hpp"
 #include "quality_meter.hpp"
 #include "run_summary.hpp"
@@ -39,9 +40,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 Status check_options(const CrowdOptions& o) {
   if (o.agents && *o.agents == 0) return make_error("--agents must be at least 1");
@@ -221,17 +219,10 @@ class TickLoop {
     for (std::uint32_t b = 0; b < controller_.size(); ++b) x_[b] = roots[b].x, z_[b] = roots[b].z;
     steering_.update(x_, z_, vx_, vz_, &pool_);
     for (std::uint32_t b = 0; b < controller_.size(); ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
-    observed_.begin_tick();
-    MMVK_TRY(controller_.tick(dt_, CrowdInput{desired_, {}}, observed_, pool_));
-    const auto matches = observed_.collected_matches();
-    figures_.record(t, ms_since(tick_start), observed_.blocked_seconds() * 1e3, matches,
-                    controller_.last_tick().searches);
-
-    controller_.world_positions(world_, pool_);
-    const TickView view{t, desired_, {}, matches, world_};
-    quality_.observe(controller_, view);
+    MMVK_TRY(observed_tick(controller_, observed_, pool_, t, dt_, CrowdInput{desired_, {}}, tick_start, world_,
+                           {figures_, quality_, recording_})
+                 .status());
     if (trace_) trace_->record(world_, controller_.contacts(), controller_.foot_locked());
-    if (recording_) recording_->observe(controller_, view);
     return {};
   }
 

@@ -10,6 +10,7 @@
 #include "crowd_limits.hpp"
 #include "gait_plan.hpp"
 #include "observed_search.hpp"
+#include "observed_tick.hpp"
 #include "run_summary.hpp"
 #include "viewer/viewer_html.hpp"
 
@@ -130,20 +131,13 @@ Status CrowdSession::step(std::span<const glm::vec3> desired_velocity, std::span
 
 // The loop body of run_crowd (crowd_run.cpp), for one tick.
 Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const float> desired_yaw) {
-  CrowdController& c = *controller_;
-  const auto tick_start = Clock::now();
-  observed_->begin_tick();
-  MMVK_TRY(c.tick(float(dt_), CrowdInput{desired, desired_yaw}, *observed_, pool_));
-  const double tick_s = std::chrono::duration<double>(Clock::now() - tick_start).count();
-  wall_s_ += tick_s;
-  const auto matches = observed_->collected_matches();
-  figures_.record(ticks_, tick_s * 1e3, observed_->blocked_seconds() * 1e3, matches, c.last_tick().searches);
-
-  c.world_positions(world_, pool_);
-  const TickView view{ticks_, desired, desired_yaw, matches, world_};
-  quality_->observe(c, view);
   // The recording ends at the first page written.
-  if (recording_ && !html_written_) recording_->observe(c, view);
+  RecordingObserver* recording = html_written_ ? nullptr : recording_.get();
+  MMVK_ASSIGN_OR_RETURN(const double tick_ms,
+                        observed_tick(*controller_, *observed_, pool_, ticks_, float(dt_),
+                                      CrowdInput{desired, desired_yaw}, Clock::now(), world_,
+                                      {figures_, *quality_, recording}));
+  wall_s_ += tick_ms / 1e3;
   ++ticks_;
   return {};
 }

@@ -21,12 +21,12 @@ namespace mmvk::cli {
 namespace {
 
 constexpr const char* kBuildDescription =
-    "Builds a motion matching database from BVH motion capture. A folder of BVH is built with the default schema "
-    "and options; a JSON manifest names clips, tags, flags and options (see runtime/include/mmvk/manifest.hpp).";
+    "Builds a motion matching database from BVH motion capture. A BVH file or a folder of BVH is built with the "
+    "default schema and options; a JSON manifest names clips, tags, flags and options (see runtime/include/mmvk/manifest.hpp).";
 
 // The command line, parsed: overrides of the manifest and build options.
 struct BuildArgs {
-  std::string input;  // manifest or folder of BVH
+  std::string input;  // manifest, folder of BVH or one BVH file
   std::string output;
   std::optional<double> fps;
   std::optional<std::string> schema;
@@ -84,7 +84,7 @@ Status check_paths(const BuildArgs& args, const Manifest& manifest) {
   std::error_code ec;
   const bool folder = std::filesystem::is_directory(args.input, ec);
   std::vector<NamedPath> paths = {{"-o", args.output, true},
-                                  {folder ? "the BVH folder" : "the manifest", args.input, false}};
+                                  {folder ? "the BVH folder" : "the input", args.input, false}};
   if (args.schema) paths.push_back({"--schema", *args.schema, false});
   for (const std::filesystem::path& file : manifest_input_files(manifest)) paths.push_back({"the input", file, false});
   return check_command_paths(paths);
@@ -147,7 +147,7 @@ int run_build(Args args, const char*) {
 
 }  // namespace
 
-const Command kBuildCommand{"build", "<manifest.json | bvh-dir> -o db.mmdb", "build a database from BVH motion capture",
+const Command kBuildCommand{"build", "<manifest.json | bvh-dir | file.bvh> -o db.mmdb", "build a database from BVH motion capture",
                             run_build};
 
 }  // namespace mmvk::cli

@@ -205,6 +205,22 @@ TEST(Manifest, LoadsSchemaFilesRelativeToTheManifest) {
   EXPECT_EQ(manifest->clips[0].file, dir / "walk.bvh");
 }
 
+TEST(Manifest, OneBvhFileIsOneClipWithTheFolderDefaults) {
+  const auto dir = test::make_temp_dir();
+  std::ofstream(dir / "Walk.BVH") << "x";
+  Result<Manifest> manifest = load_manifest_or_directory(dir / "Walk.BVH");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  ASSERT_EQ(manifest->clips.size(), 1u);
+  EXPECT_EQ(manifest->clips[0].file, dir / "Walk.BVH");
+  EXPECT_EQ(manifest->clips[0].name, "Walk");
+  EXPECT_EQ(manifest->schema.dims(), Manifest{}.schema.dims());
+  // Any other file is read as a manifest, and its error says so.
+  std::ofstream(dir / "walk.txt") << "x";
+  Result<Manifest> other = load_manifest_or_directory(dir / "walk.txt");
+  ASSERT_FALSE(other.ok());
+  EXPECT_NE(other.message().find("walk.txt: not valid JSON"), std::string::npos) << other.message();
+}
+
 TEST(Manifest, FolderOfBvhUsesDefaults) {
   const auto dir = test::make_temp_dir();
   std::ofstream(dir / "b.bvh") << "x";

@@ -321,5 +321,20 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   EXPECT_NE(run(mmvk.string() + " inspect " + db), 0);
 }
 
+TEST(DatabaseBuild, CommandLineBuildsOneBvhFile) {
+  MMVK_REQUIRE_DATA_DIR(data);
+  const auto cli = test::cli_binary();
+  if (!cli) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
+  const auto dir = test::make_temp_dir();
+  const std::filesystem::path walk = bandai(data, "dataset-2_walk_normal_003");
+  const std::string db = (dir / "walk.mmdb").string();
+  ASSERT_EQ(run(cli->string() + " build " + walk.string() + " -o " + db + " --fps 30 --no-progress"), 0);
+  Result<Database> loaded = load_database(db);
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  ASSERT_EQ(loaded->clips().size(), 1u);
+  EXPECT_EQ(loaded->clips()[0].name, walk.stem().string());
+  EXPECT_GT(loaded->frame_count(), 100u);
+}
+
 }  // namespace
 }  // namespace mmvk

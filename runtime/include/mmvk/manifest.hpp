@@ -160,7 +160,8 @@ Result<Manifest> load_manifest(const std::filesystem::path& path);
 // directly in `dir`, sorted by file name; clip names are the file stems.
 Result<Manifest> manifest_from_directory(const std::filesystem::path& dir);
 
-// A manifest file or a folder of BVH, whichever `path` is.
+// A manifest file, a folder of BVH or one BVH file (*.bvh, one clip with the
+// folder's defaults), whichever `path` is.
 Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path);
 
 // Every file a build of `manifest` reads besides the manifest itself: each

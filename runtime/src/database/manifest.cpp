@@ -462,17 +462,13 @@ Result<Manifest> load_manifest(const std::filesystem::path& path) {
   return parse_manifest_json(*text, path.string(), path.parent_path());
 }
 
-Result<Manifest> manifest_from_directory(const std::filesystem::path& dir) {
-  std::error_code error;
-  std::vector<std::filesystem::path> files;
-  for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
-    if (it->is_regular_file(error) && is_bvh(it->path())) files.push_back(it->path());
-  }
-  if (error) return make_error(dir.string() + ": cannot list the folder: " + error.message());
-  if (files.empty()) return make_error(dir.string() + ": no .bvh files in the folder");
-  std::sort(files.begin(), files.end());
+namespace {
+
+// The manifest of BVH files with default options, one clip per file named by
+// its stem.
+Manifest manifest_of_clip_files(std::string source, const std::vector<std::filesystem::path>& files) {
   Manifest manifest;
-  manifest.source = dir.string();
+  manifest.source = std::move(source);
   for (const std::filesystem::path& file : files) {
     ManifestClip clip;
     clip.file = file;
@@ -482,10 +478,26 @@ Result<Manifest> manifest_from_directory(const std::filesystem::path& dir) {
   return manifest;
 }
 
+}  // namespace
+
+Result<Manifest> manifest_from_directory(const std::filesystem::path& dir) {
+  std::error_code error;
+  std::vector<std::filesystem::path> files;
+  for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+    if (it->is_regular_file(error) && is_bvh(it->path())) files.push_back(it->path());
+  }
+  if (error) return make_error(dir.string() + ": cannot list the folder: " + error.message());
+  if (files.empty()) return make_error(dir.string() + ": no .bvh files in the folder");
+  std::sort(files.begin(), files.end());
+  return manifest_of_clip_files(dir.string(), files);
+}
+
 Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) return manifest_from_directory(path);
   if (!std::filesystem::exists(path, error)) return make_error(path.string() + ": no such file or folder");
+  // A BVH file given where a manifest is expected is one clip, as in a folder.
+  if (is_bvh(path)) return manifest_of_clip_files(path.string(), {path});
   return load_manifest(path);
 }
 

@@ -4,6 +4,17 @@
 // (topk_merge.comp) merges the blocks and adds each query's continuing
 // frame, which this pass skips.
 //
+// A workgroup scans rows_per_invocation x WG consecutive rows and its lanes
+// take them in turn (lane l: rows first + l, first + WG + l, ...), so at
+// every step the lanes read consecutive rows: with the feature rows
+// interleaved by kRowGroup (search_layout.glsl) each texel fetch reads one
+// contiguous run, coalesced on a GPU and a single prefetchable stream on
+// lavapipe. With a block of consecutive rows per lane, the 8 lanes read 8
+// streams a block apart, and a third of lavapipe's time went to the stalls
+// of those loads (perf, Bandai volume 417k). Workgroups are dispatched
+// tiles first (x = tile, y = row group), so the tiles that read the same
+// rows run one after another, while the rows are still in the caches.
+//
 // Why this shape (shared/LAVAPIPE.md): query tiles in registers beat shared
 // memory 3-5x on lavapipe; rows are read as RGBA32F texels (vectorized
 // gathers); the row loop runs at most rows_per_invocation (<= 32k)
@@ -46,9 +57,10 @@ layout(constant_id = 3) const uint T = 1;  // queries per tile
 uint query_index(uint local) { return pc.query_base + min(local, pc.query_count - 1u); }
 
 void main() {
-  const uint block = gl_GlobalInvocationID.x;
+  const uint lane = gl_LocalInvocationID.x;
+  const uint block = gl_WorkGroupID.y * gl_WorkGroupSize.x + lane;
   if (block >= pc.block_count) return;
-  const uint tile_first = gl_WorkGroupID.y * T;
+  const uint tile_first = gl_WorkGroupID.x * T;
 
   vec4 q[T][DV];
   float w[T][CHANNELS];
@@ -75,17 +87,20 @@ void main() {
     worst[t] = kInfinity;
   }
 
-  const uint row_begin = block * pc.rows_per_invocation;
-  const uint row_end = min(row_begin + pc.rows_per_invocation, pc.frame_count);
-  for (uint r = row_end; r > row_begin;) {
-    --r;
+  // This lane's rows: first + step x j for j < steps, scanned downwards.
+  const uint step = gl_WorkGroupSize.x;
+  const uint first = gl_WorkGroupID.y * step * pc.rows_per_invocation + lane;
+  const uint steps = first >= pc.frame_count ? 0u : min(pc.rows_per_invocation, (pc.frame_count - first + step - 1u) / step);
+  for (uint j = steps; j > 0u;) {
+    --j;
+    const uint r = first + j * step;
     const uvec4 meta = texelFetch(frame_meta, int(r));
     vec2 scale_bias = texelFetch(frame_cost, int(r)).xy;
     // Do-not-use, edge-excluded and block-transition rows are candidates only
     // as a continuing frame, which the merge pass evaluates.
     if ((meta.x & (kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition)) != 0u) scale_bias.y = kNaN;
     vec4 x[DV];
-    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(r * DV + v));
+    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(r, v));
 
     [[unroll]] for (uint t = 0; t < T; ++t) {
       const float cost = row_cost(x, q[t], w[t], scale_bias);

@@ -34,7 +34,7 @@ struct QueryGpu {
 layout(push_constant) uniform SearchPush {
   uint frame_count;
   uint rows_per_invocation;
-  uint block_count;        // ceil(frame_count / rows_per_invocation)
+  uint block_count;        // scan invocations (kernel_shape.hpp: KernelShape::block_count)
   uint query_base;         // first query of this chunk in the query buffers
   uint query_count;        // queries in this chunk
   uint pad0;
@@ -43,7 +43,16 @@ layout(push_constant) uniform SearchPush {
 } pc;
 #endif
 
-// [frames x dims/4] texels: the feature matrix, dims padded to 4 with zeros.
+// search_layout.hpp: kRowGroup. The feature matrix's rows are interleaved in
+// groups of kRowGroup consecutive rows, [frame / kRowGroup][dims/4][frame %
+// kRowGroup]: lanes that scan consecutive rows read consecutive texels
+// (coalesced on a GPU; on lavapipe a gather from one 128-byte run, which the
+// hardware prefetcher follows, instead of 8 streams).
+const uint kRowGroup = 8u;
+
+// [ceil(frames / kRowGroup) x dims/4 x kRowGroup] texels: the feature matrix,
+// dims padded to 4 with zeros, rows interleaved (feature_texel()); rows past
+// the last frame are zeros.
 layout(set = 0, binding = 0) uniform samplerBuffer features;
 // [frames] texels: (flags, tags low 32 bits, tags high 32 bits, clip index).
 layout(set = 0, binding = 1) uniform usamplerBuffer frame_meta;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "search_layout.hpp"
 
 namespace mmvk::vulkan::detail {
 
@@ -60,10 +61,16 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
 
   // Host copies in the kernels' layouts; creation-time only.
   {
-    std::vector<float> features(frames * padded, 0.0f);
+    // Rows interleaved by kRowGroup (search_layout.hpp), the last group
+    // padded with zero rows.
+    const std::size_t groups = (frames + kRowGroup - 1) / kRowGroup;
+    std::vector<float> features(groups * kRowGroup * padded, 0.0f);
     const std::span<const float> source = database.features();
     for (std::size_t f = 0; f < frames; ++f) {
-      for (std::size_t d = 0; d < device.dims; ++d) features[f * padded + d] = source[f * device.dims + d];
+      for (std::size_t d = 0; d < device.dims; ++d) {
+        features[feature_texel(f, static_cast<std::uint32_t>(d / 4), device.dim_vec4s) * 4 + d % 4] =
+            source[f * device.dims + d];
+      }
     }
     Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(features),
                                                    "the feature matrix", force_staging);

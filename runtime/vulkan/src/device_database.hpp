@@ -1,5 +1,8 @@
 // A Database in device-local memory, in the layout the kernels read:
-//  features   [frames x dims/4] RGBA32F texels, dims padded to 4 with zeros
+//  features   [ceil(frames / kRowGroup) x dims/4 x kRowGroup] RGBA32F texels,
+//             dims padded to 4 with zeros, rows interleaved in groups of
+//             kRowGroup (search_layout.hpp: feature_texel()), zero rows past
+//             the last frame
 //  frame_meta [frames] RGBA32UI texels (flags, tags low, tags high, clip)
 //  frame_cost [frames] RG32F texels (cost multiplier, cost bias)
 // Texel buffers, not storage buffers: texelFetch is a vectorized gather on

@@ -62,7 +62,11 @@ Result<KernelShape> make_kernel_shape(const Context& context, const Database& da
   shape.channels = static_cast<std::uint32_t>(channels.size());
   shape.workgroup_size = workgroup_size(context);
   MMVK_ASSIGN_OR_RETURN(shape.rows_per_invocation, rows_per_invocation(shape.frame_count, options));
-  shape.block_count = (shape.frame_count + shape.rows_per_invocation - 1) / shape.rows_per_invocation;
+  // The scan's invocations are its blocks; a workgroup's lanes take its
+  // rows in turn (brute_force_scan.comp), so blocks come in whole workgroups.
+  const std::uint32_t group_rows = shape.rows_per_invocation * shape.workgroup_size;
+  shape.block_count =
+      static_cast<std::uint32_t>((std::uint64_t{shape.frame_count} + group_rows - 1) / group_rows) * shape.workgroup_size;
   if (shape.block_count > kMaxScanBlocks) {
     return make_error("VulkanSearch: rows_per_invocation " + std::to_string(shape.rows_per_invocation) + " gives " +
                       std::to_string(shape.block_count) + " blocks, over " + std::to_string(kMaxScanBlocks));

@@ -41,7 +41,7 @@ struct KernelShape {
   std::uint32_t end_mask[4] = {};    // bit d: dim d ends a channel
   std::uint32_t workgroup_size = 1;
   std::uint32_t rows_per_invocation = 1;
-  std::uint32_t block_count = 1;     // ceil(frame_count / rows_per_invocation)
+  std::uint32_t block_count = 1;     // scan invocations: ceil(frame_count / (rows_per_invocation x workgroup)) x workgroup
 };
 
 // Kept pairs per query: 1, 4 or 16 (the smallest class >= k).

@@ -43,9 +43,20 @@ static_assert(sizeof(SearchPush) == 32);
 static_assert(sizeof(SearchPush) <= 128, "Vulkan guarantees only 128 bytes of push constants");
 static_assert(offsetof(SearchPush, query_count) == 16);
 
+// GLSL: kRowGroup. The feature texels are interleaved in groups of this many
+// consecutive rows, [frame / kRowGroup][dim_vec4s][frame % kRowGroup]
+// (feature_texel() in search_layout.glsl), so that the lanes of a subgroup
+// that scan consecutive rows read one contiguous run of texels per vec4.
+inline constexpr std::uint32_t kRowGroup = 8;
+
+// The texel of (frame, vec4 v) in that layout, for dim_vec4s vec4s a row.
+constexpr std::uint64_t feature_texel(std::uint64_t frame, std::uint32_t v, std::uint32_t dim_vec4s) {
+  return ((frame / kRowGroup) * dim_vec4s + v) * kRowGroup + frame % kRowGroup;
+}
+
 // Descriptor bindings of set 0 (search_layout.glsl).
 enum Binding : std::uint32_t {
-  kBindingFeatures = 0,   // uniform texel buffer, RGBA32F
+  kBindingFeatures = 0,   // uniform texel buffer, RGBA32F, rows interleaved by kRowGroup
   kBindingFrameMeta = 1,  // uniform texel buffer, RGBA32UI
   kBindingFrameCost = 2,  // uniform texel buffer, RG32F
   kBindingQueries = 3,    // storage buffer

@@ -105,14 +105,14 @@ void main() {
     [[unroll]] for (uint t = 0; t < T; ++t) {
       const float cost = row_cost(x, q[t], w[t], scale_bias);
       // The candidate rules as integer operations, no short-circuit branch.
-      const uint rejected = ((meta.y & tags[t].x) ^ tags[t].x) | ((meta.z & tags[t].y) ^ tags[t].y) |
-                            (meta.y & tags[t].z) | (meta.z & tags[t].w) |
-                            uint(r - skipped[t].x <= skipped[t].y) | uint(r - skipped[t].z <= skipped[t].w);
+      const uint tag_bits = ((meta.y & tags[t].x) ^ tags[t].x) | ((meta.z & tags[t].y) ^ tags[t].y) |
+                            (meta.y & tags[t].z) | (meta.z & tags[t].w);
+      const bool rejected = tag_bits != 0u || r - skipped[t].x <= skipped[t].y || r - skipped[t].z <= skipped[t].w;
       if (K == 1u) {
-        const bool better = rejected == 0u && cost <= best_cost[t];
+        const bool better = !rejected && cost <= best_cost[t];
         best_cost[t] = better ? cost : best_cost[t];
         best_frame[t] = better ? r : best_frame[t];
-      } else if (rejected == 0u && !(cost > worst[t])) {
+      } else if (!rejected && !(cost > worst[t])) {
         // Rare once good rows were seen (but lavapipe masks, not skips, it).
         insert_row(best[t], worst[t], cost, r);
       }

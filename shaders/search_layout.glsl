@@ -32,7 +32,7 @@ struct QueryGpu {
 // constants (the cluster kernels) define MMVK_SEARCH_LAYOUT_OWN_PUSH.
 #ifndef MMVK_SEARCH_LAYOUT_OWN_PUSH
 layout(push_constant) uniform SearchPush {
-  uint frame_count;
+  uint scan_rows;          // rows of scan_frames
   uint rows_per_invocation;
   uint block_count;        // scan invocations (kernel_shape.hpp: KernelShape::block_count)
   uint query_base;         // first query of this chunk in the query buffers
@@ -58,16 +58,19 @@ layout(set = 0, binding = 0) uniform samplerBuffer features;
 layout(set = 0, binding = 1) uniform usamplerBuffer frame_meta;
 // [frames] texels: (cost multiplier, cost bias).
 layout(set = 0, binding = 2) uniform samplerBuffer frame_cost;
+// [scan rows] texels: the frames the brute-force scan visits (every frame
+// that can be a candidate other than as a continuing frame), ascending.
+layout(set = 0, binding = 3) uniform usamplerBuffer scan_frames;
 // [max_batch x dims/4] query features, padded like the rows.
-layout(std430, set = 0, binding = 3) readonly buffer Queries { vec4 query_features[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Queries { vec4 query_features[]; };
 // [max_batch] query parameters.
-layout(std430, set = 0, binding = 4) readonly buffer Params { QueryGpu query_params[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Params { QueryGpu query_params[]; };
 // [max_batch x channels] channel weights (non-empty channels only).
-layout(std430, set = 0, binding = 5) readonly buffer Weights { float query_weights[]; };
+layout(std430, set = 0, binding = 6) readonly buffer Weights { float query_weights[]; };
 // [chunk queries x blocks x K] per-block best (key, frame) pairs.
-layout(std430, set = 0, binding = 6) buffer Scratch { uvec2 scratch[]; };
+layout(std430, set = 0, binding = 7) buffer Scratch { uvec2 scratch[]; };
 // [max_batch x max_k] final best (key, frame) pairs, sorted.
-layout(std430, set = 0, binding = 7) writeonly buffer Results { uvec2 results[]; };
+layout(std430, set = 0, binding = 8) writeonly buffer Results { uvec2 results[]; };
 
 // A (cost, frame) pair as (orderable cost bits, frame): unsigned comparison
 // of the key follows float order, negative costs included.

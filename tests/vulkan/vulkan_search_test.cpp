@@ -116,6 +116,26 @@ TEST(VulkanSearch, InterleavedRowsCoverEveryFrame) {
   }
 }
 
+// The scan visits only frames no flag excludes (scan_frames); with every
+// frame flagged it visits none, and the continuing frames, which the merge
+// evaluates on its own, are the only answers.
+TEST(VulkanSearch, EveryFrameFlaggedLeavesTheContinuingFrames) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  DatabaseParts parts = synthetic_parts({.frames = 300, .clips = 3, .seed = 123});
+  for (std::uint32_t f = 0; f < 300; ++f) parts.frame_flags[f] = f % 2 == 0 ? kFrameBlockTransition : kFrameDoNotUse;
+  const Database db = make_database(std::move(parts));
+  const std::vector<float> queries = synthetic_queries(db, 4, 124);
+  std::vector<QueryParams> params(4);
+  params[0].continuing_frame = 10;  // block-transition: a candidate as the continuing frame
+  params[2].continuing_frame = 11;  // do-not-use: never a candidate
+  ReferenceSearch reference(db);
+  const std::vector<Match> expected = run_search(reference, queries, params, 4, 4);
+  ASSERT_EQ(expected[0].frame, 10u);
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, search_options(4, 4));
+  ASSERT_NE(search, nullptr);
+  expect_identical(expected, run_search(*search, queries, params, 4, 4), 4, params, search->name());
+}
+
 TEST(VulkanSearch, ChunkedBatchesMatchReference) {
   MMVK_VULKAN_CONTEXT(context, ContextOptions{});
   const Database db = synthetic_database({.frames = 6000, .seed = 105, .constraints = true});

@@ -91,7 +91,7 @@ Status BruteForceKernel::record(const Context& context, VkCommandBuffer commands
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);
     SearchPush push{};
-    push.frame_count = shape_.frame_count;
+    push.scan_rows = shape_.scan_rows;
     push.rows_per_invocation = shape_.rows_per_invocation;
     push.block_count = shape_.block_count;
     push.query_base = base;

@@ -50,6 +50,12 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
 
 
 
+std::uint32_t scan_row_count(const Database& database) {
+  std::uint32_t rows = 0;
+  for (const std::uint32_t flags : database.frame_flags()) rows += scanned_by_brute_force(flags) ? 1 : 0;
+  return rows;
+}
+
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
                                        bool force_staging) {
   DeviceDatabase device;
@@ -98,6 +104,18 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
                           force_staging);
     if (!buffer) return buffer.error();
     device.frame_cost = std::move(*buffer);
+  }
+  {
+    std::vector<std::uint32_t> scan;
+    for (std::uint32_t f = 0; f < device.frame_count; ++f) {
+      if (scanned_by_brute_force(database.frame_flags()[f])) scan.push_back(f);
+    }
+    device.scan_rows = static_cast<std::uint32_t>(scan.size());
+    if (scan.empty()) scan.push_back(0);  // a buffer is never empty; the scan reads none of it
+    Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32_UINT, 4, bytes_of(scan),
+                                                   "the scanned frames", force_staging);
+    if (!buffer) return buffer.error();
+    device.scan_frames = std::move(*buffer);
   }
   return device;
 }

@@ -5,6 +5,8 @@
 //             the last frame
 //  frame_meta [frames] RGBA32UI texels (flags, tags low, tags high, clip)
 //  frame_cost [frames] RG32F texels (cost multiplier, cost bias)
+//  scan_frames [scan rows] R32UI texels: the frames the brute-force scan
+//             visits, ascending (scanned_by_brute_force())
 // Texel buffers, not storage buffers: texelFetch is a vectorized gather on
 // lavapipe, and maxTexelBufferElements (128 Mi texels there) is far above
 // maxStorageBufferRange (128 MiB).
@@ -28,13 +30,26 @@ struct TexelBuffer {
   UniqueBufferView view;
 };
 
+// Whether the brute-force scan visits a frame with these FrameFlag bits: a
+// do-not-use, edge-excluded or block-transition frame is a candidate only as
+// a continuing frame, which the merge pass evaluates on its own (the CPU
+// tile store leaves the same rows out of its tiles).
+constexpr bool scanned_by_brute_force(std::uint32_t flags) {
+  return (flags & (kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition)) == 0;
+}
+
+// The number of frames of `database` the brute-force scan visits.
+std::uint32_t scan_row_count(const Database& database);
+
 struct DeviceDatabase {
   std::uint32_t frame_count = 0;
+  std::uint32_t scan_rows = 0;  // frames in scan_frames
   std::uint32_t dims = 0;
   std::uint32_t dim_vec4s = 0;  // ceil(dims / 4)
   TexelBuffer features;
   TexelBuffer frame_meta;
   TexelBuffer frame_cost;
+  TexelBuffer scan_frames;  // at least one texel, even with no scan rows
 };
 
 // force_staging: copy through a staging buffer even into mappable memory.

@@ -32,7 +32,7 @@ static_assert(offsetof(QueryGpu, continuing_multiplier) == 44);
 
 // GLSL: SearchPush (push constants of every search kernel).
 struct SearchPush {
-  std::uint32_t frame_count;
+  std::uint32_t scan_rows;  // rows of the scan_frames buffer
   std::uint32_t rows_per_invocation;
   std::uint32_t block_count;
   std::uint32_t query_base;
@@ -59,14 +59,15 @@ enum Binding : std::uint32_t {
   kBindingFeatures = 0,   // uniform texel buffer, RGBA32F, rows interleaved by kRowGroup
   kBindingFrameMeta = 1,  // uniform texel buffer, RGBA32UI
   kBindingFrameCost = 2,  // uniform texel buffer, RG32F
-  kBindingQueries = 3,    // storage buffer
-  kBindingParams = 4,     // storage buffer
-  kBindingWeights = 5,    // storage buffer
-  kBindingScratch = 6,    // storage buffer
-  kBindingResults = 7,    // storage buffer
-  kBindingCount = 8,
+  kBindingScanFrames = 3, // uniform texel buffer, R32UI
+  kBindingQueries = 4,    // storage buffer
+  kBindingParams = 5,     // storage buffer
+  kBindingWeights = 6,    // storage buffer
+  kBindingScratch = 7,    // storage buffer
+  kBindingResults = 8,    // storage buffer
+  kBindingCount = 9,
 };
-inline constexpr SetShape kSearchSet{3, 5};
+inline constexpr SetShape kSearchSet{4, 5};
 static_assert(kSearchSet.texel == kBindingQueries && kSearchSet.bindings() == kBindingCount);
 
 }  // namespace mmvk::vulkan::detail

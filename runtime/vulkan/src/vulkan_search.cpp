@@ -232,7 +232,8 @@ Status VulkanSearch::Impl::create_slots() {
   };
   static_assert(std::size(buffers) == kSearchSet.storage);
   const std::array<VkBufferView, kSearchSet.texel> views = {
-      device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get()};
+      device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get(),
+      device_database.scan_frames.view.get()};
   std::vector<VkCommandBuffer> commands(options.slots);
   VkCommandBufferAllocateInfo command_info{};
   command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
@@ -479,7 +480,7 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
   slot.in_flight = true;
   stats.queries += count;
   // Cluster modes count their rows on the GPU (added in wait()).
-  if (!clusters) stats.rows_evaluated += std::uint64_t{count} * shape.frame_count;
+  if (!clusters) stats.rows_evaluated += std::uint64_t{count} * shape.scan_rows;
   return Ticket{slot_index, slot.serial};
 }
 

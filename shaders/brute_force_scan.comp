@@ -94,17 +94,18 @@ void main() {
   const uint steps = first >= pc.scan_rows ? 0u : min(pc.rows_per_invocation, (pc.scan_rows - first + step - 1u) / step);
   for (uint j = steps; j > 0u;) {
     --j;
-    const uint r = texelFetch(scan_frames, int(first + j * step)).x;
-    const uvec4 meta = texelFetch(frame_meta, int(r));
-    const vec2 scale_bias = texelFetch(frame_cost, int(r)).xy;
+    const uint row = first + j * step;
+    const uint r = texelFetch(scan_frames, int(row)).x;
+    const uvec4 terms = texelFetch(scan_terms, int(row));  // (tags lo, tags hi, multiplier, bias)
+    const vec2 scale_bias = uintBitsToFloat(terms.zw);
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(r, v));
 
     [[unroll]] for (uint t = 0; t < T; ++t) {
       const float cost = row_cost(x, q[t], w[t], scale_bias);
       // The candidate rules as integer operations, no short-circuit branch.
-      const uint tag_bits = ((meta.y & tags[t].x) ^ tags[t].x) | ((meta.z & tags[t].y) ^ tags[t].y) |
-                            (meta.y & tags[t].z) | (meta.z & tags[t].w);
+      const uint tag_bits = ((terms.x & tags[t].x) ^ tags[t].x) | ((terms.y & tags[t].y) ^ tags[t].y) |
+                            (terms.x & tags[t].z) | (terms.y & tags[t].w);
       const bool rejected = tag_bits != 0u || r - skipped[t].x <= skipped[t].y || r - skipped[t].z <= skipped[t].w;
       if (K == 1u) {
         const bool better = !rejected && cost <= best_cost[t];

@@ -61,16 +61,20 @@ layout(set = 0, binding = 2) uniform samplerBuffer frame_cost;
 // [scan rows] texels: the frames the brute-force scan visits (every frame
 // that can be a candidate other than as a continuing frame), ascending.
 layout(set = 0, binding = 3) uniform usamplerBuffer scan_frames;
+// [scan rows] texels, in scan_frames' order: what the scan needs of each of
+// those frames, (tags low, tags high, cost multiplier bits, cost bias bits),
+// in one fetch that does not wait for the frame's index.
+layout(set = 0, binding = 4) uniform usamplerBuffer scan_terms;
 // [max_batch x dims/4] query features, padded like the rows.
-layout(std430, set = 0, binding = 4) readonly buffer Queries { vec4 query_features[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Queries { vec4 query_features[]; };
 // [max_batch] query parameters.
-layout(std430, set = 0, binding = 5) readonly buffer Params { QueryGpu query_params[]; };
+layout(std430, set = 0, binding = 6) readonly buffer Params { QueryGpu query_params[]; };
 // [max_batch x channels] channel weights (non-empty channels only).
-layout(std430, set = 0, binding = 6) readonly buffer Weights { float query_weights[]; };
+layout(std430, set = 0, binding = 7) readonly buffer Weights { float query_weights[]; };
 // [chunk queries x blocks x K] per-block best (key, frame) pairs.
-layout(std430, set = 0, binding = 7) buffer Scratch { uvec2 scratch[]; };
+layout(std430, set = 0, binding = 8) buffer Scratch { uvec2 scratch[]; };
 // [max_batch x max_k] final best (key, frame) pairs, sorted.
-layout(std430, set = 0, binding = 8) writeonly buffer Results { uvec2 results[]; };
+layout(std430, set = 0, binding = 9) writeonly buffer Results { uvec2 results[]; };
 
 // A (cost, frame) pair as (orderable cost bits, frame): unsigned comparison
 // of the key follows float order, negative costs included.

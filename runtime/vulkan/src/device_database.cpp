@@ -1,6 +1,7 @@
 #include "device_database.hpp"
 
 #include <array>
+#include <bit>
 #include <string>
 #include <vector>
 
@@ -116,6 +117,20 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
                                                    "the scanned frames", force_staging);
     if (!buffer) return buffer.error();
     device.scan_frames = std::move(*buffer);
+    // The scan's per-row terms in the same order: one fetch in place of the
+    // metadata and cost texels, independent of the frame index.
+    std::vector<std::array<std::uint32_t, 4>> terms(scan.size());
+    for (std::size_t i = 0; i < device.scan_rows; ++i) {
+      const std::uint32_t f = scan[i];
+      const TagMask tags = database.frame_tags()[f];
+      terms[i] = {static_cast<std::uint32_t>(tags), static_cast<std::uint32_t>(tags >> 32),
+                  std::bit_cast<std::uint32_t>(database.frame_multiplier()[f]),
+                  std::bit_cast<std::uint32_t>(database.frame_bias()[f])};
+    }
+    Result<TexelBuffer> term_buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16,
+                                                        bytes_of(terms), "the scanned frames' terms", force_staging);
+    if (!term_buffer) return term_buffer.error();
+    device.scan_terms = std::move(*term_buffer);
   }
   return device;
 }

@@ -7,6 +7,8 @@
 //  frame_cost [frames] RG32F texels (cost multiplier, cost bias)
 //  scan_frames [scan rows] R32UI texels: the frames the brute-force scan
 //             visits, ascending (scanned_by_brute_force())
+//  scan_terms [scan rows] RGBA32UI texels, in scan_frames' order: (tags low,
+//             tags high, cost multiplier bits, cost bias bits)
 // Texel buffers, not storage buffers: texelFetch is a vectorized gather on
 // lavapipe, and maxTexelBufferElements (128 Mi texels there) is far above
 // maxStorageBufferRange (128 MiB).
@@ -50,6 +52,7 @@ struct DeviceDatabase {
   TexelBuffer frame_meta;
   TexelBuffer frame_cost;
   TexelBuffer scan_frames;  // at least one texel, even with no scan rows
+  TexelBuffer scan_terms;   // as many texels as scan_frames
 };
 
 // force_staging: copy through a staging buffer even into mappable memory.

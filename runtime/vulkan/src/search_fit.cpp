@@ -55,7 +55,7 @@ Status check_search_fits(const Context& context, const KernelShape& shape, const
                       " texels, over the device's maxTexelBufferElements of " +
                       std::to_string(limits.maxTexelBufferElements) + "; use a smaller database");
   }
-  const std::uint64_t database_bytes = feature_texels * 16 + frames * 16 + frames * 8 + std::max(shape.scan_rows, 1u) * 4;
+  const std::uint64_t database_bytes = feature_texels * 16 + frames * 16 + frames * 8 + std::max(shape.scan_rows, 1u) * 20;
   MMVK_TRY(check_heap(context, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, database_bytes,
                       "the database (" + std::to_string(frames) + " frames x " + std::to_string(shape.dims) + " dims)"));
 

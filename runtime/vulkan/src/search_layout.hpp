@@ -60,14 +60,15 @@ enum Binding : std::uint32_t {
   kBindingFrameMeta = 1,  // uniform texel buffer, RGBA32UI
   kBindingFrameCost = 2,  // uniform texel buffer, RG32F
   kBindingScanFrames = 3, // uniform texel buffer, R32UI
-  kBindingQueries = 4,    // storage buffer
-  kBindingParams = 5,     // storage buffer
-  kBindingWeights = 6,    // storage buffer
-  kBindingScratch = 7,    // storage buffer
-  kBindingResults = 8,    // storage buffer
-  kBindingCount = 9,
+  kBindingScanTerms = 4,  // uniform texel buffer, RGBA32UI
+  kBindingQueries = 5,    // storage buffer
+  kBindingParams = 6,     // storage buffer
+  kBindingWeights = 7,    // storage buffer
+  kBindingScratch = 8,    // storage buffer
+  kBindingResults = 9,    // storage buffer
+  kBindingCount = 10,
 };
-inline constexpr SetShape kSearchSet{4, 5};
+inline constexpr SetShape kSearchSet{5, 5};
 static_assert(kSearchSet.texel == kBindingQueries && kSearchSet.bindings() == kBindingCount);
 
 }  // namespace mmvk::vulkan::detail

@@ -233,7 +233,7 @@ Status VulkanSearch::Impl::create_slots() {
   static_assert(std::size(buffers) == kSearchSet.storage);
   const std::array<VkBufferView, kSearchSet.texel> views = {
       device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get(),
-      device_database.scan_frames.view.get()};
+      device_database.scan_frames.view.get(), device_database.scan_terms.view.get()};
   std::vector<VkCommandBuffer> commands(options.slots);
   VkCommandBufferAllocateInfo command_info{};
   command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;

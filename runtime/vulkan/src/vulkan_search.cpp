@@ -356,7 +356,8 @@ Status VulkanSearch::warm_up() { return impl_->warm_up(); }
 
 std::uint64_t VulkanSearch::device_bytes() const {
   const DeviceDatabase& db = impl_->device_database;
-  std::uint64_t bytes = db.features.buffer.size + db.frame_meta.buffer.size + db.frame_cost.buffer.size;
+  std::uint64_t bytes = db.features.buffer.size + db.frame_meta.buffer.size + db.frame_cost.buffer.size +
+                        db.scan_frames.buffer.size + db.scan_terms.buffer.size;
   for (const Slot& slot : impl_->slots) {
     bytes += slot.queries.size + slot.params.size + slot.weights.size + slot.scratch.size + slot.results.size;
   }

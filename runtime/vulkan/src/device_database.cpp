@@ -58,7 +58,7 @@ std::uint32_t scan_row_count(const Database& database) {
 }
 
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
-                                       bool force_staging) {
+                                       bool with_scan, bool force_staging) {
   DeviceDatabase device;
   device.frame_count = database.frame_count();
   device.dims = database.dims();
@@ -108,7 +108,7 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
   }
   {
     std::vector<std::uint32_t> scan;
-    for (std::uint32_t f = 0; f < device.frame_count; ++f) {
+    for (std::uint32_t f = 0; with_scan && f < device.frame_count; ++f) {
       if (scanned_by_brute_force(database.frame_flags()[f])) scan.push_back(f);
     }
     device.scan_rows = static_cast<std::uint32_t>(scan.size());

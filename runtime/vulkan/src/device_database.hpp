@@ -68,7 +68,9 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
                                       std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
                                       bool force_staging);
 
+// with_scan: fill scan_frames and scan_terms (the brute force); else they
+// hold one unused texel each.
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
-                                       bool force_staging);
+                                       bool with_scan, bool force_staging);
 
 }  // namespace mmvk::vulkan::detail

@@ -51,7 +51,8 @@ Result<KernelShape> make_kernel_shape(const Context& context, const Database& da
                                       const VulkanSearchOptions& options) {
   KernelShape shape;
   shape.frame_count = database.frame_count();
-  shape.scan_rows = scan_row_count(database);
+  // Only the brute force scans scan_frames; the cluster modes upload none.
+  shape.scan_rows = options.mode == SearchMode::BruteForce ? scan_row_count(database) : 0;
   shape.dims = database.dims();
   shape.dim_vec4s = (shape.dims + 3) / 4;
   // Channel ends as a bit mask over dims.

@@ -35,7 +35,7 @@ inline constexpr std::uint32_t kMaxScanBlocks = 16384;         // topk_merge loo
 
 struct KernelShape {
   std::uint32_t frame_count = 0;
-  std::uint32_t scan_rows = 0;       // frames the brute-force scan visits (device_database.hpp)
+  std::uint32_t scan_rows = 0;       // frames the brute-force scan visits (device_database.hpp); 0 in cluster modes
   std::uint32_t dims = 0;
   std::uint32_t dim_vec4s = 0;
   std::uint32_t channels = 0;        // non-empty schema channels

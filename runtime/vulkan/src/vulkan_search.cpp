@@ -266,7 +266,8 @@ Status VulkanSearch::Impl::create_slots() {
 }
 
 Status VulkanSearch::Impl::upload(bool force_staging) {
-  MMVK_ASSIGN_OR_RETURN(device_database, upload_database(*context, command_pool.get(), *database, force_staging));
+  MMVK_ASSIGN_OR_RETURN(device_database, upload_database(*context, command_pool.get(), *database,
+                                                         options.mode == SearchMode::BruteForce, force_staging));
   return {};
 }
 

@@ -44,11 +44,16 @@ struct Variant {
   // kernels, the vector width lavapipe's lanes have (shared/LAVAPIPE.md),
   // to tell the width's share of the Vulkan/CPU gap from the kernel's.
   CpuKernels kernels = CpuKernels::Widest;
+  // vulkan-brute-t32: the brute-force scan's 32-query tile (max_tile 32;
+  // the registry's default is 16, whose first compile is shorter).
+  std::uint32_t max_tile = 16;
 };
 constexpr Variant kVariants[] = {{"fast-brute", "fast-brute"},
                                  {"fast-brute-avx2", "fast-brute", 4, CpuKernels::Avx2},
                                  {"clusters", "clusters"},
-                                 {"vulkan-brute", "vulkan-brute"},       {"vulkan-clusters", "vulkan-clusters"},
+                                 {"vulkan-brute", "vulkan-brute"},
+                                 {"vulkan-brute-t32", "vulkan-brute", 4, CpuKernels::Widest, 32},
+                                 {"vulkan-clusters", "vulkan-clusters"},
                                  {"vulkan-nprobe4", "vulkan-nprobe", 4}, {"vulkan-nprobe16", "vulkan-nprobe", 16}};
 
 vulkan::Context* shared_context() {
@@ -116,6 +121,7 @@ Result<std::unique_ptr<SearchBackend>> make_variant(Setup& s, const Variant& var
   spec.fast.kernels = variant.kernels;
   spec.max_batch = kQueries;
   spec.max_k = 1;
+  spec.max_tile = variant.max_tile;
   return registry.make(spec, *s.db);
 }
 

@@ -7,6 +7,10 @@
 #include "kernel_shape.glsl"
 #include "search_layout.glsl"
 
+// The texel of row r's vec4 v: the rows are interleaved by kRowGroup
+// (search_layout.glsl).
+int feature_texel(uint r, uint v) { return int(((r / kRowGroup) * DV + v) * kRowGroup + r % kRowGroup); }
+
 // Constant-folds once d is a constant (all callers are unrolled loops).
 bool ends_channel(uint d) {
   uint word = d < 32u ? END_MASK_0 : d < 64u ? END_MASK_1 : d < 96u ? END_MASK_2 : END_MASK_3;
@@ -68,7 +72,7 @@ uvec2 continuing_pair(uint query) {
   vec4 x[DV];
   vec4 q[DV];
   float w[CHANNELS];
-  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, int(frame * DV + v));
+  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(frame, v));
   load_query(query, q, w);
   // mmvk::frame_cost's order: (multiplier * total + bias) * continuing_multiplier
   // + continuing_bias, each step rounded (precise: no fused multiply-add).

@@ -32,9 +32,9 @@ struct QueryGpu {
 // constants (the cluster kernels) define MMVK_SEARCH_LAYOUT_OWN_PUSH.
 #ifndef MMVK_SEARCH_LAYOUT_OWN_PUSH
 layout(push_constant) uniform SearchPush {
-  uint frame_count;
+  uint scan_rows;          // rows of scan_frames
   uint rows_per_invocation;
-  uint block_count;        // ceil(frame_count / rows_per_invocation)
+  uint block_count;        // scan invocations (kernel_shape.hpp: KernelShape::block_count)
   uint query_base;         // first query of this chunk in the query buffers
   uint query_count;        // queries in this chunk
   uint pad0;
@@ -43,22 +43,38 @@ layout(push_constant) uniform SearchPush {
 } pc;
 #endif
 
-// [frames x dims/4] texels: the feature matrix, dims padded to 4 with zeros.
+// search_layout.hpp: kRowGroup. The feature matrix's rows are interleaved in
+// groups of kRowGroup consecutive rows, [frame / kRowGroup][dims/4][frame %
+// kRowGroup]: lanes that scan consecutive rows read consecutive texels
+// (coalesced on a GPU; on lavapipe a gather from one 128-byte run, which the
+// hardware prefetcher follows, instead of 8 streams).
+const uint kRowGroup = 8u;
+
+// [ceil(frames / kRowGroup) x dims/4 x kRowGroup] texels: the feature matrix,
+// dims padded to 4 with zeros, rows interleaved (feature_texel()); rows past
+// the last frame are zeros.
 layout(set = 0, binding = 0) uniform samplerBuffer features;
 // [frames] texels: (flags, tags low 32 bits, tags high 32 bits, clip index).
 layout(set = 0, binding = 1) uniform usamplerBuffer frame_meta;
 // [frames] texels: (cost multiplier, cost bias).
 layout(set = 0, binding = 2) uniform samplerBuffer frame_cost;
+// [scan rows] texels: the frames the brute-force scan visits (every frame
+// that can be a candidate other than as a continuing frame), ascending.
+layout(set = 0, binding = 3) uniform usamplerBuffer scan_frames;
+// [scan rows] texels, in scan_frames' order: what the scan needs of each of
+// those frames, (tags low, tags high, cost multiplier bits, cost bias bits),
+// in one fetch that does not wait for the frame's index.
+layout(set = 0, binding = 4) uniform usamplerBuffer scan_terms;
 // [max_batch x dims/4] query features, padded like the rows.
-layout(std430, set = 0, binding = 3) readonly buffer Queries { vec4 query_features[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Queries { vec4 query_features[]; };
 // [max_batch] query parameters.
-layout(std430, set = 0, binding = 4) readonly buffer Params { QueryGpu query_params[]; };
+layout(std430, set = 0, binding = 6) readonly buffer Params { QueryGpu query_params[]; };
 // [max_batch x channels] channel weights (non-empty channels only).
-layout(std430, set = 0, binding = 5) readonly buffer Weights { float query_weights[]; };
+layout(std430, set = 0, binding = 7) readonly buffer Weights { float query_weights[]; };
 // [chunk queries x blocks x K] per-block best (key, frame) pairs.
-layout(std430, set = 0, binding = 6) buffer Scratch { uvec2 scratch[]; };
+layout(std430, set = 0, binding = 8) buffer Scratch { uvec2 scratch[]; };
 // [max_batch x max_k] final best (key, frame) pairs, sorted.
-layout(std430, set = 0, binding = 7) writeonly buffer Results { uvec2 results[]; };
+layout(std430, set = 0, binding = 9) writeonly buffer Results { uvec2 results[]; };
 
 // A (cost, frame) pair as (orderable cost bits, frame): unsigned comparison
 // of the key follows float order, negative costs included.

@@ -80,20 +80,21 @@ TEST(VulkanLimits, BatchOverLavapipesOwnStorageRangeNamesTheLimit) {
 
 TEST(VulkanLimits, DatabaseOverMaxTexelBufferElementsNamesTheLimit) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 1000, 0));
-  const Database db = synthetic_database({.frames = 500, .clips = 2});  // 500 x 7 = 3500 texels
+  const Database db = synthetic_database({.frames = 500, .clips = 2});  // 504 (groups of 8) x 7 = 3528 texels
   const Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options());
   ASSERT_FALSE(search.ok());
-  EXPECT_TRUE(contains(search.message(), "500 frames x 7 texels) needs 3500 texels")) << search.message();
+  EXPECT_TRUE(contains(search.message(), "500 frames, 504 in groups of 8, x 7 texels) needs 3528 texels")) << search.message();
   EXPECT_TRUE(contains(search.message(), "maxTexelBufferElements of 1000")) << search.message();
 }
 
 TEST(VulkanLimits, DatabaseOverTheDeviceHeapNamesTheHeap) {
-  // 500 frames: 500 x 7 x 16 + 500 x 16 + 500 x 8 = 68000 bytes.
+  // 500 frames: 504 (groups of 8) x 7 x 16 + 500 x 16 + 500 x 8 + 500 x 20 (the
+  // scanned frames and their terms) = 78448 bytes.
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 65536));
   const Database db = synthetic_database({.frames = 500, .clips = 2});
   const Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options());
   ASSERT_FALSE(search.ok());
-  EXPECT_TRUE(contains(search.message(), "the database (500 frames x 27 dims) needs 68000 bytes of device memory"))
+  EXPECT_TRUE(contains(search.message(), "the database (500 frames x 27 dims) needs 78448 bytes of device memory"))
       << search.message();
   EXPECT_TRUE(contains(search.message(), "more than the 65536 bytes of memory heap")) << search.message();
 }

@@ -89,6 +89,53 @@ TEST(VulkanSearch, LargeDatabaseStaysExact) {
   EXPECT_EQ(out[3].frame, 17u);
 }
 
+// A workgroup's lanes take its rows in turn, and the feature rows are
+// interleaved in groups of 8 (brute_force_scan.comp): frame counts that end
+// inside a group and inside a workgroup, with lanes of the last workgroup
+// running different row counts, still visit every row exactly once.
+TEST(VulkanSearch, InterleavedRowsCoverEveryFrame) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  for (std::uint32_t frames : {1003u, 1009u}) {
+    const Database db = synthetic_database({.frames = frames, .seed = 121, .constraints = true});
+    std::vector<float> queries = synthetic_queries(db, 28, 122);
+    // Queries equal to the first and last rows: a lane that skipped its
+    // last or first step would miss them.
+    for (std::uint32_t f : {frames - 1, frames - 2, frames - 9, 0u}) {
+      queries.insert(queries.end(), db.row(f).begin(), db.row(f).end());
+    }
+    ReferenceSearch reference(db);
+    const std::vector<Match> expected = run_search(reference, queries, {}, 32, 1);
+    for (std::uint32_t rows : {1u, 7u, 64u}) {
+      SCOPED_TRACE("frames " + std::to_string(frames) + ", rows_per_invocation " + std::to_string(rows));
+      VulkanSearchOptions options = search_options(32, 1);
+      options.rows_per_invocation = rows;
+      std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
+      ASSERT_NE(search, nullptr);
+      expect_identical(expected, run_search(*search, queries, {}, 32, 1), 1, {}, search->name());
+    }
+  }
+}
+
+// The scan visits only frames no flag excludes (scan_frames); with every
+// frame flagged it visits none, and the continuing frames, which the merge
+// evaluates on its own, are the only answers.
+TEST(VulkanSearch, EveryFrameFlaggedLeavesTheContinuingFrames) {
+  MMVK_VULKAN_CONTEXT(context, ContextOptions{});
+  DatabaseParts parts = synthetic_parts({.frames = 300, .clips = 3, .seed = 123});
+  for (std::uint32_t f = 0; f < 300; ++f) parts.frame_flags[f] = f % 2 == 0 ? kFrameBlockTransition : kFrameDoNotUse;
+  const Database db = make_database(std::move(parts));
+  const std::vector<float> queries = synthetic_queries(db, 4, 124);
+  std::vector<QueryParams> params(4);
+  params[0].continuing_frame = 10;  // block-transition: a candidate as the continuing frame
+  params[2].continuing_frame = 11;  // do-not-use: never a candidate
+  ReferenceSearch reference(db);
+  const std::vector<Match> expected = run_search(reference, queries, params, 4, 4);
+  ASSERT_EQ(expected[0].frame, 10u);
+  std::unique_ptr<VulkanSearch> search = make_search(*context, db, search_options(4, 4));
+  ASSERT_NE(search, nullptr);
+  expect_identical(expected, run_search(*search, queries, params, 4, 4), 4, params, search->name());
+}
+
 TEST(VulkanSearch, ChunkedBatchesMatchReference) {
   MMVK_VULKAN_CONTEXT(context, ContextOptions{});
   const Database db = synthetic_database({.frames = 6000, .seed = 105, .constraints = true});

@@ -91,15 +91,17 @@ Status BruteForceKernel::record(const Context& context, VkCommandBuffer commands
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);
     SearchPush push{};
-    push.frame_count = shape_.frame_count;
+    push.scan_rows = shape_.scan_rows;
     push.rows_per_invocation = shape_.rows_per_invocation;
     push.block_count = shape_.block_count;
     push.query_base = base;
     push.query_count = count;
     // The previous chunk's merge read the scratch this scan overwrites.
     if (base != 0) compute_barrier(commands);
-    MMVK_TRY(dispatch(context, commands, variant->scan.get(), layout, push, (shape_.block_count + wg - 1) / wg,
-                      (count + tile - 1) / tile, "brute_force_scan"));
+    // Tiles along x, so that the workgroups that read the same rows run
+    // one after another (brute_force_scan.comp).
+    MMVK_TRY(dispatch(context, commands, variant->scan.get(), layout, push, (count + tile - 1) / tile,
+                      shape_.block_count / wg, "brute_force_scan"));
     compute_barrier(commands);
     MMVK_TRY(dispatch(context, commands, merge, layout, push, (count + wg - 1) / wg, 1, "topk_merge"));
   }

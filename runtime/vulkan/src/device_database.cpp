@@ -1,10 +1,12 @@
 #include "device_database.hpp"
 
 #include <array>
+#include <bit>
 #include <string>
 #include <vector>
 
 #include "check.hpp"
+#include "search_layout.hpp"
 
 namespace mmvk::vulkan::detail {
 
@@ -49,8 +51,14 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
 
 
 
+std::uint32_t scan_row_count(const Database& database) {
+  std::uint32_t rows = 0;
+  for (const std::uint32_t flags : database.frame_flags()) rows += scanned_by_brute_force(flags) ? 1 : 0;
+  return rows;
+}
+
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
-                                       bool force_staging) {
+                                       bool with_scan, bool force_staging) {
   DeviceDatabase device;
   device.frame_count = database.frame_count();
   device.dims = database.dims();
@@ -60,10 +68,16 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
 
   // Host copies in the kernels' layouts; creation-time only.
   {
-    std::vector<float> features(frames * padded, 0.0f);
+    // Rows interleaved by kRowGroup (search_layout.hpp), the last group
+    // padded with zero rows.
+    const std::size_t groups = (frames + kRowGroup - 1) / kRowGroup;
+    std::vector<float> features(groups * kRowGroup * padded, 0.0f);
     const std::span<const float> source = database.features();
     for (std::size_t f = 0; f < frames; ++f) {
-      for (std::size_t d = 0; d < device.dims; ++d) features[f * padded + d] = source[f * device.dims + d];
+      for (std::size_t d = 0; d < device.dims; ++d) {
+        features[feature_texel(f, static_cast<std::uint32_t>(d / 4), device.dim_vec4s) * 4 + d % 4] =
+            source[f * device.dims + d];
+      }
     }
     Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(features),
                                                    "the feature matrix", force_staging);
@@ -91,6 +105,32 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
                           force_staging);
     if (!buffer) return buffer.error();
     device.frame_cost = std::move(*buffer);
+  }
+  {
+    std::vector<std::uint32_t> scan;
+    for (std::uint32_t f = 0; with_scan && f < device.frame_count; ++f) {
+      if (scanned_by_brute_force(database.frame_flags()[f])) scan.push_back(f);
+    }
+    device.scan_rows = static_cast<std::uint32_t>(scan.size());
+    if (scan.empty()) scan.push_back(0);  // a buffer is never empty; the scan reads none of it
+    Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32_UINT, 4, bytes_of(scan),
+                                                   "the scanned frames", force_staging);
+    if (!buffer) return buffer.error();
+    device.scan_frames = std::move(*buffer);
+    // The scan's per-row terms in the same order: one fetch in place of the
+    // metadata and cost texels, independent of the frame index.
+    std::vector<std::array<std::uint32_t, 4>> terms(scan.size());
+    for (std::size_t i = 0; i < device.scan_rows; ++i) {
+      const std::uint32_t f = scan[i];
+      const TagMask tags = database.frame_tags()[f];
+      terms[i] = {static_cast<std::uint32_t>(tags), static_cast<std::uint32_t>(tags >> 32),
+                  std::bit_cast<std::uint32_t>(database.frame_multiplier()[f]),
+                  std::bit_cast<std::uint32_t>(database.frame_bias()[f])};
+    }
+    Result<TexelBuffer> term_buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_UINT, 16,
+                                                        bytes_of(terms), "the scanned frames' terms", force_staging);
+    if (!term_buffer) return term_buffer.error();
+    device.scan_terms = std::move(*term_buffer);
   }
   return device;
 }

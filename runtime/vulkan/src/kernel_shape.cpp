@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <string>
 
+#include "device_database.hpp"
+
 namespace mmvk::vulkan::detail {
 
 std::uint32_t k_class(std::uint32_t k) { return k <= 1 ? 1 : k <= 4 ? 4 : 16; }
@@ -49,6 +51,8 @@ Result<KernelShape> make_kernel_shape(const Context& context, const Database& da
                                       const VulkanSearchOptions& options) {
   KernelShape shape;
   shape.frame_count = database.frame_count();
+  // Only the brute force scans scan_frames; the cluster modes upload none.
+  shape.scan_rows = options.mode == SearchMode::BruteForce ? scan_row_count(database) : 0;
   shape.dims = database.dims();
   shape.dim_vec4s = (shape.dims + 3) / 4;
   // Channel ends as a bit mask over dims.
@@ -61,8 +65,13 @@ Result<KernelShape> make_kernel_shape(const Context& context, const Database& da
   }
   shape.channels = static_cast<std::uint32_t>(channels.size());
   shape.workgroup_size = workgroup_size(context);
-  MMVK_ASSIGN_OR_RETURN(shape.rows_per_invocation, rows_per_invocation(shape.frame_count, options));
-  shape.block_count = (shape.frame_count + shape.rows_per_invocation - 1) / shape.rows_per_invocation;
+  MMVK_ASSIGN_OR_RETURN(shape.rows_per_invocation, rows_per_invocation(shape.scan_rows, options));
+  // The scan's invocations are its blocks; a workgroup's lanes take its
+  // rows in turn (brute_force_scan.comp), so blocks come in whole workgroups
+  // (at least one, so that the scratch is never empty).
+  const std::uint64_t group_rows = std::uint64_t{shape.rows_per_invocation} * shape.workgroup_size;
+  const std::uint64_t groups = std::max<std::uint64_t>(1, (shape.scan_rows + group_rows - 1) / group_rows);
+  shape.block_count = static_cast<std::uint32_t>(std::min<std::uint64_t>(groups * shape.workgroup_size, UINT32_MAX));
   if (shape.block_count > kMaxScanBlocks) {
     return make_error("VulkanSearch: rows_per_invocation " + std::to_string(shape.rows_per_invocation) + " gives " +
                       std::to_string(shape.block_count) + " blocks, over " + std::to_string(kMaxScanBlocks));

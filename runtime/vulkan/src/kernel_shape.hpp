@@ -35,13 +35,14 @@ inline constexpr std::uint32_t kMaxScanBlocks = 16384;         // topk_merge loo
 
 struct KernelShape {
   std::uint32_t frame_count = 0;
+  std::uint32_t scan_rows = 0;       // frames the brute-force scan visits (device_database.hpp); 0 in cluster modes
   std::uint32_t dims = 0;
   std::uint32_t dim_vec4s = 0;
   std::uint32_t channels = 0;        // non-empty schema channels
   std::uint32_t end_mask[4] = {};    // bit d: dim d ends a channel
   std::uint32_t workgroup_size = 1;
   std::uint32_t rows_per_invocation = 1;
-  std::uint32_t block_count = 1;     // ceil(frame_count / rows_per_invocation)
+  std::uint32_t block_count = 1;     // scan invocations: ceil(scan_rows / (rows_per_invocation x workgroup)) x workgroup, >= 1 workgroup
 };
 
 // Kept pairs per query: 1, 4 or 16 (the smallest class >= k).

@@ -45,14 +45,17 @@ Status check_search_fits(const Context& context, const KernelShape& shape, const
   const std::uint64_t frames = shape.frame_count;
 
   // The database: three texel buffers in device-local memory.
-  const std::uint64_t feature_texels = frames * shape.dim_vec4s;
+  // The feature rows are interleaved in whole groups of kRowGroup.
+  const std::uint64_t padded_frames = (frames + kRowGroup - 1) / kRowGroup * kRowGroup;
+  const std::uint64_t feature_texels = padded_frames * shape.dim_vec4s;
   if (feature_texels > limits.maxTexelBufferElements) {
-    return make_error("VulkanSearch: the feature matrix (" + std::to_string(frames) + " frames x " +
+    return make_error("VulkanSearch: the feature matrix (" + std::to_string(frames) + " frames, " +
+                      std::to_string(padded_frames) + " in groups of " + std::to_string(kRowGroup) + ", x " +
                       std::to_string(shape.dim_vec4s) + " texels) needs " + std::to_string(feature_texels) +
                       " texels, over the device's maxTexelBufferElements of " +
                       std::to_string(limits.maxTexelBufferElements) + "; use a smaller database");
   }
-  const std::uint64_t database_bytes = feature_texels * 16 + frames * 16 + frames * 8;
+  const std::uint64_t database_bytes = feature_texels * 16 + frames * 16 + frames * 8 + std::max(shape.scan_rows, 1u) * 20;
   MMVK_TRY(check_heap(context, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, database_bytes,
                       "the database (" + std::to_string(frames) + " frames x " + std::to_string(shape.dims) + " dims)"));
 

@@ -32,7 +32,7 @@ static_assert(offsetof(QueryGpu, continuing_multiplier) == 44);
 
 // GLSL: SearchPush (push constants of every search kernel).
 struct SearchPush {
-  std::uint32_t frame_count;
+  std::uint32_t scan_rows;  // rows of the scan_frames buffer
   std::uint32_t rows_per_invocation;
   std::uint32_t block_count;
   std::uint32_t query_base;
@@ -43,19 +43,32 @@ static_assert(sizeof(SearchPush) == 32);
 static_assert(sizeof(SearchPush) <= 128, "Vulkan guarantees only 128 bytes of push constants");
 static_assert(offsetof(SearchPush, query_count) == 16);
 
+// GLSL: kRowGroup. The feature texels are interleaved in groups of this many
+// consecutive rows, [frame / kRowGroup][dim_vec4s][frame % kRowGroup]
+// (feature_texel() in search_layout.glsl), so that the lanes of a subgroup
+// that scan consecutive rows read one contiguous run of texels per vec4.
+inline constexpr std::uint32_t kRowGroup = 8;
+
+// The texel of (frame, vec4 v) in that layout, for dim_vec4s vec4s a row.
+constexpr std::uint64_t feature_texel(std::uint64_t frame, std::uint32_t v, std::uint32_t dim_vec4s) {
+  return ((frame / kRowGroup) * dim_vec4s + v) * kRowGroup + frame % kRowGroup;
+}
+
 // Descriptor bindings of set 0 (search_layout.glsl).
 enum Binding : std::uint32_t {
-  kBindingFeatures = 0,   // uniform texel buffer, RGBA32F
+  kBindingFeatures = 0,   // uniform texel buffer, RGBA32F, rows interleaved by kRowGroup
   kBindingFrameMeta = 1,  // uniform texel buffer, RGBA32UI
   kBindingFrameCost = 2,  // uniform texel buffer, RG32F
-  kBindingQueries = 3,    // storage buffer
-  kBindingParams = 4,     // storage buffer
-  kBindingWeights = 5,    // storage buffer
-  kBindingScratch = 6,    // storage buffer
-  kBindingResults = 7,    // storage buffer
-  kBindingCount = 8,
+  kBindingScanFrames = 3, // uniform texel buffer, R32UI
+  kBindingScanTerms = 4,  // uniform texel buffer, RGBA32UI
+  kBindingQueries = 5,    // storage buffer
+  kBindingParams = 6,     // storage buffer
+  kBindingWeights = 7,    // storage buffer
+  kBindingScratch = 8,    // storage buffer
+  kBindingResults = 9,    // storage buffer
+  kBindingCount = 10,
 };
-inline constexpr SetShape kSearchSet{3, 5};
+inline constexpr SetShape kSearchSet{5, 5};
 static_assert(kSearchSet.texel == kBindingQueries && kSearchSet.bindings() == kBindingCount);
 
 }  // namespace mmvk::vulkan::detail

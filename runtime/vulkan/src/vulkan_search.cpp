@@ -232,7 +232,8 @@ Status VulkanSearch::Impl::create_slots() {
   };
   static_assert(std::size(buffers) == kSearchSet.storage);
   const std::array<VkBufferView, kSearchSet.texel> views = {
-      device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get()};
+      device_database.features.view.get(), device_database.frame_meta.view.get(), device_database.frame_cost.view.get(),
+      device_database.scan_frames.view.get(), device_database.scan_terms.view.get()};
   std::vector<VkCommandBuffer> commands(options.slots);
   VkCommandBufferAllocateInfo command_info{};
   command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
@@ -265,7 +266,8 @@ Status VulkanSearch::Impl::create_slots() {
 }
 
 Status VulkanSearch::Impl::upload(bool force_staging) {
-  MMVK_ASSIGN_OR_RETURN(device_database, upload_database(*context, command_pool.get(), *database, force_staging));
+  MMVK_ASSIGN_OR_RETURN(device_database, upload_database(*context, command_pool.get(), *database,
+                                                         options.mode == SearchMode::BruteForce, force_staging));
   return {};
 }
 
@@ -355,7 +357,8 @@ Status VulkanSearch::warm_up() { return impl_->warm_up(); }
 
 std::uint64_t VulkanSearch::device_bytes() const {
   const DeviceDatabase& db = impl_->device_database;
-  std::uint64_t bytes = db.features.buffer.size + db.frame_meta.buffer.size + db.frame_cost.buffer.size;
+  std::uint64_t bytes = db.features.buffer.size + db.frame_meta.buffer.size + db.frame_cost.buffer.size +
+                        db.scan_frames.buffer.size + db.scan_terms.buffer.size;
   for (const Slot& slot : impl_->slots) {
     bytes += slot.queries.size + slot.params.size + slot.weights.size + slot.scratch.size + slot.results.size;
   }
@@ -479,7 +482,7 @@ Result<Ticket> VulkanSearch::Impl::submit(const QueryBatch& batch, std::uint32_t
   slot.in_flight = true;
   stats.queries += count;
   // Cluster modes count their rows on the GPU (added in wait()).
-  if (!clusters) stats.rows_evaluated += std::uint64_t{count} * shape.frame_count;
+  if (!clusters) stats.rows_evaluated += std::uint64_t{count} * shape.scan_rows;
   return Ticket{slot_index, slot.serial};
 }
 

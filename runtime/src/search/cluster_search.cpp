@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -177,6 +178,7 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   std::uint32_t tile_packs = 0;
   place_clusters(l, tile_packs);
   l.rows = detail::TileStore::build(database, l.frame);
+  if (options.half_filter) l.half = detail::HalfTileStore::build(database, l.frame, l.tile_offsets);
   build_tile_boxes(l, database, tile_packs);
   build_span_boxes(l, database);
   build_cluster_boxes(l);
@@ -233,13 +235,66 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
   // their sums), against the k-th best from before the chunk.
   std::array<std::uint32_t, kTileChunk> chunk{};
   std::uint32_t chunk_size = 0;
-  const auto flush = [&] {
+  const auto evaluate = [&](const std::uint32_t* tiles_to_evaluate, std::uint32_t count) {
     const detail::KernelQuery kernel_query{v.q, v.w, v.best.back().cost};
-    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, chunk.data(), chunk_size, s.hits.data());
-    chunk_size = 0;
+    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, tiles_to_evaluate, count, s.hits.data());
     for (std::size_t h = 0; h < hits; ++h) {
       detail::offer_tile_row(x.db, *v.params, v.best, Match{l.frame[s.hits[h].slot], s.hits[h].cost});
     }
+  };
+  const bool half_filter = x.options.half_filter;
+  detail::HalfFilterLimits half_limits =
+      half_filter ? detail::HalfFilterLimits(l.half, l.rows.channel_end, v.w) : detail::HalfFilterLimits{};
+  // half_filter: the lanes whose half-precision bound passes the k-th best
+  // are evaluated exactly, one by one with the reference's cost (the same
+  // bits as the kernel's) when few, else with the whole tile. While the
+  // list is not full (k-th best +inf) every lane passes: no filter then.
+  const auto filter_and_evaluate = [&] {
+    // Tiles evaluated whole one at a time while the list is not full (its
+    // k-th best +inf: every lane would pass; with k = 1 one tile fills it).
+    std::uint32_t first = 0;
+    for (; first < chunk_size && !(v.best.back().cost < std::numeric_limits<float>::infinity()); ++first) {
+      evaluate(chunk.data() + first, 1);
+    }
+    if (first == chunk_size) return;
+    const float threshold = v.best.back().cost;
+    l.kernels.half_filter(x.half_tiles, v.q, v.w, chunk.data() + first, half_limits(c, threshold), chunk_size - first,
+                          s.masks.data() + first);
+    s.counters.tiles_filtered += chunk_size - first;
+    std::uint32_t exact_count = 0;
+    std::uint32_t recheck_count = 0;
+    for (std::uint32_t i = first; i < chunk_size; ++i) {
+      std::uint32_t mask = s.masks[i];
+      if (mask == 0) continue;
+      const auto lanes = static_cast<std::uint32_t>(std::popcount(mask));
+      s.counters.rows_rechecked += lanes;
+      if (lanes > kRecheckLanes) {
+        s.exact[exact_count++] = chunk[i];
+        continue;
+      }
+      for (; mask != 0; mask &= mask - 1) {
+        const std::uint32_t frame = l.frame[std::size_t{chunk[i]} * kLanes + std::countr_zero(mask)];
+        // The rows are scattered over the database: all requested before
+        // the first is read.
+        const std::span<const float> row = x.db.row(frame);
+        __builtin_prefetch(row.data());
+        __builtin_prefetch(row.data() + row.size() - 1);
+        s.recheck[recheck_count++] = frame;
+      }
+    }
+    for (std::uint32_t i = 0; i < recheck_count; ++i) {
+      const std::uint32_t frame = s.recheck[i];
+      detail::offer_tile_row(x.db, *v.params, v.best, Match{frame, frame_cost(x.db, frame, {v.q, l.dims}, *v.params)});
+    }
+    if (exact_count != 0) evaluate(s.exact.data(), exact_count);
+  };
+  const auto flush = [&] {
+    if (half_filter) {
+      filter_and_evaluate();
+    } else {
+      evaluate(chunk.data(), chunk_size);
+    }
+    chunk_size = 0;
   };
   // The tiles whose bound passes the k-th best from before the walk,
   // compacted without a branch (most tiles fail, in no pattern a predictor
@@ -251,8 +306,18 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
     passing[passing_count] = i;
     passing_count += !x.options.tile_bound || !(s.tile_bound[i] > threshold_before) ? 1u : 0u;
   }
+  // half_filter: the start of the half tile kHalfLookahead places ahead is
+  // requested while this one waits (the hardware prefetcher follows on
+  // with the rest of it).
+  const std::size_t half_tile_bytes = std::size_t{l.dims} * kLanes * sizeof(std::uint16_t);
+  const auto* half_base = reinterpret_cast<const char*>(l.half.features.data());
   for (std::uint32_t j = 0; j < passing_count; ++j) {
     const std::uint32_t i = passing[j];
+    if (half_filter && j + kHalfLookahead < passing_count) {
+      const char* ahead = half_base + (first_tile + passing[j + kHalfLookahead]) * half_tile_bytes;
+      __builtin_prefetch(ahead);
+      __builtin_prefetch(ahead + 64);
+    }
     if (x.options.tile_bound && s.tile_bound[i] > v.best.back().cost) continue;
     const std::uint32_t tile = first_tile + i;
     s.rows += l.tile_rows[tile];
@@ -438,7 +503,8 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   const QueryParams default_params;
   const ClusterSearchOptions options = options_;
   const WalkContext x{*database_, l, options, l.rows.arrays(), l.tile_boxes.arrays(l.rows.channel_end),
-                      l.span_boxes.arrays(l.rows.channel_end)};
+                      l.span_boxes.arrays(l.rows.channel_end),
+                      l.half.arrays(l.rows.channel_end.data())};
   for (Scratch& s : l.scratch) {
     s.rows = 0;
     s.counters = {};
@@ -465,6 +531,8 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
     stats_.rows_evaluated += s.rows;
     counters_.clusters_visited += s.counters.clusters_visited;
     counters_.tiles_checked += s.counters.tiles_checked;
+    counters_.tiles_filtered += s.counters.tiles_filtered;
+    counters_.rows_rechecked += s.counters.rows_rechecked;
   }
   return {};
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mmvk/cluster_search.hpp"
+#include "search/half_tile_store.hpp"
 #include "search/tile_kernels.hpp"
 #include "search/tile_store.hpp"
 
@@ -28,7 +29,12 @@ constexpr std::uint32_t kNoCluster = 0xffffffffu;
 constexpr std::size_t kSubBatch = 512;
 constexpr std::uint32_t kRankedRounds = 1;
 // Tiles of one cluster handed to the kernel at once.
-constexpr std::uint32_t kTileChunk = 4;
+constexpr std::uint32_t kTileChunk = 8;
+// half_filter: a tile with at most this many lanes through the filter has
+// them evaluated one by one from the database's rows (two cache lines a
+// row); more, and the whole float tile is evaluated (dims cache lines).
+constexpr std::uint32_t kRecheckLanes = 4;
+constexpr std::uint32_t kHalfLookahead = 4;
 // The group level above the clusters: runs of kGroupPacks cluster packs
 // (32 clusters) whose centroids lie near each other. Exact mode computes the
 // group bounds first and the cluster bounds only of the groups whose bound
@@ -76,6 +82,11 @@ struct Scratch {
   std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
   std::vector<std::uint32_t> passing;            // [tiles of the largest cluster]
   std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
+  // half_filter: per tile of a chunk, its lanes through the filter; the
+  // tiles evaluated whole and the frames evaluated one by one.
+  std::array<std::uint16_t, kTileChunk> masks{};
+  std::array<std::uint32_t, kTileChunk> exact{};
+  std::array<std::uint32_t, kTileChunk * kRecheckLanes> recheck{};
   // The grouped walk (batch_by_cluster).
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
   std::vector<float> batch_group_bound;                        // [kSubBatch][groups, padded to 16]
@@ -114,6 +125,8 @@ struct ClusterSearch::Layout {
   // tile of a cluster is padded (kNoFrame, an invalid lane).
   std::vector<std::uint32_t> frame;          // [tiles x 16]
   detail::TileStore rows;
+  // The same tiles at half precision (options.half_filter; else empty).
+  detail::HalfTileStore half;
   // The box of each tile's member rows, with their minimum multiplier and
   // bias. A cluster's tile boxes start a pack of their own, so its bounds
   // are whole packs: tile i of cluster c is box tile_box_pack[c] * 16 + i.
@@ -156,6 +169,7 @@ struct WalkContext {
   detail::TileArrays tiles;
   detail::BoxArrays tile_boxes;
   detail::BoxArrays span_boxes;
+  detail::HalfTileArrays half_tiles;
 };
 
 // Whether query `params` may take a frame from cluster c (flags and tags).

@@ -93,10 +93,11 @@ struct ClusterSearchOptions {
 struct ClusterSearchCounters {
   std::uint64_t clusters_visited = 0;  // clusters whose tiles were walked
   std::uint64_t tiles_checked = 0;     // tiles whose bound was computed
-  // half_filter: tiles filtered at half precision, and rows that passed it
-  // and were evaluated exactly (one by one, or with the whole tile).
+  // half_filter: tiles filtered at half precision, rows that passed the
+  // filter (deferred to the query's end), and rows evaluated exactly there.
   std::uint64_t tiles_filtered = 0;
   std::uint64_t rows_rechecked = 0;
+  std::uint64_t rows_exact = 0;
 };
 
 class ClusterSearch final : public SearchBackend {

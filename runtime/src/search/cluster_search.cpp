@@ -155,6 +155,10 @@ void size_scratch(ClusterSearch::Layout& l, unsigned threads) {
     s.bound_state.resize(kSubBatch);
     s.cursor.resize(kSubBatch);
     s.candidate_end.resize(kSubBatch);
+    // Rows deferred per query: about 60 on the Bandai volume set; grown
+    // past this once if needed, and kept.
+    s.deferred.resize(kSubBatch);
+    for (std::vector<DeferredRow>& rows : s.deferred) rows.reserve(l.half.tiles != 0 ? 256 : 0);
   }
 }
 
@@ -246,51 +250,41 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
   detail::HalfFilterLimits half_limits =
       half_filter ? detail::HalfFilterLimits(l.half, l.rows.channel_end, v.w) : detail::HalfFilterLimits{};
   // half_filter: the lanes whose half-precision bound passes the k-th best
-  // are evaluated exactly, one by one with the reference's cost (the same
-  // bits as the kernel's) when few, else with the whole tile. While the
-  // list is not full (k-th best +inf) every lane passes: no filter then.
-  const auto filter_and_evaluate = [&] {
-    // Tiles evaluated whole one at a time while the list is not full (its
-    // k-th best +inf: every lane would pass; with k = 1 one tile fills it).
-    std::uint32_t first = 0;
-    for (; first < chunk_size && !(v.best.back().cost < std::numeric_limits<float>::infinity()); ++first) {
-      evaluate(chunk.data() + first, 1);
-    }
-    if (first == chunk_size) return;
-    const float threshold = v.best.back().cost;
-    l.kernels.half_filter(x.half_tiles, v.q, v.w, chunk.data() + first, half_limits(c, threshold), chunk_size - first,
-                          s.masks.data() + first);
-    s.counters.tiles_filtered += chunk_size - first;
-    std::uint32_t exact_count = 0;
-    std::uint32_t recheck_count = 0;
-    for (std::uint32_t i = first; i < chunk_size; ++i) {
-      std::uint32_t mask = s.masks[i];
-      if (mask == 0) continue;
-      const auto lanes = static_cast<std::uint32_t>(std::popcount(mask));
-      s.counters.rows_rechecked += lanes;
-      if (lanes > kRecheckLanes) {
-        s.exact[exact_count++] = chunk[i];
-        continue;
+  // are deferred to the query's end (finish_query), and enter the list now
+  // with an upper bound of their cost. The exact costs of rows that do not
+  // end near the top would be cache misses (the float rows are not read
+  // otherwise), and most rows that pass early are beaten later. While the
+  // list is not full (k-th best +inf) every lane passes: a tile at a time
+  // then, which fills a list of k <= 16.
+  const auto filter = [&] {
+    for (std::uint32_t first = 0; first < chunk_size;) {
+      const float threshold = v.best.back().cost;
+      const std::uint32_t count = threshold < std::numeric_limits<float>::infinity() ? chunk_size - first : 1;
+      l.kernels.half_filter(x.half_tiles, v.q, v.w, chunk.data() + first, half_limits(c, threshold), count,
+                            s.masks.data(), s.distances.data());
+      s.counters.tiles_filtered += count;
+      for (std::uint32_t i = 0; i < count; ++i) {
+        for (std::uint32_t mask = s.masks[i]; mask != 0; mask &= mask - 1) {
+          const auto lane = static_cast<std::uint32_t>(std::countr_zero(mask));
+          const std::uint32_t frame = l.frame[std::size_t{chunk[first + i]} * kLanes + lane];
+          const float distance = s.distances[i * kLanes + lane];
+          v.deferred->push_back({frame, distance, c});
+          ++s.counters.rows_rechecked;
+          // As offer_tile_row (the continuing frame is seeded on its own),
+          // with the candidate test, a look-up in the frame's tags, only
+          // for rows that enter the list; finish_query tests the others.
+          const Match entry{frame, half_limits.upper(c, distance)};
+          if (!match_less(entry, v.best.back())) continue;
+          if (frame == v.params->continuing_frame || !is_candidate(x.db, frame, *v.params)) continue;
+          detail::insert_sorted(v.best, entry);
+        }
       }
-      for (; mask != 0; mask &= mask - 1) {
-        const std::uint32_t frame = l.frame[std::size_t{chunk[i]} * kLanes + std::countr_zero(mask)];
-        // The rows are scattered over the database: all requested before
-        // the first is read.
-        const std::span<const float> row = x.db.row(frame);
-        __builtin_prefetch(row.data());
-        __builtin_prefetch(row.data() + row.size() - 1);
-        s.recheck[recheck_count++] = frame;
-      }
+      first += count;
     }
-    for (std::uint32_t i = 0; i < recheck_count; ++i) {
-      const std::uint32_t frame = s.recheck[i];
-      detail::offer_tile_row(x.db, *v.params, v.best, Match{frame, frame_cost(x.db, frame, {v.q, l.dims}, *v.params)});
-    }
-    if (exact_count != 0) evaluate(s.exact.data(), exact_count);
   };
   const auto flush = [&] {
     if (half_filter) {
-      filter_and_evaluate();
+      filter();
     } else {
       evaluate(chunk.data(), chunk_size);
     }
@@ -327,16 +321,48 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
   if (chunk_size != 0) flush();
 }
 
-// Clears the query's list and seeds it with the continuing frame: its cost
+// Seeds the query's (cleared) list with the continuing frame: its cost
 // carries continuing_bias (possibly negative), which no cluster bound
 // covers, so it is evaluated on its own and skipped by the tiles.
+bool seed_continuing(const WalkContext& x, const QueryView& v) {
+  const std::uint32_t continuing = v.params->continuing_frame;
+  if (continuing == kNoFrame || !is_candidate(x.db, continuing, *v.params)) return false;
+  detail::insert_sorted(v.best, Match{continuing, frame_cost(x.db, continuing, {v.q, x.l.dims}, *v.params)});
+  return true;
+}
+
 void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
   std::fill(v.best.begin(), v.best.end(), Match{});
-  const std::uint32_t continuing = v.params->continuing_frame;
-  if (continuing != kNoFrame && is_candidate(x.db, continuing, *v.params)) {
-    detail::insert_sorted(v.best, Match{continuing, frame_cost(x.db, continuing, {v.q, x.l.dims}, *v.params)});
-    ++s.rows;
+  if (v.deferred != nullptr) v.deferred->clear();
+  if (seed_continuing(x, v)) ++s.rows;
+}
+
+// half_filter: the exact re-rank. The k-th entry of the list (upper bounds)
+// is at least the k-th best cost, so every row of the result, and every row
+// tied with one, has a half-precision distance within the limit of that
+// entry: those rows, and only those, get their exact cost (the reference's
+// frame_cost, the bits of the tile kernel) and make the list again, with
+// the continuing frame.
+void finish_query(const WalkContext& x, Scratch& s, const QueryView& v) {
+  if (!x.options.half_filter) return;
+  std::vector<DeferredRow>& rows = *v.deferred;
+  detail::HalfFilterLimits limits(x.l.half, x.l.rows.channel_end, v.w);
+  const float threshold = v.best.back().cost;
+  std::size_t kept = 0;
+  for (const DeferredRow& row : rows) {
+    if (row.distance > limits(row.block, threshold)) continue;
+    __builtin_prefetch(x.db.row(row.frame).data());  // scattered rows: all requested before the first is read
+    rows[kept++] = row;
   }
+  std::fill(v.best.begin(), v.best.end(), Match{});
+  seed_continuing(x, v);
+  for (std::size_t i = 0; i < kept; ++i) {
+    const std::uint32_t frame = rows[i].frame;
+    if (frame == v.params->continuing_frame || !is_candidate(x.db, frame, *v.params)) continue;
+    detail::insert_sorted(v.best, Match{frame, frame_cost(x.db, frame, {v.q, x.l.dims}, *v.params)});
+  }
+  s.counters.rows_exact += kept;
+  rows.clear();
 }
 
 // The per-query walk: one query's clusters in order, with no batch
@@ -448,7 +474,11 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
   const std::size_t group_stride = packs_of(x.l.group_count) * kLanes;
   for (std::size_t base = first; base < last; base += kSubBatch) {
     const std::uint32_t n = static_cast<std::uint32_t>(std::min(kSubBatch, last - base));
-    const auto local = [&](std::uint32_t i) { return view_of(base + i); };
+    const auto local = [&](std::uint32_t i) {
+      QueryView v = view_of(base + i);
+      v.deferred = &s.deferred[i];
+      return v;
+    };
     s.pairs.clear();
     for (std::uint32_t i = 0; i < n; ++i) {
       const QueryView v = local(i);
@@ -492,6 +522,7 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
       if (s.pairs.empty()) break;
       visit_grouped(x, s, local);
     }
+    for (std::uint32_t i = 0; i < n; ++i) finish_query(x, s, local(i));
   }
 }
 
@@ -520,9 +551,11 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
       return;
     }
     for (std::size_t qi = first; qi < last; ++qi) {
-      const QueryView v = view_of(qi);
+      QueryView v = view_of(qi);
+      v.deferred = &s.deferred[0];
       start_query(x, s, v);
       walk_one(x, s, v);
+      finish_query(x, s, v);
     }
   });
 
@@ -533,6 +566,7 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
     counters_.tiles_checked += s.counters.tiles_checked;
     counters_.tiles_filtered += s.counters.tiles_filtered;
     counters_.rows_rechecked += s.counters.rows_rechecked;
+    counters_.rows_exact += s.counters.rows_exact;
   }
   return {};
 }

@@ -30,10 +30,8 @@ constexpr std::size_t kSubBatch = 512;
 constexpr std::uint32_t kRankedRounds = 1;
 // Tiles of one cluster handed to the kernel at once.
 constexpr std::uint32_t kTileChunk = 8;
-// half_filter: a tile with at most this many lanes through the filter has
-// them evaluated one by one from the database's rows (two cache lines a
-// row); more, and the whole float tile is evaluated (dims cache lines).
-constexpr std::uint32_t kRecheckLanes = 4;
+// half_filter: the start of the half tile kHalfLookahead places ahead in a
+// cluster's list is requested while the current one is read.
 constexpr std::uint32_t kHalfLookahead = 4;
 // The group level above the clusters: runs of kGroupPacks cluster packs
 // (32 clusters) whose centroids lie near each other. Exact mode computes the
@@ -73,6 +71,15 @@ struct VisitPair {
 // never read.
 enum class BoundState : std::uint8_t { All, Partial, Probed };
 
+// half_filter: a row whose half-precision bound passed the k-th best when
+// its tile was filtered; its exact cost is computed at the end of the query
+// if the bound still passes then (see cluster_search.cpp).
+struct DeferredRow {
+  std::uint32_t frame;
+  float distance;      // the kernel's half-precision distance
+  std::uint32_t block;  // its cluster (HalfTileStore block)
+};
+
 struct Scratch {
   std::vector<ClusterBound> order;
   std::vector<float> bound, distance;            // [clusters, padded to 16]
@@ -82,11 +89,12 @@ struct Scratch {
   std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
   std::vector<std::uint32_t> passing;            // [tiles of the largest cluster]
   std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
-  // half_filter: per tile of a chunk, its lanes through the filter; the
-  // tiles evaluated whole and the frames evaluated one by one.
+  // half_filter: per tile of a chunk, its lanes through the filter and
+  // their half-precision distances; per query of a sub-batch (one query:
+  // the first), the rows deferred to its exact re-rank.
   std::array<std::uint16_t, kTileChunk> masks{};
-  std::array<std::uint32_t, kTileChunk> exact{};
-  std::array<std::uint32_t, kTileChunk * kRecheckLanes> recheck{};
+  std::array<float, kLanes * kTileChunk> distances{};
+  std::vector<std::vector<DeferredRow>> deferred;  // [kSubBatch]
   // The grouped walk (batch_by_cluster).
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
   std::vector<float> batch_group_bound;                        // [kSubBatch][groups, padded to 16]
@@ -158,7 +166,12 @@ struct QueryView {
   const float* q;
   const float* w;
   const QueryParams* params;
-  std::span<Match> best;  // sorted, k entries
+  // Sorted, k entries. With half_filter, until the query's end, a row's
+  // entry holds an upper bound of its cost (HalfFilterLimits::upper), so the
+  // k-th entry is still at least the k-th best cost: every bound compared
+  // with it prunes only rows that cannot enter the result.
+  std::span<Match> best;
+  std::vector<DeferredRow>* deferred = nullptr;  // half_filter: this query's rows to re-rank
 };
 
 // What every walk needs besides the query.

@@ -13,10 +13,10 @@ namespace {
 
 constexpr float kFloatInf = std::numeric_limits<float>::infinity();
 
-// A float >= v (v >= 0, or +inf, or NaN which stays NaN): float(v) is
-// within 2^-24 of v relatively, or 2^-150 absolutely below the normal
-// range, and the factor and the term cover both.
-float round_up(double v) { return static_cast<float>(v * (1.0 + 0x1p-22) + 0x1p-149); }
+// A float >= v (+inf stays +inf, NaN stays NaN): float(v) is within 2^-24
+// of |v| relatively, or 2^-150 absolutely below the normal range, and the
+// added terms cover both.
+float round_up(double v) { return static_cast<float>(v + std::fabs(v) * 0x1p-22 + 0x1p-149); }
 
 }  // namespace
 
@@ -62,7 +62,9 @@ HalfTileStore HalfTileStore::build(const Database& db, std::span<const std::uint
         const float m = db.frame_multiplier()[f];
         const float b = db.frame_bias()[f];
         stats.min_multiplier = any_row ? std::min(stats.min_multiplier, m) : m;
+        stats.max_multiplier = any_row ? std::max(stats.max_multiplier, m) : m;
         stats.min_bias = any_row ? std::min(stats.min_bias, b) : b;
+        stats.max_bias = any_row ? std::max(stats.max_bias, b) : b;
         stats.max_abs_bias = std::max(stats.max_abs_bias, std::fabs(b));
         any_row = true;
       }
@@ -134,6 +136,21 @@ float HalfFilterLimits::operator()(std::uint32_t block, float threshold) {
     limit_ = round_up((d * d * g + underflow_) * (1.0 + 0x1p-30));
   }
   return limit_;
+}
+
+// The other direction, with the notation above: S >= H^2 (1 - u)^n - U, so
+// H^2 <= (S + U)(1 + g); D <= H + R; T <= D^2 (1 + g) + U; P = fl(m T) <=
+// max_multiplier T (1 + u) + 2^-150; and the cost fl(P + b) <= P + max_bias
+// + u (P + max_abs_bias). Computed in double, with 2^-30 of the value and
+// 2^-140 absolutely for the double rounding, then rounded up.
+float HalfFilterLimits::upper(std::uint32_t block, float distance) const {
+  const HalfTileStore::Block& b = store_->blocks[block];
+  constexpr double u = 0x1p-24;
+  const double g = 1.0 + store_->rounding;
+  const double d = std::sqrt((double(distance) + underflow_) * g) + weight_root_ * double(b.error);
+  const double p = double(b.max_multiplier) * (d * d * g + underflow_) * (1.0 + u) + 0x1p-150;
+  const double cost = p + double(b.max_bias) + u * (p + double(b.max_abs_bias));
+  return round_up(cost + std::fabs(cost) * 0x1p-30 + 0x1p-140);
 }
 
 }  // namespace mmvk::detail

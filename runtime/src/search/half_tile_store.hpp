@@ -28,14 +28,12 @@ struct HalfTileStore {
   // TileStore::lane_valid, 2 bytes a tile instead of 64).
   std::vector<std::uint16_t> lane_mask;
   // Per block, over its rows (padding left out): the largest
-  // sqrt(sum_d (x_d - half(x_d))^2), rounded up, and the smallest
-  // multiplier and bias and largest |bias| (one struct: one cache line per
-  // visited block).
+  // sqrt(sum_d (x_d - half(x_d))^2), rounded up, and the range of the
+  // multipliers and biases (one struct: one cache line per visited block).
   struct Block {
     float error = 0.0f;
-    float min_multiplier = 1.0f;
-    float min_bias = 0.0f;
-    float max_abs_bias = 0.0f;
+    float min_multiplier = 1.0f, max_multiplier = 1.0f;
+    float min_bias = 0.0f, max_bias = 0.0f, max_abs_bias = 0.0f;
   };
   std::vector<Block> blocks;
   // Relative slack for the float rounding of one distance (see
@@ -55,17 +53,21 @@ struct HalfTileStore {
   std::size_t bytes() const;
 };
 
-// The largest half-precision distance (the kernels' half_filter) that a
-// lane of a block can have when the exact kernel would report it at a given
-// threshold (cost <= threshold); one per query, and it keeps the last
-// block's and threshold's limit.
+// Bounds between a lane's half-precision distance (the kernels'
+// half_filter) and its exact cost, per query: the largest distance a lane
+// of a block can have when its cost is <= a threshold, and an upper bound
+// of the cost of a lane of a given distance.
 class HalfFilterLimits {
  public:
   HalfFilterLimits() = default;
   HalfFilterLimits(const HalfTileStore& store, std::span<const std::uint32_t> channel_end, const float* weights);
   // +inf when threshold is +inf or NaN; -inf when no row of the block can
   // cost <= threshold.
+  // Keeps the last block's and threshold's limit.
   float operator()(std::uint32_t block, float threshold);
+  // A float >= the lane's exact cost (the kernel's and the reference's);
+  // NaN for a NaN distance.
+  float upper(std::uint32_t block, float distance) const;
 
  private:
   const HalfTileStore* store_ = nullptr;

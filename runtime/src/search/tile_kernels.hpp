@@ -79,13 +79,15 @@ struct Kernels {
   // skipped.
   void (*box_bounds)(const BoxArrays& boxes, std::size_t first_pack, std::size_t pack_count, const float* query,
                      const float* weights, float* out);
-  // ClusterSearch's first filter, for one query: masks[i] gets the valid
-  // lanes (bit l: lane l) of tile tile_ids[i] whose distance over the half
-  // rows, sum_ch w_ch sum_d (q_d - xh_d)^2 summed in the cost's order, is
-  // not above `limit` (a NaN distance passes). No multiplier or bias:
-  // HalfFilterLimits folds them into the limit.
+  // ClusterSearch's first filter, for one query: distances[i * 16 + l] gets
+  // lane l's distance over the half rows of tile tile_ids[i], sum_ch w_ch
+  // sum_d (q_d - xh_d)^2 summed in the cost's order, and masks[i] the valid
+  // lanes (bit l: lane l) whose distance is not above `limit` (a NaN
+  // distance passes). No multiplier or bias: HalfFilterLimits folds them
+  // into the limit.
   void (*half_filter)(const HalfTileArrays& tiles, const float* query, const float* weights,
-                      const std::uint32_t* tile_ids, float limit, std::size_t count, std::uint16_t* masks);
+                      const std::uint32_t* tile_ids, float limit, std::size_t count, std::uint16_t* masks,
+                      float* distances);
   const char* name;  // "avx512f", "avx2" or "generic"
   // Queries per brute-force pass, which share each row load: 4 with
   // AVX-512's 32 registers of one tile each (1.2x faster than 2 on the

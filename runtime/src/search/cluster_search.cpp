@@ -235,9 +235,10 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
       span = run_end;
     }
   }
-  // Tiles that pass are evaluated kTileChunk at a time (the kernel overlaps
-  // their sums), against the k-th best from before the chunk.
-  std::array<std::uint32_t, kTileChunk> chunk{};
+  // Tiles that pass are evaluated kTileChunk (half_filter: kHalfChunk) at a
+  // time (the kernel overlaps their sums), against the k-th best from
+  // before the chunk.
+  std::array<std::uint32_t, std::max(kTileChunk, kHalfChunk)> chunk{};
   std::uint32_t chunk_size = 0;
   const auto evaluate = [&](const std::uint32_t* tiles_to_evaluate, std::uint32_t count) {
     const detail::KernelQuery kernel_query{v.q, v.w, v.best.back().cost};
@@ -300,23 +301,13 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
     passing[passing_count] = i;
     passing_count += !x.options.tile_bound || !(s.tile_bound[i] > threshold_before) ? 1u : 0u;
   }
-  // half_filter: the start of the half tile kHalfLookahead places ahead is
-  // requested while this one waits (the hardware prefetcher follows on
-  // with the rest of it).
-  const std::size_t half_tile_bytes = std::size_t{l.dims} * kLanes * sizeof(std::uint16_t);
-  const auto* half_base = reinterpret_cast<const char*>(l.half.features.data());
   for (std::uint32_t j = 0; j < passing_count; ++j) {
     const std::uint32_t i = passing[j];
-    if (half_filter && j + kHalfLookahead < passing_count) {
-      const char* ahead = half_base + (first_tile + passing[j + kHalfLookahead]) * half_tile_bytes;
-      __builtin_prefetch(ahead);
-      __builtin_prefetch(ahead + 64);
-    }
     if (x.options.tile_bound && s.tile_bound[i] > v.best.back().cost) continue;
     const std::uint32_t tile = first_tile + i;
     s.rows += l.tile_rows[tile];
     chunk[chunk_size++] = tile;
-    if (chunk_size == kTileChunk) flush();
+    if (chunk_size == (half_filter ? kHalfChunk : kTileChunk)) flush();
   }
   if (chunk_size != 0) flush();
 }

@@ -28,11 +28,10 @@ constexpr std::uint32_t kNoCluster = 0xffffffffu;
 // candidate cluster per query before the rest are taken at once.
 constexpr std::size_t kSubBatch = 512;
 constexpr std::uint32_t kRankedRounds = 1;
-// Tiles of one cluster handed to the kernel at once.
-constexpr std::uint32_t kTileChunk = 8;
-// half_filter: the start of the half tile kHalfLookahead places ahead in a
-// cluster's list is requested while the current one is read.
-constexpr std::uint32_t kHalfLookahead = 4;
+// Tiles of one cluster handed to the kernel at once (half_filter: to the
+// filter, which holds 8 tiles' sums at once with AVX-512).
+constexpr std::uint32_t kTileChunk = 4;
+constexpr std::uint32_t kHalfChunk = 8;
 // The group level above the clusters: runs of kGroupPacks cluster packs
 // (32 clusters) whose centroids lie near each other. Exact mode computes the
 // group bounds first and the cluster bounds only of the groups whose bound
@@ -92,8 +91,8 @@ struct Scratch {
   // half_filter: per tile of a chunk, its lanes through the filter and
   // their half-precision distances; per query of a sub-batch (one query:
   // the first), the rows deferred to its exact re-rank.
-  std::array<std::uint16_t, kTileChunk> masks{};
-  std::array<float, kLanes * kTileChunk> distances{};
+  std::array<std::uint16_t, kHalfChunk> masks{};
+  std::array<float, kLanes * kHalfChunk> distances{};
   std::vector<std::vector<DeferredRow>> deferred;  // [kSubBatch]
   // The grouped walk (batch_by_cluster).
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]

@@ -79,11 +79,13 @@ struct ClusterSearchOptions {
   // (see cluster_search.cpp). Off: the one-query walk, query by query. A
   // thread's share of one query takes the one-query walk either way.
   bool batch_by_cluster = true;
-  // A first filter per visited tile from a 16-bit (IEEE half) copy of the
-  // rows: a lane is evaluated exactly only when its bound from the half row
-  // (which never exceeds its exact cost) is at most the k-th best, so results
-  // stay those of the reference. Costs half the row store again in memory
-  // (27 dims: 55 bytes a row beside the 108 of the float rows).
+  // Visited tiles are read from a 16-bit (IEEE half) copy of the rows: a
+  // row whose lower bound from its half row passes the k-th best enters the
+  // list with an upper bound of its cost, and at the query's end the rows
+  // that can still be in the result get their exact cost. Results and costs
+  // stay the reference's, bit for bit. The copy adds 2 bytes a value (27
+  // dims: 54 bytes a row beside the float rows' 108). Off: every visited
+  // row is evaluated from the float rows.
   bool half_filter = true;
   // As FastSearchOptions::kernels.
   CpuKernels kernels = CpuKernels::Widest;

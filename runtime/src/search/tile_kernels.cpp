@@ -317,42 +317,11 @@ struct PassBits {
 MMVK_DEFINE_KERNELS(avx2, V8)
 #pragma clang attribute pop
 #pragma clang attribute push(__attribute__((target("avx2,f16c"))), apply_to = function)
-namespace half_avx2 {
-using V = V8;
-struct HalfLoad {
-  MMVK_INLINE V operator()(const std::uint16_t* p) const {
-    const __m256 f = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
-    return load<V>(&f);
-  }
-};
-struct PassBits {
-  MMVK_INLINE std::uint32_t operator()(const V& total, float limit) const {
-    const __m256 pass = _mm256_cmp_ps(load<__m256>(&total), _mm256_set1_ps(limit), _CMP_NGT_UQ);
-    return static_cast<std::uint32_t>(_mm256_movemask_ps(pass));
-  }
-};
-#include "search/half_filter_kernel.inc"
-}  // namespace half_avx2
+#include "search/half_filter_avx2.inc"
 #pragma clang attribute pop
 #pragma clang attribute push(__attribute__((target("avx512f"))), apply_to = function)
 MMVK_DEFINE_KERNELS(avx512, V16)
-namespace half_avx512 {
-using V = V16;
-struct HalfLoad {
-  MMVK_INLINE V operator()(const std::uint16_t* p) const {
-    // The all-lanes masked form: GCC 12 warns of the plain one's
-    // _mm512_undefined_ps source (maybe-uninitialized).
-    const __m512 f = _mm512_maskz_cvtph_ps(0xffff, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
-    return load<V>(&f);
-  }
-};
-struct PassBits {
-  MMVK_INLINE std::uint32_t operator()(const V& total, float limit) const {
-    return _mm512_cmp_ps_mask(load<__m512>(&total), _mm512_set1_ps(limit), _CMP_NGT_UQ);
-  }
-};
-#include "search/half_filter_kernel.inc"
-}  // namespace half_avx512
+#include "search/half_filter_avx512.inc"
 #pragma clang attribute pop
 #elif defined(__x86_64__) && defined(__GNUC__)
 #define MMVK_HAS_X86_KERNELS 1
@@ -362,43 +331,12 @@ MMVK_DEFINE_KERNELS(avx2, V8)
 #pragma GCC pop_options
 #pragma GCC push_options
 #pragma GCC target("avx2,f16c")
-namespace half_avx2 {
-using V = V8;
-struct HalfLoad {
-  MMVK_INLINE V operator()(const std::uint16_t* p) const {
-    const __m256 f = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
-    return load<V>(&f);
-  }
-};
-struct PassBits {
-  MMVK_INLINE std::uint32_t operator()(const V& total, float limit) const {
-    const __m256 pass = _mm256_cmp_ps(load<__m256>(&total), _mm256_set1_ps(limit), _CMP_NGT_UQ);
-    return static_cast<std::uint32_t>(_mm256_movemask_ps(pass));
-  }
-};
-#include "search/half_filter_kernel.inc"
-}  // namespace half_avx2
+#include "search/half_filter_avx2.inc"
 #pragma GCC pop_options
 #pragma GCC push_options
 #pragma GCC target("avx512f")
 MMVK_DEFINE_KERNELS(avx512, V16)
-namespace half_avx512 {
-using V = V16;
-struct HalfLoad {
-  MMVK_INLINE V operator()(const std::uint16_t* p) const {
-    // The all-lanes masked form: GCC 12 warns of the plain one's
-    // _mm512_undefined_ps source (maybe-uninitialized).
-    const __m512 f = _mm512_maskz_cvtph_ps(0xffff, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
-    return load<V>(&f);
-  }
-};
-struct PassBits {
-  MMVK_INLINE std::uint32_t operator()(const V& total, float limit) const {
-    return _mm512_cmp_ps_mask(load<__m512>(&total), _mm512_set1_ps(limit), _CMP_NGT_UQ);
-  }
-};
-#include "search/half_filter_kernel.inc"
-}  // namespace half_avx512
+#include "search/half_filter_avx512.inc"
 #pragma GCC pop_options
 #endif
 

@@ -290,7 +290,6 @@ MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t first_pack, std::s
   }
 
 MMVK_DEFINE_KERNELS(generic, V4)
-constexpr int kHalfGroup = 8;
 namespace half_generic {
 using V = V4;
 struct HalfLoad {

@@ -82,10 +82,12 @@ struct ClusterSearchOptions {
   // Visited tiles are read from a 16-bit (IEEE half) copy of the rows: a
   // row whose lower bound from its half row passes the k-th best enters the
   // list with an upper bound of its cost, and at the query's end the rows
-  // that can still be in the result get their exact cost. Results and costs
-  // stay the reference's, bit for bit. The copy adds 2 bytes a value (27
-  // dims: 54 bytes a row beside the float rows' 108). Off: every visited
-  // row is evaluated from the float rows.
+  // that can still be in the result get their exact cost (from the
+  // database's rows). Results and costs stay the reference's, bit for bit.
+  // The half copy replaces the backend's float copy of the rows: 2 bytes a
+  // value instead of 4 (27 dims: 54 bytes a row instead of 120 with the
+  // float copy's multiplier, bias and lane flag). Off: every visited row is
+  // evaluated from the float copy.
   bool half_filter = true;
   // As FastSearchOptions::kernels.
   CpuKernels kernels = CpuKernels::Widest;

@@ -181,8 +181,15 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   }
   std::uint32_t tile_packs = 0;
   place_clusters(l, tile_packs);
-  l.rows = detail::TileStore::build(database, l.frame);
-  if (options.half_filter) l.half = detail::HalfTileStore::build(database, l.frame, l.tile_offsets);
+  if (options.half_filter) {
+    // The float tiles would never be read: the filter reads the half copy
+    // and the exact stage the database's rows. Only their channel ends.
+    l.rows.dims = l.dims;
+    l.rows.channel_end = detail::channel_ends(database);
+    l.half = detail::HalfTileStore::build(database, l.frame, l.tile_offsets);
+  } else {
+    l.rows = detail::TileStore::build(database, l.frame);
+  }
   build_tile_boxes(l, database, tile_packs);
   build_span_boxes(l, database);
   build_cluster_boxes(l);

@@ -131,8 +131,9 @@ struct ClusterSearch::Layout {
   // The members of each cluster, in frame order, fill its tiles; the last
   // tile of a cluster is padded (kNoFrame, an invalid lane).
   std::vector<std::uint32_t> frame;          // [tiles x 16]
+  // With options.half_filter, `half` holds the tiles at half precision and
+  // `rows` only its channel ends (no tiles); else `half` is empty.
   detail::TileStore rows;
-  // The same tiles at half precision (options.half_filter; else empty).
   detail::HalfTileStore half;
   // The box of each tile's member rows, with their minimum multiplier and
   // bias. A cluster's tile boxes start a pack of their own, so its bounds

@@ -17,6 +17,7 @@
 #include "search/half_float.hpp"
 
 #if defined(__x86_64__)
+#include <cpuid.h>
 #include <immintrin.h>
 #endif
 
@@ -342,11 +343,17 @@ MMVK_DEFINE_KERNELS(avx512, V16)
 Kernels generic_kernels() { return {evaluate_tiles_generic, box_bounds_generic, half_generic::half_filter, "generic", 2}; }
 
 #if defined(MMVK_HAS_X86_KERNELS)
+// F16C from CPUID leaf 1 (Clang's __builtin_cpu_supports has no "f16c").
+bool has_f16c() {
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  return __get_cpuid(1, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_F16C) != 0;
+}
+
 // AVX2 machines without F16C (none are known) filter with the baseline
 // conversion.
 Kernels avx2_kernels() {
-  return {evaluate_tiles_avx2, box_bounds_avx2,
-          __builtin_cpu_supports("f16c") ? half_avx2::half_filter : half_generic::half_filter, "avx2", 4};
+  return {evaluate_tiles_avx2, box_bounds_avx2, has_f16c() ? half_avx2::half_filter : half_generic::half_filter,
+          "avx2", 4};
 }
 Kernels avx512_kernels() { return {evaluate_tiles_avx512, box_bounds_avx512, half_avx512::half_filter, "avx512f", 4}; }
 #endif

@@ -155,7 +155,7 @@ void size_scratch(ClusterSearch::Layout& l, unsigned threads) {
     s.bound_state.resize(kSubBatch);
     s.cursor.resize(kSubBatch);
     s.candidate_end.resize(kSubBatch);
-    // Rows deferred per query: about 60 on the Bandai volume set; grown
+    // Rows deferred per query: about 70 on the Bandai volume set; grown
     // past this once if needed, and kept.
     s.deferred.resize(kSubBatch);
     for (std::vector<DeferredRow>& rows : s.deferred) rows.reserve(l.half.tiles != 0 ? 256 : 0);
@@ -259,9 +259,9 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
       half_filter ? detail::HalfFilterLimits(l.half, l.rows.channel_end, v.w) : detail::HalfFilterLimits{};
   // half_filter: the lanes whose half-precision bound passes the k-th best
   // are deferred to the query's end (finish_query), and enter the list now
-  // with an upper bound of their cost. The exact costs of rows that do not
-  // end near the top would be cache misses (the float rows are not read
-  // otherwise), and most rows that pass early are beaten later. While the
+  // with an upper bound of their cost. An exact cost reads the row from the
+  // database (a cache miss: frame order, not cluster order), and most rows
+  // that pass early are beaten later. While the
   // list is not full (k-th best +inf) every lane passes: a tile at a time
   // then, which fills a list of k <= 16.
   const auto filter = [&] {

@@ -43,6 +43,9 @@ struct Variant {
   // 256-bit kernels to the 256-bit plain loop (plain-loop-avx2) on a CPU
   // that also has AVX-512F.
   CpuKernels kernels = CpuKernels::Widest;
+  // clusters-float: ClusterSearchOptions::half_filter off (every visited
+  // row evaluated from the float tiles), for before/after in one run.
+  bool half_filter = true;
 };
 
 const std::vector<Variant>& variants() {
@@ -50,7 +53,8 @@ const std::vector<Variant>& variants() {
     std::vector<Variant> v = {{"reference", "reference"}, {"fast-brute", "fast-brute"}, {"fast-box", "fast-box"},
                               {"clusters", "clusters"}, {"clusters-per-query", "clusters", 0, true},
                               {"fast-brute-avx2", "fast-brute", 0, false, CpuKernels::Avx2},
-                              {"clusters-avx2", "clusters", 0, false, CpuKernels::Avx2}};
+                              {"clusters-avx2", "clusters", 0, false, CpuKernels::Avx2},
+                              {"clusters-float", "clusters", 0, false, CpuKernels::Widest, false}};
     for (const std::uint32_t nprobe : {1u, 4u, 8u, 16u, 32u, 64u}) {
       v.push_back({"clusters-nprobe" + std::to_string(nprobe), "clusters-nprobe", nprobe});
     }
@@ -107,6 +111,7 @@ Fixture* fixture(DataSet set) {
         spec.nprobe = variant.nprobe;
         spec.fast.kernels = variant.kernels;
         spec.cluster.kernels = variant.kernels;
+        spec.cluster.half_filter = variant.half_filter;
         // Tuning switch (MMVK_BENCH_NO_SEED=1).
         spec.cluster.seed_nearest = std::getenv("MMVK_BENCH_NO_SEED") == nullptr;
         if (variant.per_query) {
@@ -193,6 +198,10 @@ void run(benchmark::State& state, DataSet set, QueryStream stream, const std::st
     state.counters["clusters"] = clusters->cluster_count();
     state.counters["visited/q"] = double(clusters->counters().clusters_visited) / queries;
     state.counters["tiles_checked/q"] = double(clusters->counters().tiles_checked) / queries;
+    state.counters["tiles_filtered/q"] = double(clusters->counters().tiles_filtered) / queries;
+    state.counters["passed/q"] = double(clusters->counters().rows_rechecked) / queries;
+    state.counters["exact/q"] = double(clusters->counters().rows_exact) / queries;
+    state.counters["rows/q"] = double(backend.stats().rows_evaluated) / queries;
   }
 }
 

@@ -120,6 +120,9 @@ const Variant kExactVariants[] = {
     // runs with kernels = Generic).
     {"generic kernels", {.kernels = CpuKernels::Generic}},
     {"generic kernels, no nearest seed", {.nprobe = 0, .seed_nearest = false, .kernels = CpuKernels::Generic}},
+    // Every visited row evaluated from the float tiles (no half filter).
+    {"float rows", {.nprobe = 0, .half_filter = false}},
+    {"float rows, generic kernels", {.nprobe = 0, .half_filter = false, .kernels = CpuKernels::Generic}},
 };
 
 // 200 clusters: several groups of 32 (the level above the clusters, whose
@@ -351,6 +354,7 @@ TEST(ClusterSearch, GroupedAndSpannedPathsMatchTheReference) {
       {"spans only", {.span_bound = true, .batch_by_cluster = false}},
       {"all off", {.span_bound = false, .batch_by_cluster = false}},
       {"all on, no seed", {.seed_nearest = false}},
+      {"all on, float rows", {.half_filter = false}},
   };
   // 150 clusters: five groups of 32 in the group level above the clusters.
   for (const std::uint32_t clusters : {3u, 40u, 150u}) {

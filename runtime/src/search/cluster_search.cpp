@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -154,6 +155,10 @@ void size_scratch(ClusterSearch::Layout& l, unsigned threads) {
     s.bound_state.resize(kSubBatch);
     s.cursor.resize(kSubBatch);
     s.candidate_end.resize(kSubBatch);
+    // Rows deferred per query: about 70 on the Bandai volume set; grown
+    // past this once if needed, and kept.
+    s.deferred.resize(kSubBatch);
+    for (std::vector<DeferredRow>& rows : s.deferred) rows.reserve(l.half.tiles != 0 ? 256 : 0);
   }
 }
 
@@ -176,7 +181,15 @@ Result<std::unique_ptr<ClusterSearch>> ClusterSearch::create(const Database& dat
   }
   std::uint32_t tile_packs = 0;
   place_clusters(l, tile_packs);
-  l.rows = detail::TileStore::build(database, l.frame);
+  if (options.half_filter) {
+    // The float tiles would never be read: the filter reads the half copy
+    // and the exact stage the database's rows. Only their channel ends.
+    l.rows.dims = l.dims;
+    l.rows.channel_end = detail::channel_ends(database);
+    l.half = detail::HalfTileStore::build(database, l.frame, l.tile_offsets);
+  } else {
+    l.rows = detail::TileStore::build(database, l.frame);
+  }
   build_tile_boxes(l, database, tile_packs);
   build_span_boxes(l, database);
   build_cluster_boxes(l);
@@ -229,17 +242,61 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
       span = run_end;
     }
   }
-  // Tiles that pass are evaluated kTileChunk at a time (the kernel overlaps
-  // their sums), against the k-th best from before the chunk.
-  std::array<std::uint32_t, kTileChunk> chunk{};
+  // Tiles that pass are evaluated kTileChunk (half_filter: kHalfChunk) at a
+  // time (the kernel overlaps their sums), against the k-th best from
+  // before the chunk.
+  std::array<std::uint32_t, std::max(kTileChunk, kHalfChunk)> chunk{};
   std::uint32_t chunk_size = 0;
-  const auto flush = [&] {
+  const auto evaluate = [&](const std::uint32_t* tiles_to_evaluate, std::uint32_t count) {
     const detail::KernelQuery kernel_query{v.q, v.w, v.best.back().cost};
-    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, chunk.data(), chunk_size, s.hits.data());
-    chunk_size = 0;
+    const std::size_t hits = l.kernels.evaluate_tiles(x.tiles, &kernel_query, 1, tiles_to_evaluate, count, s.hits.data());
     for (std::size_t h = 0; h < hits; ++h) {
       detail::offer_tile_row(x.db, *v.params, v.best, Match{l.frame[s.hits[h].slot], s.hits[h].cost});
     }
+  };
+  const bool half_filter = x.options.half_filter;
+  detail::HalfFilterLimits half_limits =
+      half_filter ? detail::HalfFilterLimits(l.half, l.rows.channel_end, v.w) : detail::HalfFilterLimits{};
+  // half_filter: the lanes whose half-precision bound passes the k-th best
+  // are deferred to the query's end (finish_query), and enter the list now
+  // with an upper bound of their cost. An exact cost reads the row from the
+  // database (a cache miss: frame order, not cluster order), and most rows
+  // that pass early are beaten later. While the
+  // list is not full (k-th best +inf) every lane passes: a tile at a time
+  // then, which fills a list of k <= 16.
+  const auto filter = [&] {
+    for (std::uint32_t first = 0; first < chunk_size;) {
+      const float threshold = v.best.back().cost;
+      const std::uint32_t count = threshold < std::numeric_limits<float>::infinity() ? chunk_size - first : 1;
+      l.kernels.half_filter(x.half_tiles, v.q, v.w, chunk.data() + first, half_limits(c, threshold), count,
+                            s.masks.data(), s.distances.data());
+      s.counters.tiles_filtered += count;
+      for (std::uint32_t i = 0; i < count; ++i) {
+        for (std::uint32_t mask = s.masks[i]; mask != 0; mask &= mask - 1) {
+          const auto lane = static_cast<std::uint32_t>(std::countr_zero(mask));
+          const std::uint32_t frame = l.frame[std::size_t{chunk[first + i]} * kLanes + lane];
+          const float distance = s.distances[i * kLanes + lane];
+          v.deferred->push_back({frame, distance, c});
+          ++s.counters.rows_rechecked;
+          // As offer_tile_row (the continuing frame is seeded on its own),
+          // with the candidate test, a look-up in the frame's tags, only
+          // for rows that enter the list; finish_query tests the others.
+          const Match entry{frame, half_limits.upper(c, distance)};
+          if (!match_less(entry, v.best.back())) continue;
+          if (frame == v.params->continuing_frame || !is_candidate(x.db, frame, *v.params)) continue;
+          detail::insert_sorted(v.best, entry);
+        }
+      }
+      first += count;
+    }
+  };
+  const auto flush = [&] {
+    if (half_filter) {
+      filter();
+    } else {
+      evaluate(chunk.data(), chunk_size);
+    }
+    chunk_size = 0;
   };
   // The tiles whose bound passes the k-th best from before the walk,
   // compacted without a branch (most tiles fail, in no pattern a predictor
@@ -257,21 +314,53 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
     const std::uint32_t tile = first_tile + i;
     s.rows += l.tile_rows[tile];
     chunk[chunk_size++] = tile;
-    if (chunk_size == kTileChunk) flush();
+    if (chunk_size == (half_filter ? kHalfChunk : kTileChunk)) flush();
   }
   if (chunk_size != 0) flush();
 }
 
-// Clears the query's list and seeds it with the continuing frame: its cost
+// Seeds the query's (cleared) list with the continuing frame: its cost
 // carries continuing_bias (possibly negative), which no cluster bound
 // covers, so it is evaluated on its own and skipped by the tiles.
+bool seed_continuing(const WalkContext& x, const QueryView& v) {
+  const std::uint32_t continuing = v.params->continuing_frame;
+  if (continuing == kNoFrame || !is_candidate(x.db, continuing, *v.params)) return false;
+  detail::insert_sorted(v.best, Match{continuing, frame_cost(x.db, continuing, {v.q, x.l.dims}, *v.params)});
+  return true;
+}
+
 void start_query(const WalkContext& x, Scratch& s, const QueryView& v) {
   std::fill(v.best.begin(), v.best.end(), Match{});
-  const std::uint32_t continuing = v.params->continuing_frame;
-  if (continuing != kNoFrame && is_candidate(x.db, continuing, *v.params)) {
-    detail::insert_sorted(v.best, Match{continuing, frame_cost(x.db, continuing, {v.q, x.l.dims}, *v.params)});
-    ++s.rows;
+  if (v.deferred != nullptr) v.deferred->clear();
+  if (seed_continuing(x, v)) ++s.rows;
+}
+
+// half_filter: the exact re-rank. The k-th entry of the list (upper bounds)
+// is at least the k-th best cost, so every row of the result, and every row
+// tied with one, has a half-precision distance within the limit of that
+// entry: those rows, and only those, get their exact cost (the reference's
+// frame_cost, the bits of the tile kernel) and make the list again, with
+// the continuing frame.
+void finish_query(const WalkContext& x, Scratch& s, const QueryView& v) {
+  if (!x.options.half_filter) return;
+  std::vector<DeferredRow>& rows = *v.deferred;
+  detail::HalfFilterLimits limits(x.l.half, x.l.rows.channel_end, v.w);
+  const float threshold = v.best.back().cost;
+  std::size_t kept = 0;
+  for (const DeferredRow& row : rows) {
+    if (row.distance > limits(row.block, threshold)) continue;
+    __builtin_prefetch(x.db.row(row.frame).data());  // scattered rows: all requested before the first is read
+    rows[kept++] = row;
   }
+  std::fill(v.best.begin(), v.best.end(), Match{});
+  seed_continuing(x, v);
+  for (std::size_t i = 0; i < kept; ++i) {
+    const std::uint32_t frame = rows[i].frame;
+    if (frame == v.params->continuing_frame || !is_candidate(x.db, frame, *v.params)) continue;
+    detail::insert_sorted(v.best, Match{frame, frame_cost(x.db, frame, {v.q, x.l.dims}, *v.params)});
+  }
+  s.counters.rows_exact += kept;
+  rows.clear();
 }
 
 // The per-query walk: one query's clusters in order, with no batch
@@ -383,7 +472,11 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
   const std::size_t group_stride = packs_of(x.l.group_count) * kLanes;
   for (std::size_t base = first; base < last; base += kSubBatch) {
     const std::uint32_t n = static_cast<std::uint32_t>(std::min(kSubBatch, last - base));
-    const auto local = [&](std::uint32_t i) { return view_of(base + i); };
+    const auto local = [&](std::uint32_t i) {
+      QueryView v = view_of(base + i);
+      v.deferred = &s.deferred[i];
+      return v;
+    };
     s.pairs.clear();
     for (std::uint32_t i = 0; i < n; ++i) {
       const QueryView v = local(i);
@@ -427,6 +520,7 @@ void walk_batched(const WalkContext& x, Scratch& s, const ViewOf& view_of, std::
       if (s.pairs.empty()) break;
       visit_grouped(x, s, local);
     }
+    for (std::uint32_t i = 0; i < n; ++i) finish_query(x, s, local(i));
   }
 }
 
@@ -438,7 +532,8 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
   const QueryParams default_params;
   const ClusterSearchOptions options = options_;
   const WalkContext x{*database_, l, options, l.rows.arrays(), l.tile_boxes.arrays(l.rows.channel_end),
-                      l.span_boxes.arrays(l.rows.channel_end)};
+                      l.span_boxes.arrays(l.rows.channel_end),
+                      l.half.arrays(l.rows.channel_end.data())};
   for (Scratch& s : l.scratch) {
     s.rows = 0;
     s.counters = {};
@@ -454,9 +549,11 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
       return;
     }
     for (std::size_t qi = first; qi < last; ++qi) {
-      const QueryView v = view_of(qi);
+      QueryView v = view_of(qi);
+      v.deferred = &s.deferred[0];
       start_query(x, s, v);
       walk_one(x, s, v);
+      finish_query(x, s, v);
     }
   });
 
@@ -465,6 +562,9 @@ Status ClusterSearch::search(const QueryBatch& batch, std::uint32_t k, std::span
     stats_.rows_evaluated += s.rows;
     counters_.clusters_visited += s.counters.clusters_visited;
     counters_.tiles_checked += s.counters.tiles_checked;
+    counters_.tiles_filtered += s.counters.tiles_filtered;
+    counters_.rows_rechecked += s.counters.rows_rechecked;
+    counters_.rows_exact += s.counters.rows_exact;
   }
   return {};
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mmvk/cluster_search.hpp"
+#include "search/half_tile_store.hpp"
 #include "search/tile_kernels.hpp"
 #include "search/tile_store.hpp"
 
@@ -27,8 +28,10 @@ constexpr std::uint32_t kNoCluster = 0xffffffffu;
 // candidate cluster per query before the rest are taken at once.
 constexpr std::size_t kSubBatch = 512;
 constexpr std::uint32_t kRankedRounds = 1;
-// Tiles of one cluster handed to the kernel at once.
+// Tiles of one cluster handed to the kernel at once (half_filter: to the
+// filter, which holds 8 tiles' sums at once with AVX-512).
 constexpr std::uint32_t kTileChunk = 4;
+constexpr std::uint32_t kHalfChunk = 8;
 // The group level above the clusters: runs of kGroupPacks cluster packs
 // (32 clusters) whose centroids lie near each other. Exact mode computes the
 // group bounds first and the cluster bounds only of the groups whose bound
@@ -67,6 +70,15 @@ struct VisitPair {
 // never read.
 enum class BoundState : std::uint8_t { All, Partial, Probed };
 
+// half_filter: a row whose half-precision bound passed the k-th best when
+// its tile was filtered; its exact cost is computed at the end of the query
+// if the bound still passes then (see cluster_search.cpp).
+struct DeferredRow {
+  std::uint32_t frame;
+  float distance;      // the kernel's half-precision distance
+  std::uint32_t block;  // its cluster (HalfTileStore block)
+};
+
 struct Scratch {
   std::vector<ClusterBound> order;
   std::vector<float> bound, distance;            // [clusters, padded to 16]
@@ -76,6 +88,12 @@ struct Scratch {
   std::vector<float> span_bound;                 // [spans of the largest cluster, padded to 16]
   std::vector<std::uint32_t> passing;            // [tiles of the largest cluster]
   std::array<detail::LaneHit, kLanes * kTileChunk> hits{};
+  // half_filter: per tile of a chunk, its lanes through the filter and
+  // their half-precision distances; per query of a sub-batch (one query:
+  // the first), the rows deferred to its exact re-rank.
+  std::array<std::uint16_t, kHalfChunk> masks{};
+  std::array<float, kLanes * kHalfChunk> distances{};
+  std::vector<std::vector<DeferredRow>> deferred;  // [kSubBatch]
   // The grouped walk (batch_by_cluster).
   std::vector<float> batch_bound;                              // [kSubBatch][clusters, padded to 16]
   std::vector<float> batch_group_bound;                        // [kSubBatch][groups, padded to 16]
@@ -113,7 +131,10 @@ struct ClusterSearch::Layout {
   // The members of each cluster, in frame order, fill its tiles; the last
   // tile of a cluster is padded (kNoFrame, an invalid lane).
   std::vector<std::uint32_t> frame;          // [tiles x 16]
+  // With options.half_filter, `half` holds the tiles at half precision and
+  // `rows` only its channel ends (no tiles); else `half` is empty.
   detail::TileStore rows;
+  detail::HalfTileStore half;
   // The box of each tile's member rows, with their minimum multiplier and
   // bias. A cluster's tile boxes start a pack of their own, so its bounds
   // are whole packs: tile i of cluster c is box tile_box_pack[c] * 16 + i.
@@ -145,7 +166,12 @@ struct QueryView {
   const float* q;
   const float* w;
   const QueryParams* params;
-  std::span<Match> best;  // sorted, k entries
+  // Sorted, k entries. With half_filter, until the query's end, a row's
+  // entry holds an upper bound of its cost (HalfFilterLimits::upper), so the
+  // k-th entry is still at least the k-th best cost: every bound compared
+  // with it prunes only rows that cannot enter the result.
+  std::span<Match> best;
+  std::vector<DeferredRow>* deferred = nullptr;  // half_filter: this query's rows to re-rank
 };
 
 // What every walk needs besides the query.
@@ -156,6 +182,7 @@ struct WalkContext {
   detail::TileArrays tiles;
   detail::BoxArrays tile_boxes;
   detail::BoxArrays span_boxes;
+  detail::HalfTileArrays half_tiles;
 };
 
 // Whether query `params` may take a frame from cluster c (flags and tags).

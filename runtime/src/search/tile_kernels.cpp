@@ -14,6 +14,13 @@
 
 #include <cstring>
 
+#include "search/half_float.hpp"
+
+#if defined(__x86_64__)
+#include <cpuid.h>
+#include <immintrin.h>
+#endif
+
 namespace mmvk::detail {
 
 namespace {
@@ -284,6 +291,22 @@ MMVK_INLINE void box_bounds_v(const BoxArrays& b, std::size_t first_pack, std::s
   }
 
 MMVK_DEFINE_KERNELS(generic, V4)
+namespace half_generic {
+using V = V4;
+struct HalfLoad {
+  MMVK_INLINE V operator()(const std::uint16_t* p) const {
+    return V{half_to_float(p[0]), half_to_float(p[1]), half_to_float(p[2]), half_to_float(p[3])};
+  }
+};
+struct PassBits {
+  MMVK_INLINE std::uint32_t operator()(const V& total, float limit) const {
+    std::uint32_t bits = 0;
+    for (int lane = 0; lane < 4; ++lane) bits |= !(total[lane] > limit) ? 1u << lane : 0u;
+    return bits;
+  }
+};
+#include "search/half_filter_kernel.inc"
+}  // namespace half_generic
 #if defined(__x86_64__) && defined(__clang__)
 // Clang ignores GCC's target pragmas (the kernels would be built for SSE2
 // and only named avx2 / avx512f); its own pragma sets the target of every
@@ -293,8 +316,12 @@ MMVK_DEFINE_KERNELS(generic, V4)
 #pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
 MMVK_DEFINE_KERNELS(avx2, V8)
 #pragma clang attribute pop
+#pragma clang attribute push(__attribute__((target("avx2,f16c"))), apply_to = function)
+#include "search/half_filter_avx2.inc"
+#pragma clang attribute pop
 #pragma clang attribute push(__attribute__((target("avx512f"))), apply_to = function)
 MMVK_DEFINE_KERNELS(avx512, V16)
+#include "search/half_filter_avx512.inc"
 #pragma clang attribute pop
 #elif defined(__x86_64__) && defined(__GNUC__)
 #define MMVK_HAS_X86_KERNELS 1
@@ -303,23 +330,46 @@ MMVK_DEFINE_KERNELS(avx512, V16)
 MMVK_DEFINE_KERNELS(avx2, V8)
 #pragma GCC pop_options
 #pragma GCC push_options
+#pragma GCC target("avx2,f16c")
+#include "search/half_filter_avx2.inc"
+#pragma GCC pop_options
+#pragma GCC push_options
 #pragma GCC target("avx512f")
 MMVK_DEFINE_KERNELS(avx512, V16)
+#include "search/half_filter_avx512.inc"
 #pragma GCC pop_options
+#endif
+
+Kernels generic_kernels() { return {evaluate_tiles_generic, box_bounds_generic, half_generic::half_filter, "generic", 2}; }
+
+#if defined(MMVK_HAS_X86_KERNELS)
+// F16C from CPUID leaf 1 (Clang's __builtin_cpu_supports has no "f16c").
+bool has_f16c() {
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  return __get_cpuid(1, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_F16C) != 0;
+}
+
+// AVX2 machines without F16C (none are known) filter with the baseline
+// conversion.
+Kernels avx2_kernels() {
+  return {evaluate_tiles_avx2, box_bounds_avx2, has_f16c() ? half_avx2::half_filter : half_generic::half_filter,
+          "avx2", 4};
+}
+Kernels avx512_kernels() { return {evaluate_tiles_avx512, box_bounds_avx512, half_avx512::half_filter, "avx512f", 4}; }
 #endif
 
 }  // namespace
 
 Kernels select_kernels(bool baseline) {
 #if defined(MMVK_HAS_X86_KERNELS)
-  if (baseline) return {evaluate_tiles_generic, box_bounds_generic, "generic", 2};
+  if (baseline) return generic_kernels();
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f")) return {evaluate_tiles_avx512, box_bounds_avx512, "avx512f", 4};
-  if (__builtin_cpu_supports("avx2")) return {evaluate_tiles_avx2, box_bounds_avx2, "avx2", 4};
+  if (__builtin_cpu_supports("avx512f")) return avx512_kernels();
+  if (__builtin_cpu_supports("avx2")) return avx2_kernels();
 #else
   (void)baseline;
 #endif
-  return {evaluate_tiles_generic, box_bounds_generic, "generic", 2};
+  return generic_kernels();
 }
 
 bool select_kernels(CpuKernels set, Kernels& out) {
@@ -330,12 +380,12 @@ bool select_kernels(CpuKernels set, Kernels& out) {
     case CpuKernels::Avx2:
       __builtin_cpu_init();
       if (!__builtin_cpu_supports("avx2")) return false;
-      out = {evaluate_tiles_avx2, box_bounds_avx2, "avx2", 4};
+      out = avx2_kernels();
       return true;
     case CpuKernels::Avx512:
       __builtin_cpu_init();
       if (!__builtin_cpu_supports("avx512f")) return false;
-      out = {evaluate_tiles_avx512, box_bounds_avx512, "avx512f", 4};
+      out = avx512_kernels();
       return true;
 #endif
     default: return false;

@@ -52,6 +52,17 @@ struct BoxArrays {
   std::uint32_t dims;
 };
 
+// Tiles at half precision (half_tile_store.hpp): [tile][dims][16] IEEE
+// binary16 features, and [tile] masks of the lanes that may be candidates
+// (bit l: lane l).
+struct HalfTileArrays {
+  const std::uint16_t* features;
+  const std::uint16_t* lane_mask;
+  const std::uint32_t* channel_end;
+  std::uint32_t channels;
+  std::uint32_t dims;
+};
+
 // The kernels for one instruction set, chosen once at run time.
 struct Kernels {
   // Evaluates the tiles tile_ids[0..count) for `query_count` queries (1, 2 or
@@ -68,6 +79,15 @@ struct Kernels {
   // skipped.
   void (*box_bounds)(const BoxArrays& boxes, std::size_t first_pack, std::size_t pack_count, const float* query,
                      const float* weights, float* out);
+  // ClusterSearch's first filter, for one query: distances[i * 16 + l] gets
+  // lane l's distance over the half rows of tile tile_ids[i], sum_ch w_ch
+  // sum_d (q_d - xh_d)^2 summed in the cost's order, and masks[i] the valid
+  // lanes (bit l: lane l) whose distance is not above `limit` (a NaN
+  // distance passes). No multiplier or bias: HalfFilterLimits folds them
+  // into the limit.
+  void (*half_filter)(const HalfTileArrays& tiles, const float* query, const float* weights,
+                      const std::uint32_t* tile_ids, float limit, std::size_t count, std::uint16_t* masks,
+                      float* distances);
   const char* name;  // "avx512f", "avx2" or "generic"
   // Queries per brute-force pass, which share each row load: 4 with
   // AVX-512's 32 registers of one tile each (1.2x faster than 2 on the

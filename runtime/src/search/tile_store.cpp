@@ -6,12 +6,6 @@
 
 namespace mmvk::detail {
 
-AlignedFloats::AlignedFloats(std::size_t count, float fill)
-    : data_(static_cast<float*>(::operator new[](std::max<std::size_t>(count, 1) * sizeof(float), std::align_val_t{64}))),
-      size_(count) {
-  std::fill(data_.get(), data_.get() + count, fill);
-}
-
 std::vector<std::uint32_t> channel_ends(const Database& db) {
   std::vector<std::uint32_t> ends;
   std::uint32_t end = 0;

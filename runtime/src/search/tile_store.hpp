@@ -3,6 +3,7 @@
 // order, ClusterSearch in cluster order; both build them here.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <new>
@@ -14,25 +15,31 @@
 
 namespace mmvk::detail {
 
-// A float array aligned to a cache line, so each 16-lane load touches one
-// line.
-class AlignedFloats {
+// An array aligned to a cache line, so each 16-lane load touches one line
+// (floats) or half of one (16-bit halves).
+template <class T>
+class AlignedArray {
  public:
-  AlignedFloats() = default;
-  explicit AlignedFloats(std::size_t count, float fill = 0.0f);
-  float* data() { return data_.get(); }
-  const float* data() const { return data_.get(); }
-  float& operator[](std::size_t i) { return data_.get()[i]; }
-  float operator[](std::size_t i) const { return data_.get()[i]; }
+  AlignedArray() = default;
+  explicit AlignedArray(std::size_t count, T fill = T{})
+      : data_(static_cast<T*>(::operator new[](std::max<std::size_t>(count, 1) * sizeof(T), std::align_val_t{64}))),
+        size_(count) {
+    std::fill(data_.get(), data_.get() + count, fill);
+  }
+  T* data() { return data_.get(); }
+  const T* data() const { return data_.get(); }
+  T& operator[](std::size_t i) { return data_.get()[i]; }
+  T operator[](std::size_t i) const { return data_.get()[i]; }
   std::size_t size() const { return size_; }
 
  private:
   struct Free {
-    void operator()(float* p) const { ::operator delete[](p, std::align_val_t{64}); }
+    void operator()(T* p) const { ::operator delete[](p, std::align_val_t{64}); }
   };
-  std::unique_ptr<float[], Free> data_;
+  std::unique_ptr<T[], Free> data_;
   std::size_t size_ = 0;
 };
+using AlignedFloats = AlignedArray<float>;
 
 // One past each channel's last dim, in schema order.
 std::vector<std::uint32_t> channel_ends(const Database& db);

@@ -209,14 +209,10 @@ std::string_view ClusterSearch::kernel_name() const { return layout_->kernels.na
 
 namespace {
 
-// Evaluates the tiles of cluster c whose own bound is at most the k-th best
-// (strictly greater is skipped: a member costing exactly the k-th best could
-// still win on a lower frame id).
-void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c) {
+// The bounds of cluster c's `tiles` tiles into s.tile_bound: by the tile
+// boxes, or first by their spans (a failing span's tiles get +inf).
+void bound_tiles(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c, std::uint32_t tiles) {
   const ClusterSearch::Layout& l = x.l;
-  ++s.counters.clusters_visited;
-  const std::uint32_t first_tile = l.tile_offsets[c];
-  const std::uint32_t tiles = l.tile_offsets[c + 1] - first_tile;
   if (x.options.tile_bound && (!x.options.span_bound || l.span_box_pack[c] == kNoCluster)) {
     // Members are in frame order, so a tile mostly holds neighbouring
     // frames of a clip and its box is tight.
@@ -242,6 +238,53 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
       span = run_end;
     }
   }
+}
+
+// half_filter: the lanes whose half-precision bound passes the k-th best
+// are deferred to the query's end (finish_query), and enter the list now
+// with an upper bound of their cost. An exact cost reads the row from the
+// database (a cache miss: frame order, not cluster order), and most rows
+// that pass early are beaten later. While the list is not full (k-th best
+// +inf) every lane passes: a tile at a time then, which fills a list of
+// k <= 16.
+void filter_half_tiles(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c,
+                       detail::HalfFilterLimits& half_limits, const std::uint32_t* chunk, std::uint32_t chunk_size) {
+  const ClusterSearch::Layout& l = x.l;
+  for (std::uint32_t first = 0; first < chunk_size;) {
+    const float threshold = v.best.back().cost;
+    const std::uint32_t count = threshold < std::numeric_limits<float>::infinity() ? chunk_size - first : 1;
+    l.kernels.half_filter(x.half_tiles, v.q, v.w, chunk + first, half_limits(c, threshold), count,
+                          s.masks.data(), s.distances.data());
+    s.counters.tiles_filtered += count;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      for (std::uint32_t mask = s.masks[i]; mask != 0; mask &= mask - 1) {
+        const auto lane = static_cast<std::uint32_t>(std::countr_zero(mask));
+        const std::uint32_t frame = l.frame[std::size_t{chunk[first + i]} * kLanes + lane];
+        const float distance = s.distances[i * kLanes + lane];
+        v.deferred->push_back({frame, distance, c});
+        ++s.counters.rows_rechecked;
+        // As offer_tile_row (the continuing frame is seeded on its own),
+        // with the candidate test, a look-up in the frame's tags, only
+        // for rows that enter the list; finish_query tests the others.
+        const Match entry{frame, half_limits.upper(c, distance)};
+        if (!match_less(entry, v.best.back())) continue;
+        if (frame == v.params->continuing_frame || !is_candidate(x.db, frame, *v.params)) continue;
+        detail::insert_sorted(v.best, entry);
+      }
+    }
+    first += count;
+  }
+}
+
+// Evaluates the tiles of cluster c whose own bound is at most the k-th best
+// (strictly greater is skipped: a member costing exactly the k-th best could
+// still win on a lower frame id).
+void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::uint32_t c) {
+  const ClusterSearch::Layout& l = x.l;
+  ++s.counters.clusters_visited;
+  const std::uint32_t first_tile = l.tile_offsets[c];
+  const std::uint32_t tiles = l.tile_offsets[c + 1] - first_tile;
+  bound_tiles(x, s, v, c, tiles);
   // Tiles that pass are evaluated kTileChunk (half_filter: kHalfChunk) at a
   // time (the kernel overlaps their sums), against the k-th best from
   // before the chunk.
@@ -257,42 +300,9 @@ void visit_cluster(const WalkContext& x, Scratch& s, const QueryView& v, std::ui
   const bool half_filter = x.options.half_filter;
   detail::HalfFilterLimits half_limits =
       half_filter ? detail::HalfFilterLimits(l.half, l.rows.channel_end, v.w) : detail::HalfFilterLimits{};
-  // half_filter: the lanes whose half-precision bound passes the k-th best
-  // are deferred to the query's end (finish_query), and enter the list now
-  // with an upper bound of their cost. An exact cost reads the row from the
-  // database (a cache miss: frame order, not cluster order), and most rows
-  // that pass early are beaten later. While the
-  // list is not full (k-th best +inf) every lane passes: a tile at a time
-  // then, which fills a list of k <= 16.
-  const auto filter = [&] {
-    for (std::uint32_t first = 0; first < chunk_size;) {
-      const float threshold = v.best.back().cost;
-      const std::uint32_t count = threshold < std::numeric_limits<float>::infinity() ? chunk_size - first : 1;
-      l.kernels.half_filter(x.half_tiles, v.q, v.w, chunk.data() + first, half_limits(c, threshold), count,
-                            s.masks.data(), s.distances.data());
-      s.counters.tiles_filtered += count;
-      for (std::uint32_t i = 0; i < count; ++i) {
-        for (std::uint32_t mask = s.masks[i]; mask != 0; mask &= mask - 1) {
-          const auto lane = static_cast<std::uint32_t>(std::countr_zero(mask));
-          const std::uint32_t frame = l.frame[std::size_t{chunk[first + i]} * kLanes + lane];
-          const float distance = s.distances[i * kLanes + lane];
-          v.deferred->push_back({frame, distance, c});
-          ++s.counters.rows_rechecked;
-          // As offer_tile_row (the continuing frame is seeded on its own),
-          // with the candidate test, a look-up in the frame's tags, only
-          // for rows that enter the list; finish_query tests the others.
-          const Match entry{frame, half_limits.upper(c, distance)};
-          if (!match_less(entry, v.best.back())) continue;
-          if (frame == v.params->continuing_frame || !is_candidate(x.db, frame, *v.params)) continue;
-          detail::insert_sorted(v.best, entry);
-        }
-      }
-      first += count;
-    }
-  };
   const auto flush = [&] {
     if (half_filter) {
-      filter();
+      filter_half_tiles(x, s, v, c, half_limits, chunk.data(), chunk_size);
     } else {
       evaluate(chunk.data(), chunk_size);
     }

@@ -242,10 +242,13 @@ TEST(VulkanClusterSearch, DeviceBytesCountTheDatabaseTablesAndSlots) {
     EXPECT_TRUE(gpu.ok()) << gpu.message();
     return gpu.ok() ? (*gpu)->device_bytes() : 0;
   };
-  const std::uint64_t brute = bytes_of(vulkan::SearchMode::BruteForce, 1, 1u << 20);
-  const std::uint64_t clusters[] = {bytes_of(vulkan::SearchMode::ClustersExact, 1, 1u << 20),
-                                    bytes_of(vulkan::SearchMode::ClustersExact, 2, 1u << 20),
-                                    bytes_of(vulkan::SearchMode::ClustersExact, 3, 1u << 20)};
+  // A budget below max_batch queries' scratch (small with 256-row blocks),
+  // so that a roomier one holds more queries per chunk.
+  constexpr std::uint64_t kSmallScratch = 16u << 10;
+  const std::uint64_t brute = bytes_of(vulkan::SearchMode::BruteForce, 1, kSmallScratch);
+  const std::uint64_t clusters[] = {bytes_of(vulkan::SearchMode::ClustersExact, 1, kSmallScratch),
+                                    bytes_of(vulkan::SearchMode::ClustersExact, 2, kSmallScratch),
+                                    bytes_of(vulkan::SearchMode::ClustersExact, 3, kSmallScratch)};
   // Metadata 16 and cost terms 8 bytes a frame; every frame is scanned here
   // (no flags), with 4 + 16 bytes for scan_frames and scan_terms.
   EXPECT_GE(brute, feature_bytes + std::uint64_t{db.frame_count()} * (16 + 8 + 4 + 16));

@@ -19,10 +19,15 @@ namespace {
 // of block-level culling: a block is a run of a cluster's members in frame
 // order (mostly neighbouring frames), so its box is much tighter than its
 // cluster's (ClusterSearch's 16-row tiles are the same idea). The smallest
-// of these whose loops fit (block_rows_for); on the Bandai volume set (417k
-// frames, transition queries, k = 1) 32 rows visited 2.9% of the rows and
-// 64 rows 3.9%.
-constexpr std::uint32_t kBlockRows[] = {32, 64, 128, 256, 512, 1024, 2048, 4096};
+// of these whose loops fit (block_rows_for). Smaller blocks visit fewer
+// rows, but on lavapipe the costs that grow with the block count (each
+// scan tile's setup: its block's binary search and its queries' loads; the
+// per-query block listing; the merges' pairs) outweigh that: on the Bandai
+// volume set (417k frames, transition queries, k = 1, B = 1024) 32-row
+// blocks visited 2.9% of the rows in 115 ms a batch, 128 rows 5.0% in
+// 67-92 ms, 256 rows in 61 ms and 512 rows in 63 ms (bench/RESULTS.md,
+// 2026-11-27; not split by kernel).
+constexpr std::uint32_t kBlockRows[] = {256, 512, 1024, 2048, 4096};
 // Loop limits of one invocation (llvmpipe stops loops at 65,535 iterations
 // in total): the round-0 merge walks the clusters, lists blocks and moves
 // them, the round-1 merge inserts K pairs per block visited (counted as K

@@ -184,6 +184,50 @@ TEST(VulkanClusterSearch, TiledScanOverSharedBlocksStaysExact) {
   EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, the first: " << messages.front();
 }
 
+// Clusters of about a thousand members, so that each holds several member
+// blocks (256 rows and up: the other tests' tables give one block a
+// cluster): the blocks of one cluster are culled one by one, and what is
+// left stays exact for k = 1 and 4, with the candidate rules, under the
+// validation layer.
+TEST(VulkanClusterSearch, BlocksOfOneClusterAreCulledExactly) {
+  vulkan::ContextOptions context_options;
+  context_options.validation = true;
+  MMVK_VULKAN_CONTEXT(context, context_options);
+  const Database db = synthetic_database({.frames = 6000, .clips = 12, .seed = 131, .constraints = true});
+  ThreadPool pool(2);
+  KMeansParams kmeans;
+  kmeans.clusters = 6;
+  kmeans.iterations = 4;
+  Result<ClusterTable> table = train_cluster_table(db, kmeans, pool);
+  ASSERT_TRUE(table.ok()) << table.message();
+  std::uint32_t largest = 0;
+  for (std::uint32_t c = 0; c < table->cluster_count; ++c) {
+    largest = std::max(largest, table->offsets[c + 1] - table->offsets[c]);
+  }
+  ASSERT_GT(largest, 3u * 256u) << "no cluster of four blocks or more";
+  constexpr std::uint32_t kBatch = 64;
+  const std::vector<float> queries = synthetic_queries(db, kBatch, 132, 0.05f);
+  const std::vector<QueryParams> params = random_params(db, kBatch, 133);
+  vulkan::VulkanSearchOptions options;
+  options.warm_up = false;
+  options.mode = vulkan::SearchMode::ClustersExact;
+  options.max_batch = kBatch;
+  options.max_k = 4;
+  auto gpu = vulkan::VulkanSearch::create(*context, db, options, &*table);
+  ASSERT_TRUE(gpu.ok()) << gpu.message();
+  for (const std::uint32_t k : {1u, 4u}) {
+    SCOPED_TRACE("k " + std::to_string(k));
+    expect_identical(reference_results(db, queries, params, kBatch, k), run_search(**gpu, queries, params, kBatch, k),
+                     k, params, (*gpu)->name());
+    expect_identical(reference_results(db, queries, {}, kBatch, k), run_search(**gpu, queries, {}, kBatch, k), k, {},
+                     (*gpu)->name());
+  }
+  EXPECT_LT((*gpu)->stats().rows_fraction(db.frame_count()), 0.9);
+  gpu->reset();
+  const std::vector<std::string> messages = context->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, the first: " << messages.front();
+}
+
 // A backend builds the pipelines of its own mode only (warm_up() runs each):
 // the cluster modes no brute-force kernel, brute force no cluster kernel.
 TEST(VulkanClusterSearch, BuildsOnlyItsModesKernels) {

@@ -1,4 +1,4 @@
-// Cluster search, pass 1: one invocation per (cluster, query) writes the
+// Cluster search, pass 1: for each (cluster, query), writes the
 // cluster's lower bound for the query as an orderable key, or kSkip when the
 // cluster holds no candidate (ClusterSearch's rules: empty, all members
 // do-not-use / edge-excluded / block-transition, tag union misses
@@ -17,12 +17,9 @@
 #include "search_cost.glsl"
 #include "cluster_bound.glsl"
 
-void main() {
-  const uint c = gl_GlobalInvocationID.x;
-  if (c >= pc.cluster_count) return;
-  const uint local_query = gl_WorkGroupID.y;
-  const uint query = pc.query_base + local_query;
-  const QueryGpu p = query_params[query];
+// The cluster's (bound key, centroid distance key) for the query (q, w)
+// and its rule parameters p.
+uvec2 cluster_keys(uint c, QueryGpu p, vec4 q[DV], float w[CHANNELS]) {
   const uvec4 info = texelFetch(cluster_info, int(c * 3u));
   const uvec4 tags = texelFetch(cluster_info, int(c * 3u + 1u));
   const uvec4 scale = texelFetch(cluster_info, int(c * 3u + 2u));
@@ -30,21 +27,32 @@ void main() {
                     (tags.x & p.require_lo) != p.require_lo || (tags.y & p.require_hi) != p.require_hi ||
                     (tags.z & p.exclude_lo) != 0u || (tags.w & p.exclude_hi) != 0u ||
                     (p.require_lo & p.exclude_lo) != 0u || (p.require_hi & p.exclude_hi) != 0u;
-  uvec2 keys = uvec2(kSkip, kSkip);
-  if (!skip) {
-    vec4 q[DV];
-    vec4 lo[DV];
-    vec4 hi[DV];
-    vec4 center[DV];
-    float w[CHANNELS];
-    load_query(query, q, w);
-    [[unroll]] for (uint v = 0; v < DV; ++v) {
-      lo[v] = texelFetch(cluster_vectors, int((c * 3u) * DV + v));
-      hi[v] = texelFetch(cluster_vectors, int((c * 3u + 1u) * DV + v));
-      center[v] = texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v));
-    }
-    keys.x = bound_key(box_total(q, w, lo, hi), scale.xy);
-    keys.y = orderable_bits(box_total(q, w, center, center));
+  if (skip) return uvec2(kSkip, kSkip);
+  vec4 lo[DV];
+  vec4 hi[DV];
+  vec4 center[DV];
+  [[unroll]] for (uint v = 0; v < DV; ++v) {
+    lo[v] = texelFetch(cluster_vectors, int((c * 3u) * DV + v));
+    hi[v] = texelFetch(cluster_vectors, int((c * 3u + 1u) * DV + v));
+    center[v] = texelFetch(cluster_vectors, int((c * 3u + 2u) * DV + v));
   }
-  bound_keys[local_query * pc.cluster_count + c] = keys;
+  return uvec2(bound_key(box_total(q, w, lo, hi), scale.xy), orderable_bits(box_total(q, w, center, center)));
+}
+
+// Invocation x of a query's row of workgroups takes clusters x, x + stride,
+// ... (kClustersPerBoundsInvocation at most): the query's features, weights
+// and parameters are loaded once for them (storage-buffer loads are scalar
+// loops over the lanes on lavapipe; one load per (cluster, query) was about
+// half of this pass).
+void main() {
+  const uint local_query = gl_WorkGroupID.y;
+  const uint query = pc.query_base + local_query;
+  const QueryGpu p = query_params[query];
+  vec4 q[DV];
+  float w[CHANNELS];
+  load_query(query, q, w);
+  const uint stride = gl_NumWorkGroups.x * kItemsPerScanGroup;
+  for (uint c = gl_GlobalInvocationID.x; c < pc.cluster_count; c += stride) {
+    bound_keys[local_query * pc.cluster_count + c] = cluster_keys(c, p, q, w);
+  }
 }

@@ -19,6 +19,10 @@ const uint kNeverCandidate = 7u;
 // Work items (one invocation each) per cluster_scan workgroup
 // (cluster_layout.hpp: kScanWorkgroup); the scan is built with that size.
 const uint kItemsPerScanGroup = 64u;
+// Clusters per cluster_bounds invocation (cluster_layout.hpp:
+// kClustersPerBoundsInvocation): the host dispatches
+// ceil(clusters / (kItemsPerScanGroup x this)) workgroups per query.
+const uint kClustersPerBoundsInvocation = 8u;
 // Most workgroups of an indirect cluster dispatch (Vulkan's minimum of
 // maxComputeWorkGroupCount[0], cluster_layout.hpp: kMaxIndirectGroups);
 // past it, invocations take several items (a grid-stride loop), so a

@@ -396,6 +396,8 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
   const VkPipelineLayout layout = pipeline_layout_.get();
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, sets.data(), 0, nullptr);
   const std::uint32_t items_per_group = kItemsPerScanGroup;
+  const std::uint32_t bounds_clusters = kScanWorkgroup * kClustersPerBoundsInvocation;
+  const std::uint32_t bounds_groups = (cluster_count_ + bounds_clusters - 1) / bounds_clusters;
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);
     ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, scan_tile(kc)};
@@ -406,8 +408,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
                       kScanDispatchReset.data());
     // Both rounds' per-block item counters.
     vkCmdFillBuffer(commands, scratch.block_sort.buffer.get(), 0, std::uint64_t{block_count_} * 2 * 4, 0);
-    MMVK_TRY(dispatch(context, commands, bounds_.get(), layout, push,
-                      (cluster_count_ + kScanWorkgroup - 1) / kScanWorkgroup, count, "cluster_bounds"));
+    MMVK_TRY(dispatch(context, commands, bounds_.get(), layout, push, bounds_groups, count, "cluster_bounds"));
     full_barrier(commands);
     MMVK_TRY(dispatch(context, commands, select_.get(), layout, push, query_groups, 1, "cluster_select"));
     // A round lists each (query, block) at most once, so its work items

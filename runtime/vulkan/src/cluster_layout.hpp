@@ -71,6 +71,9 @@ static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() =
 // kItemsPerScanGroup.
 inline constexpr std::uint32_t kScanWorkgroup = 64;
 inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup;
+// Clusters per cluster_bounds invocation (GLSL: the same name): the query's
+// loads are shared by them.
+inline constexpr std::uint32_t kClustersPerBoundsInvocation = 8;
 
 // GLSL: ScanDispatch, (groups x, 1, 1, count) per scan round for the
 // per-item sort steps, then per round for the tiled scan; reset by the

@@ -33,6 +33,54 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
   return rows;
 }
 
+// Lists, in the query's row of `listed`, the blocks whose bound key is <=
+// upper of the other clusters whose bound key is <= upper (list_blocks'
+// rule); returns how many. Two loops: the clusters that can win go to the
+// row's tail (the i-th at block_count - 1 - i), then one flat loop takes
+// them from the last and tests their blocks, each iteration either moving
+// to the next cluster or testing one block. The lanes of a SIMD group
+// (different queries) so run about max(clusters that can win + their
+// blocks) iterations, where a loop over the clusters with an inner loop
+// over their blocks ran the union of the lanes' blocks (the largest cost of
+// small blocks on lavapipe). Blocks are listed at the row's front: before
+// the m-th cluster taken is tested, at most (its blocks and the earlier
+// ones') <= block_count - (clusters left) - (seed's blocks) entries are
+// written, so the front never reaches a tail entry still to be read. The
+// order of the items does not change the results (the merges insert pairs
+// in a strict total order). At most cluster_count, then cluster_count +
+// block_count iterations.
+uint list_other_blocks(uint local_query, uint seed, uint upper, vec4 q[DV], float w[CHANNELS]) {
+  const uint key_base = local_query * pc.cluster_count;
+  const uint row = local_query * pc.block_count;
+  uint tail = pc.block_count;
+  for (uint c = 0u; c < pc.cluster_count; ++c) {
+    const uint key = bound_keys[key_base + c].x;
+    if (c != seed && key != kSkip && key <= upper) {
+      --tail;
+      listed[row + tail] = c;
+    }
+  }
+  uint count = 0u;
+  uint b = 0u;
+  uint end = 0u;
+  while (b < end || tail < pc.block_count) {
+    if (b < end) {
+      const uint key = block_key(b, q, w);
+      if (key != kSkip && key <= upper) {
+        listed[row + count] = b;
+        ++count;
+      }
+      ++b;
+    } else {
+      const uint c = listed[row + tail];
+      ++tail;
+      b = texelFetch(cluster_info, int(c * 3u)).w;
+      end = texelFetch(cluster_info, int(c * 3u + 2u)).z;
+    }
+  }
+  return count;
+}
+
 void main() {
   const uint local_query = gl_GlobalInvocationID.x;
   if (local_query >= pc.query_count) return;
@@ -53,16 +101,7 @@ void main() {
     vec4 q[DV];
     float w[CHANNELS];
     load_query(query, q, w);
-    uint count = 0u;
-    const uint key_base = local_query * pc.cluster_count;
-    for (uint c = 0u; c < pc.cluster_count; ++c) {
-      const uint key = bound_keys[key_base + c].x;
-      if (c == state.seed || key == kSkip || key > upper) continue;
-      const uint first = texelFetch(cluster_info, int(c * 3u)).w;
-      const uint end = texelFetch(cluster_info, int(c * 3u + 2u)).z;
-      count = list_blocks(local_query, first, end, upper, count, q, w);
-    }
-    states[query].items1 = move_listed(1u, local_query, count);
+    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.seed, upper, q, w));
     return;
   }
 

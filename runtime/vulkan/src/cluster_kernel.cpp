@@ -20,13 +20,13 @@ namespace {
 // order (mostly neighbouring frames), so its box is much tighter than its
 // cluster's (ClusterSearch's 16-row tiles are the same idea). The smallest
 // of these whose loops fit (block_rows_for). Smaller blocks visit fewer
-// rows, but on lavapipe the costs that grow with the block count (each
-// scan tile's setup: its block's binary search and its queries' loads; the
-// per-query block listing; the merges' pairs) outweigh that: on the Bandai
-// volume set (417k frames, transition queries, k = 1, B = 1024) 32-row
-// blocks visited 2.9% of the rows in 115 ms a batch, 128 rows 5.0% in
-// 67-92 ms, 256 rows in 61 ms and 512 rows in 63 ms (bench/RESULTS.md,
-// 2026-11-27; not split by kernel).
+// rows, but on lavapipe the costs that grow with the block count outweigh
+// that: timed by kernel on the Bandai volume set (417k frames, transition
+// queries, k = 1, B = 1024), the round-0 merge's block listing grew from
+// 17 to 56 ms a batch between 256- and 32-row blocks and round 1's scan
+// stayed at about 40 ms while its rows halved (per-tile costs); after the
+// listing was made cheaper, 64 rows took 73 ms, 128 rows 55 ms and 256
+// rows 51 ms (bench/RESULTS.md, 2026-11-27, "the time split by kernel").
 constexpr std::uint32_t kBlockRows[] = {256, 512, 1024, 2048, 4096};
 // Loop limits of one invocation (llvmpipe stops loops at 65,535 iterations
 // in total): the round-0 merge walks the clusters, lists blocks and moves

@@ -45,6 +45,9 @@ uvec2 cluster_keys(uint c, QueryGpu p, vec4 q[DV], float w[CHANNELS]) {
 // loops over the lanes on lavapipe; one load per (cluster, query) was about
 // half of this pass).
 void main() {
+  // Lanes with no cluster load nothing: with fewer clusters than a
+  // workgroup's lanes (small databases), their loads would be most of it.
+  if (gl_GlobalInvocationID.x >= pc.cluster_count) return;
   const uint local_query = gl_WorkGroupID.y;
   const uint query = pc.query_base + local_query;
   const QueryGpu p = query_params[query];

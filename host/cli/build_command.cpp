@@ -83,10 +83,9 @@ Result<Manifest> manifest_with_overrides(const BuildArgs& args) {
 Status check_paths(const BuildArgs& args, const Manifest& manifest) {
   std::error_code ec;
   const bool folder = std::filesystem::is_directory(args.input, ec);
-  // A BVH file is its manifest's one clip, and names itself below.
-  const bool bvh_file = !manifest.clips.empty() && manifest.clips.front().file == args.input;
   std::vector<NamedPath> paths = {{"-o", args.output, true}};
-  if (!bvh_file) paths.push_back({folder ? "the BVH folder" : "the manifest", args.input, false});
+  // A BVH file is its manifest's one clip, and is named as an input below.
+  if (folder || !is_bvh_path(args.input)) paths.push_back({folder ? "the BVH folder" : "the manifest", args.input, false});
   if (args.schema) paths.push_back({"--schema", *args.schema, false});
   for (const std::filesystem::path& file : manifest_input_files(manifest)) paths.push_back({"the input", file, false});
   return check_command_paths(paths);

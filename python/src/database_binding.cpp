@@ -141,12 +141,14 @@ std::shared_ptr<Database> build(const py::object& source, const py::object& sche
     std::error_code ec;
     if (fields.empty()) {
       manifest = take(load_manifest_or_directory(path), kind);
-    } else if (std::filesystem::is_directory(path, ec)) {
-      // A folder's manifest as JSON, so that the fields are read by the
-      // manifest's own parser (and named in its errors).
-      const Manifest listed = take(manifest_from_directory(path), kind);
+    } else if (std::filesystem::is_directory(path, ec) || is_bvh_path(path)) {
+      // A folder's (or a BVH file's) manifest as JSON, so that the fields
+      // are read by the manifest's own parser (and named in its errors).
+      const Manifest listed = take(load_manifest_or_directory(path), kind);
       nlohmann::json clips = nlohmann::json::array();
-      for (const ManifestClip& clip : listed.clips) clips.push_back({{"file", clip.file.string()}});
+      for (const ManifestClip& clip : listed.clips) {
+        clips.push_back({{"file", std::filesystem::absolute(clip.file).string()}});
+      }
       const std::string text = nlohmann::json{{"clips", clips}}.dump();
       manifest = take(parse_manifest_json(merged_manifest(text, fields, path.string()), path.string(), path));
     } else {

@@ -61,6 +61,16 @@ def test_build_fields_override_the_manifest(db):
     assert len(folder.clips) == 16 and folder.clips[1]["mirrored"]
 
 
+
+def test_build_one_bvh_file(monkeypatch):
+    bvh = CMU131.parent / "131_01.bvh"
+    one = mmvk.build(bvh)
+    assert len(one.clips) == 1 and one.clips[0]["name"] == "131_01"
+    # With fields, and a path relative to the working directory.
+    monkeypatch.chdir(CMU131.parent.parent)
+    at_15 = mmvk.build("cmu131/131_01.bvh", fps=15, mirror=True)
+    assert at_15.fps == 15 and len(at_15.clips) == 2 and at_15.clips[1]["mirrored"]
+
 def test_build_with_a_schema_dict(db):
     schema = {"channels": [{"name": "trajectory_position", "kind": "trajectory_position",
                             "offsets_seconds": [0.5, 1.0]}]}

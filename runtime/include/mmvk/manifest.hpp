@@ -156,6 +156,10 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
                                      const std::filesystem::path& base_dir);
 Result<Manifest> load_manifest(const std::filesystem::path& path);
 
+// Whether `path` names a BVH file by its extension (.bvh, any case), as
+// folders and build sources tell BVH from manifests.
+bool is_bvh_path(const std::filesystem::path& path);
+
 // A manifest with defaults for every *.bvh (case-insensitive extension)
 // directly in `dir`, sorted by file name; clip names are the file stems.
 Result<Manifest> manifest_from_directory(const std::filesystem::path& dir);

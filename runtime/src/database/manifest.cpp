@@ -288,12 +288,6 @@ Result<FootContactParams> read_contacts(const Json& value, const std::string& wh
   return params;
 }
 
-bool is_bvh(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".bvh";
-}
-
 struct EdgeRuleEntry {
   EdgeRule rule;
   std::string_view name;
@@ -462,6 +456,12 @@ Result<Manifest> load_manifest(const std::filesystem::path& path) {
   return parse_manifest_json(*text, path.string(), path.parent_path());
 }
 
+bool is_bvh_path(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".bvh";
+}
+
 namespace {
 
 // The manifest of BVH files with default options, one clip per file named by
@@ -484,7 +484,7 @@ Result<Manifest> manifest_from_directory(const std::filesystem::path& dir) {
   std::error_code error;
   std::vector<std::filesystem::path> files;
   for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
-    if (it->is_regular_file(error) && is_bvh(it->path())) files.push_back(it->path());
+    if (it->is_regular_file(error) && is_bvh_path(it->path())) files.push_back(it->path());
   }
   if (error) return make_error(dir.string() + ": cannot list the folder: " + error.message());
   if (files.empty()) return make_error(dir.string() + ": no .bvh files in the folder");
@@ -497,7 +497,7 @@ Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, error)) return manifest_from_directory(path);
   if (!std::filesystem::exists(path, error)) return make_error(path.string() + ": no such file or folder");
   // A BVH file given where a manifest is expected is one clip, as in a folder.
-  if (is_bvh(path)) return manifest_of_clip_files(path.string(), {path});
+  if (is_bvh_path(path)) return manifest_of_clip_files(path.string(), {path});
   return load_manifest(path);
 }
 

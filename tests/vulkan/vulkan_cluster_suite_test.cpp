@@ -108,6 +108,16 @@ TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
   EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, the first: " << messages.front();
 }
 
+// A table of `clusters` clusters (fewer than ClusterTableCache's default,
+// so that each holds many member blocks), trained briefly.
+Result<ClusterTable> train_few_clusters(const Database& db, std::uint32_t clusters, std::uint32_t iterations) {
+  ThreadPool pool(2);
+  KMeansParams params;
+  params.clusters = clusters;
+  params.iterations = iterations;
+  return train_cluster_table(db, params, pool);
+}
+
 // The cluster kernels' loops (the listing and merging of member blocks per
 // query) stay within llvmpipe's 65,535 iterations at large N, where a loop
 // cut short returns wrong answers silently (shared/LAVAPIPE.md): 300k
@@ -116,11 +126,7 @@ TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
 TEST(VulkanClusterSearch, LargeDatabaseStaysExact) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 300000, .clips = 64, .seed = 111, .channel_dims = {2, 2}});
-  ThreadPool pool(2);
-  KMeansParams params;
-  params.clusters = 48;
-  params.iterations = 3;
-  Result<ClusterTable> table = train_cluster_table(db, params, pool);
+  Result<ClusterTable> table = train_few_clusters(db, 48, 3);
   ASSERT_TRUE(table.ok()) << table.message();
   std::vector<float> queries = synthetic_queries(db, 48, 112);
   for (std::size_t i = 0; i < 16 * db.dims(); ++i) queries.push_back(queries[i] + (i % 2 == 0 ? 40.0f : -25.0f));
@@ -194,11 +200,7 @@ TEST(VulkanClusterSearch, BlocksOfOneClusterAreCulledExactly) {
   context_options.validation = true;
   MMVK_VULKAN_CONTEXT(context, context_options);
   const Database db = synthetic_database({.frames = 6000, .clips = 12, .seed = 131, .constraints = true});
-  ThreadPool pool(2);
-  KMeansParams kmeans;
-  kmeans.clusters = 6;
-  kmeans.iterations = 4;
-  Result<ClusterTable> table = train_cluster_table(db, kmeans, pool);
+  Result<ClusterTable> table = train_few_clusters(db, 6, 4);
   ASSERT_TRUE(table.ok()) << table.message();
   std::uint32_t largest = 0;
   for (std::uint32_t c = 0; c < table->cluster_count; ++c) {

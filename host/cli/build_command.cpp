@@ -139,8 +139,9 @@ int run_build(Args args, const char*) {
     std::fprintf(stderr, "mmvk build: %s\n", saved.message().c_str());
     return 1;
   }
-  std::printf("wrote %s: %zu clips, %s frames, %u dims, %g fps (built in %.2f s, %s frames/s)\n", parsed.output.c_str(),
-              database->clips().size(), thousands(database->frame_count()).c_str(), database->dims(),
+  std::printf("wrote %s: %s, %s, %u dims, %g fps (built in %.2f s, %s frames/s)\n", parsed.output.c_str(),
+              counted(database->clips().size(), "clip").c_str(), counted(database->frame_count(), "frame").c_str(),
+              database->dims(),
               double(database->fps()), seconds,
               thousands(static_cast<unsigned long long>(seconds > 0 ? database->frame_count() / seconds : 0)).c_str());
   return 0;

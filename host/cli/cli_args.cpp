@@ -99,6 +99,10 @@ std::string thousands(unsigned long long value) {
   return out;
 }
 
+std::string counted(unsigned long long count, std::string_view noun) {
+  return thousands(count) + " " + std::string(noun) + (count == 1 ? "" : "s");
+}
+
 std::string progress_bar(double fraction) {
   constexpr int kWidth = 30;
   const int filled = static_cast<int>(kWidth * std::clamp(fraction, 0.0, 1.0));

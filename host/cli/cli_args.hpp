@@ -37,6 +37,10 @@ int report_error(std::string_view command, std::string_view message, int exit_co
 // "1,234,567"
 std::string thousands(unsigned long long value);
 
+// "1 clip", "0 clips", "1,234 clips": the count with thousands separators and
+// the noun in the singular only for exactly one.
+std::string counted(unsigned long long count, std::string_view noun);
+
 // "[#########.....................]": `fraction` of 30 cells (clamped to
 // [0, 1]), for the progress lines of long commands.
 std::string progress_bar(double fraction);

@@ -144,9 +144,9 @@ void print_json(const Database& db, const std::string& path, const Counts& count
 }
 
 void print_summary(const Database& db, const std::string& path, const Counts& counts) {
-  std::printf("%s: %s frames (%.1f s), %zu clips (%zu mirrored, %zu looping), %u dims, %g fps\n",
-              printable(path).c_str(), thousands(db.frame_count()).c_str(), db.frame_count() / double(db.fps()),
-              db.clips().size(), counts.mirrored, counts.looping, db.dims(), double(db.fps()));
+  std::printf("%s: %s (%.1f s), %s (%zu mirrored, %zu looping), %u dims, %g fps\n", printable(path).c_str(),
+              counted(db.frame_count(), "frame").c_str(), db.frame_count() / double(db.fps()),
+              counted(db.clips().size(), "clip").c_str(), counts.mirrored, counts.looping, db.dims(), double(db.fps()));
   std::printf("content hash: %s\n", hash_hex(db.content_hash()).c_str());
   print_animation(db);
   print_units(db);

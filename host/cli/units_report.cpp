@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_args.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/pose_batch.hpp"
 
@@ -96,7 +97,7 @@ void print_units(const Database& database) {
     }
     units += (units.empty() ? "" : "; ") + std::string(text);
     if (database.clips().size() > 1 && unit_counts(database).size() > 1) {
-      units += ", " + std::to_string(count.clips) + " clips";
+      units += ", " + counted(count.clips, "clip");
     }
   }
   std::printf("units: %s\n", units.c_str());

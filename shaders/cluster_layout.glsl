@@ -52,7 +52,7 @@ struct ClusterQueryState {
   uvec2 continuing_pair;  // (key, frame) of the continuing frame, (kNone, kNone) when not a candidate
   uvec2 items0;           // (first work item, count) of the query's blocks in scan round 0
   uvec2 items1;           // the same for round 1 (first counts from item 0 of round 0)
-  uvec2 pad1;
+  uvec2 seed_blocks;      // the blocks scan round 0 evaluated (cluster_select), kNone where fewer
 };
 
 // The rows in cluster order (ClusterTable::members, cluster by cluster),

@@ -49,13 +49,13 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 // order of the items does not change the results (the merges insert pairs
 // in a strict total order). At most cluster_count, then cluster_count +
 // block_count iterations.
-uint list_other_blocks(uint local_query, uint seed, uint upper, vec4 q[DV], float w[CHANNELS]) {
+uint list_other_blocks(uint local_query, uvec2 seed_blocks, uint upper, vec4 q[DV], float w[CHANNELS]) {
   const uint key_base = local_query * pc.cluster_count;
   const uint row = local_query * pc.block_count;
   uint tail = pc.block_count;
   for (uint c = 0u; c < pc.cluster_count; ++c) {
     const uint key = bound_keys[key_base + c].x;
-    if (c != seed && key != kSkip && key <= upper) {
+    if (key != kSkip && key <= upper) {
       --tail;
       listed[row + tail] = c;
     }
@@ -65,7 +65,7 @@ uint list_other_blocks(uint local_query, uint seed, uint upper, vec4 q[DV], floa
   uint end = 0u;
   while (b < end || tail < pc.block_count) {
     if (b < end) {
-      const uint key = block_key(b, q, w);
+      const uint key = b == seed_blocks.x || b == seed_blocks.y ? kSkip : block_key(b, q, w);
       if (key != kSkip && key <= upper) {
         listed[row + count] = b;
         ++count;
@@ -101,7 +101,7 @@ void main() {
     vec4 q[DV];
     float w[CHANNELS];
     load_query(query, q, w);
-    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.seed, upper, q, w));
+    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.seed_blocks, upper, q, w));
     return;
   }
 

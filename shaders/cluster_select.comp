@@ -21,6 +21,30 @@
 #include "cluster_bound.glsl"
 #include "cluster_blocks.glsl"
 
+// Of the blocks of clusters a and b (b may be kNone), the two of least
+// (bound key, block) whose key is <= upper, kNone where there are fewer.
+// At most the two clusters' block count iterations.
+uvec2 least_blocks(uint a, uint b, uint upper, vec4 q[DV], float w[CHANNELS]) {
+  const uint a_first = texelFetch(cluster_info, int(a * 3u)).w;
+  const uint a_blocks = texelFetch(cluster_info, int(a * 3u + 2u)).z - a_first;
+  const uint b_first = b == kNone ? 0u : texelFetch(cluster_info, int(b * 3u)).w;
+  const uint b_blocks = b == kNone ? 0u : texelFetch(cluster_info, int(b * 3u + 2u)).z - b_first;
+  uvec2 keys = uvec2(kSkip, kSkip);
+  uvec2 blocks = uvec2(kNone, kNone);
+  for (uint i = 0u; i < a_blocks + b_blocks; ++i) {
+    const uint block = i < a_blocks ? a_first + i : b_first + (i - a_blocks);
+    const uint key = block_key(block, q, w);
+    if (key == kSkip || key > upper) continue;
+    const bool first = blocks.x == kNone || key < keys.x || (key == keys.x && block < blocks.x);
+    const bool second = !first && (blocks.y == kNone || key < keys.y || (key == keys.y && block < blocks.y));
+    keys.y = first ? keys.x : second ? key : keys.y;
+    blocks.y = first ? blocks.x : second ? block : blocks.y;
+    keys.x = first ? key : keys.x;
+    blocks.x = first ? block : blocks.x;
+  }
+  return blocks;
+}
+
 void main() {
   const uint local_query = gl_GlobalInvocationID.x;
   if (local_query >= pc.query_count) return;
@@ -61,28 +85,39 @@ void main() {
     }
   }
 
+  // The two eligible clusters of least (centroid distance, id).
   uint seed = kNone;
   uint seed_distance = kSkip;
+  uint seed2 = kNone;
+  uint seed2_distance = kSkip;
   for (uint c = 0u; c < clusters; ++c) {
     const uvec2 keys = bound_keys[base + c];
-    if (keys.x != kSkip && (seed == kNone || keys.y < seed_distance)) {
-      seed_distance = keys.y;
-      seed = c;
-    }
+    const bool eligible = keys.x != kSkip;
+    const bool first = eligible && (seed == kNone || keys.y < seed_distance);
+    const bool second = eligible && !first && (seed2 == kNone || keys.y < seed2_distance);
+    seed2_distance = first ? seed_distance : second ? keys.y : seed2_distance;
+    seed2 = first ? seed : second ? c : seed2;
+    seed_distance = first ? keys.y : seed_distance;
+    seed = first ? c : seed;
   }
 
   const uvec2 continuing = continuing_pair(query);
   uvec2 items = uvec2(0u, 0u);
+  uvec2 seed_blocks = uvec2(kNone, kNone);
   if (seed != kNone) {
     vec4 q[DV];
     float w[CHANNELS];
     load_query(query, q, w);
     const uint upper = pc.k == 1u && continuing.y != kNone ? continuing.x : kSkip;
-    const uint first = texelFetch(cluster_info, int(seed * 3u)).w;
-    const uint end = texelFetch(cluster_info, int(seed * 3u + 2u)).z;
-    items = move_listed(0u, local_query, list_blocks(local_query, first, end, upper, 0u, q, w));
+    seed_blocks = least_blocks(seed, seed2, upper, q, w);
+    const uint row = local_query * pc.block_count;
+    uint count = 0u;
+    if (seed_blocks.x != kNone) listed[row + count++] = seed_blocks.x;
+    if (seed_blocks.y != kNone) listed[row + count++] = seed_blocks.y;
+    items = move_listed(0u, local_query, count);
   }
   states[query].seed = seed;
+  states[query].seed_blocks = seed_blocks;
   states[query].continuing_pair = continuing;
   states[query].items0 = items;
 }

@@ -36,7 +36,7 @@ layout(push_constant) uniform ClusterPush {
   uint query_base;     // first query of this chunk in the query buffers
   uint query_count;    // queries in this chunk
   uint k;              // the search's k (<= K)
-  uint round;          // 0: the seed cluster, 1: every other cluster that can win
+  uint round;          // 0: cluster_select's two blocks, 1: every other block that can win
   uint cluster_count;
   uint block_count;    // member blocks over all clusters
   uint nprobe;         // 0: exact; else clusters probed per query (< cluster_count)
@@ -45,8 +45,8 @@ layout(push_constant) uniform ClusterPush {
 
 // cluster_layout.hpp: ClusterQueryState (48 bytes, std430).
 struct ClusterQueryState {
-  uint seed;              // cluster evaluated first (nearest centroid), kNone if none
-  uint upper_key;         // orderable key of the k-th best after the seed, kSkip if fewer than k
+  uint seed;              // nearest eligible cluster (centroid), kNone if none
+  uint upper_key;         // orderable key of the k-th best after round 0, kSkip if fewer than k
   uint rows;              // rows evaluated (statistics)
   uint pad0;
   uvec2 continuing_pair;  // (key, frame) of the continuing frame, (kNone, kNone) when not a candidate

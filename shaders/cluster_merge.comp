@@ -1,10 +1,10 @@
 // Cluster search, pass 4 (twice per chunk): one invocation per query merges
 // the continuing frame's pair and the per-lane best pairs of its work items
 // into the query's best K, in the strict (cost, frame) order.
-//  round 0: the seed cluster's items; the k-th best key is the upper bound
+//  round 0: cluster_select's items; the k-th best key is the upper bound
 //           of round 1 (kSkip while fewer than k were found); lists, of the
-//           other clusters whose bound key is <= it, the blocks whose own
-//           bound key is <= it (block-level culling: a block's box is much
+//           clusters whose bound key is <= it, the blocks not scanned in
+//           round 0 whose own bound key is <= it (block-level culling: a block's box is much
 //           tighter than its cluster's) for scan round 1.
 //  round 1: the items of both rounds; writes the results and the number of
 //           rows evaluated.
@@ -34,8 +34,9 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 }
 
 // Lists, in the query's row of `listed`, the blocks whose bound key is <=
-// upper of the other clusters whose bound key is <= upper (list_blocks'
-// rule); returns how many. Two loops: the clusters that can win go to the
+// upper (strictly greater cannot win; equal may still win on a lower frame
+// id) of the clusters whose bound key is <= upper, except round 0's
+// seed_blocks; returns how many. Two loops: the clusters that can win go to the
 // row's tail (the i-th at block_count - 1 - i), then one flat loop takes
 // them from the last and tests their blocks, each iteration either moving
 // to the next cluster or testing one block. The lanes of a SIMD group
@@ -44,8 +45,7 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 // over their blocks ran the union of the lanes' blocks (the largest cost of
 // small blocks on lavapipe). Blocks are listed at the row's front: before
 // the m-th cluster taken is tested, at most (its blocks and the earlier
-// ones') <= block_count - (clusters left) - (seed's blocks) entries are
-// written, so the front never reaches a tail entry still to be read. The
+// ones') <= block_count - (clusters left) entries are written, so the front never reaches a tail entry still to be read. The
 // order of the items does not change the results (the merges insert pairs
 // in a strict total order). At most cluster_count, then cluster_count +
 // block_count iterations.

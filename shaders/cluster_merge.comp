@@ -36,7 +36,7 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 // Lists, in the query's row of `listed`, the blocks whose bound key is <=
 // upper (strictly greater cannot win; equal may still win on a lower frame
 // id) of the clusters whose bound key is <= upper, except round 0's
-// seed_blocks; returns how many. Two loops: the clusters that can win go to the
+// (items0); returns how many. Two loops: the clusters that can win go to the
 // row's tail (the i-th at block_count - 1 - i), then one flat loop takes
 // them from the last and tests their blocks, each iteration either moving
 // to the next cluster or testing one block. The lanes of a SIMD group
@@ -49,7 +49,12 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 // order of the items does not change the results (the merges insert pairs
 // in a strict total order). At most cluster_count, then cluster_count +
 // block_count iterations.
-uint list_other_blocks(uint local_query, uvec2 seed_blocks, uint upper, vec4 q[DV], float w[CHANNELS]) {
+uint list_other_blocks(uint local_query, uvec2 items0, uint upper, vec4 q[DV], float w[CHANNELS]) {
+  // Round 0's blocks (at most kSeedBlocks), kNone where fewer.
+  uint seed_blocks[kSeedBlocks];
+  [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) {
+    seed_blocks[j] = j < items0.y ? work_items[items0.x + j].y : kNone;
+  }
   const uint key_base = local_query * pc.cluster_count;
   const uint row = local_query * pc.block_count;
   uint tail = pc.block_count;
@@ -65,7 +70,9 @@ uint list_other_blocks(uint local_query, uvec2 seed_blocks, uint upper, vec4 q[D
   uint end = 0u;
   while (b < end || tail < pc.block_count) {
     if (b < end) {
-      const uint key = b == seed_blocks.x || b == seed_blocks.y ? kSkip : block_key(b, q, w);
+      bool scanned = false;
+      [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) scanned = scanned || b == seed_blocks[j];
+      const uint key = scanned ? kSkip : block_key(b, q, w);
       if (key != kSkip && key <= upper) {
         listed[row + count] = b;
         ++count;
@@ -101,7 +108,7 @@ void main() {
     vec4 q[DV];
     float w[CHANNELS];
     load_query(query, q, w);
-    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.seed_blocks, upper, q, w));
+    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.items0, upper, q, w));
     return;
   }
 

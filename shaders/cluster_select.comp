@@ -8,12 +8,14 @@
 //    continuing_bias), which the cluster scans skip, as ClusterSearch seeds it;
 //  - picks the seed: the eligible cluster of least (centroid distance, id),
 //    ClusterSearch's seed_nearest (the least bound was a worse seed: many
-//    clusters whose box holds the query tie at 0), and the next one; lists
-//    for scan round 0 the two blocks of least bound among theirs (with
-//    k = 1 and a continuing frame, of those whose bound is <= its cost).
-//    Their best gives round 1's upper bound: all the seed cluster's blocks
-//    (15 a query, 256 rows each) gave a bound little better, and their rows
-//    were a quarter of those visited (Bandai volume set, transition).
+//    clusters whose box holds the query tie at 0), and the next nearest
+//    (kSeedClusters in all); lists for scan round 0 the kSeedBlocks (4)
+//    blocks of least bound among theirs (with k = 1 and a continuing
+//    frame, of those whose bound is <= its cost). Their best gives round
+//    1's upper bound. Scanning every block of the nearest clusters (about
+//    15 a query for the nearest) cost more rows than its tighter bound
+//    saved: on the Bandai volume set (transition) every block of the two
+//    nearest visited 5.45% of the rows, their 2 least blocks 4.38%.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -24,28 +26,43 @@
 #include "cluster_bound.glsl"
 #include "cluster_blocks.glsl"
 
-// Of the blocks of clusters a and b (b may be kNone), the two of least
-// (bound key, block) whose key is <= upper, kNone where there are fewer.
-// At most the two clusters' block count iterations.
-uvec2 least_blocks(uint a, uint b, uint upper, vec4 q[DV], float w[CHANNELS]) {
-  const uint a_first = texelFetch(cluster_info, int(a * 3u)).w;
-  const uint a_blocks = texelFetch(cluster_info, int(a * 3u + 2u)).z - a_first;
-  const uint b_first = b == kNone ? 0u : texelFetch(cluster_info, int(b * 3u)).w;
-  const uint b_blocks = b == kNone ? 0u : texelFetch(cluster_info, int(b * 3u + 2u)).z - b_first;
-  uvec2 keys = uvec2(kSkip, kSkip);
-  uvec2 blocks = uvec2(kNone, kNone);
-  for (uint i = 0u; i < a_blocks + b_blocks; ++i) {
-    const uint block = i < a_blocks ? a_first + i : b_first + (i - a_blocks);
-    const uint key = block_key(block, q, w);
-    if (key == kSkip || key > upper) continue;
-    const bool first = blocks.x == kNone || key < keys.x || (key == keys.x && block < blocks.x);
-    const bool second = !first && (blocks.y == kNone || key < keys.y || (key == keys.y && block < blocks.y));
-    keys.y = first ? keys.x : second ? key : keys.y;
-    blocks.y = first ? blocks.x : second ? block : blocks.y;
-    keys.x = first ? key : keys.x;
-    blocks.x = first ? block : blocks.x;
+// Of the blocks of the seed clusters (kNone past the last), the
+// kSeedBlocks of least (bound key, block) whose key is <= upper, listed in
+// the query's row of `listed`; returns how many. At most the seed clusters'
+// block count iterations.
+uint least_blocks(uint local_query, uint seeds[kSeedClusters], uint upper, vec4 q[DV], float w[CHANNELS]) {
+  uint keys[kSeedBlocks];
+  uint blocks[kSeedBlocks];
+  [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) {
+    keys[j] = kSkip;
+    blocks[j] = kNone;
   }
-  return blocks;
+  [[unroll]] for (uint s = 0u; s < kSeedClusters; ++s) {
+    const uint first = seeds[s] == kNone ? 0u : texelFetch(cluster_info, int(seeds[s] * 3u)).w;
+    const uint end = seeds[s] == kNone ? 0u : texelFetch(cluster_info, int(seeds[s] * 3u + 2u)).z;
+    for (uint b = first; b < end; ++b) {
+      uint block = b;
+      uint key = block_key(block, q, w);
+      if (key == kSkip || key > upper) continue;
+      // Insertion into the sorted list, branch-free: each place keeps the
+      // lesser of its pair and the carried one, and carries the other.
+      [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) {
+        const bool less = blocks[j] == kNone || key < keys[j] || (key == keys[j] && block < blocks[j]);
+        const uint carried_key = less ? keys[j] : key;
+        const uint carried_block = less ? blocks[j] : block;
+        keys[j] = less ? key : keys[j];
+        blocks[j] = less ? block : blocks[j];
+        key = carried_key;
+        block = carried_block;
+      }
+    }
+  }
+  const uint row = local_query * pc.block_count;
+  uint count = 0u;
+  [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) {
+    if (blocks[j] != kNone) listed[row + count++] = blocks[j];
+  }
+  return count;
 }
 
 void main() {
@@ -88,39 +105,41 @@ void main() {
     }
   }
 
-  // The two eligible clusters of least (centroid distance, id).
-  uint seed = kNone;
-  uint seed_distance = kSkip;
-  uint seed2 = kNone;
-  uint seed2_distance = kSkip;
+  // The kSeedClusters eligible clusters of least (centroid distance, id),
+  // the first the seed; kNone past the eligible ones.
+  uint seeds[kSeedClusters];
+  uint seed_distances[kSeedClusters];
+  [[unroll]] for (uint j = 0u; j < kSeedClusters; ++j) {
+    seeds[j] = kNone;
+    seed_distances[j] = kSkip;
+  }
   for (uint c = 0u; c < clusters; ++c) {
     const uvec2 keys = bound_keys[base + c];
-    const bool eligible = keys.x != kSkip;
-    const bool first = eligible && (seed == kNone || keys.y < seed_distance);
-    const bool second = eligible && !first && (seed2 == kNone || keys.y < seed2_distance);
-    seed2_distance = first ? seed_distance : second ? keys.y : seed2_distance;
-    seed2 = first ? seed : second ? c : seed2;
-    seed_distance = first ? keys.y : seed_distance;
-    seed = first ? c : seed;
+    if (keys.x == kSkip) continue;
+    uint cluster = c;
+    uint distance = keys.y;
+    // Insertion as in least_blocks; ascending ids keep the lower one first on ties.
+    [[unroll]] for (uint j = 0u; j < kSeedClusters; ++j) {
+      const bool less = seeds[j] == kNone || distance < seed_distances[j];
+      const uint carried_distance = less ? seed_distances[j] : distance;
+      const uint carried_cluster = less ? seeds[j] : cluster;
+      seed_distances[j] = less ? distance : seed_distances[j];
+      seeds[j] = less ? cluster : seeds[j];
+      distance = carried_distance;
+      cluster = carried_cluster;
+    }
   }
 
   const uvec2 continuing = continuing_pair(query);
   uvec2 items = uvec2(0u, 0u);
-  uvec2 seed_blocks = uvec2(kNone, kNone);
-  if (seed != kNone) {
+  if (seeds[0] != kNone) {
     vec4 q[DV];
     float w[CHANNELS];
     load_query(query, q, w);
     const uint upper = pc.k == 1u && continuing.y != kNone ? continuing.x : kSkip;
-    seed_blocks = least_blocks(seed, seed2, upper, q, w);
-    const uint row = local_query * pc.block_count;
-    uint count = 0u;
-    if (seed_blocks.x != kNone) listed[row + count++] = seed_blocks.x;
-    if (seed_blocks.y != kNone) listed[row + count++] = seed_blocks.y;
-    items = move_listed(0u, local_query, count);
+    items = move_listed(0u, local_query, least_blocks(local_query, seeds, upper, q, w));
   }
-  states[query].seed = seed;
-  states[query].seed_blocks = seed_blocks;
+  states[query].seed = seeds[0];
   states[query].continuing_pair = continuing;
   states[query].items0 = items;
 }

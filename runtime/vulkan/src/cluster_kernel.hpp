@@ -6,8 +6,8 @@
 //   cluster_bounds  (cluster, query): lower bound key per cluster, kSkip for
 //                   clusters without candidates; centroid distance (nprobe)
 //   cluster_select  (query): nprobe selection, the continuing frame's
-//                   pair, the two blocks of least bound among the blocks
-//                   of the two nearest clusters (by centroid)
+//                   pair, the 4 blocks of least bound among the blocks
+//                   of the 2 nearest clusters (by centroid)
 //   cluster_sort    per round, 3 steps: the listed work items sorted by
 //                   block (a counting sort), tiles of up to scan_tile(K)
 //                   items of one block

@@ -37,7 +37,7 @@ struct ClusterQueryState {
   std::uint32_t continuing_pair[2];  // (key, frame) of the continuing frame
   std::uint32_t items0[2];           // (first work item, count) of scan round 0
   std::uint32_t items1[2];           // the same for round 1
-  std::uint32_t seed_blocks[2];      // the blocks scan round 0 evaluated, kNoFrame where fewer
+  std::uint32_t pad1[2];
 };
 static_assert(sizeof(ClusterQueryState) == 48);
 static_assert(offsetof(ClusterQueryState, rows) == 8);

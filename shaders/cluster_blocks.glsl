@@ -45,19 +45,4 @@ uint block_key(uint b, vec4 q[DV], float w[CHANNELS]) {
   return bound_key(box_total(q, w, lo, hi), texelFetch(block_info, int(b * 2u + 1u)).xy);
 }
 
-// Lists, in the query's row of `listed`, the blocks [first, end) whose
-// bound key is <= upper (strictly greater cannot win; equal may still win
-// on a lower frame id); returns how many.
-uint list_blocks(uint local_query, uint first, uint end, uint upper, uint count, vec4 q[DV], float w[CHANNELS]) {
-  const uint row = local_query * pc.block_count;
-  for (uint b = first; b < end; ++b) {
-    const uint key = block_key(b, q, w);
-    if (key != kSkip && key <= upper) {
-      listed[row + count] = b;
-      ++count;
-    }
-  }
-  return count;
-}
-
 #endif

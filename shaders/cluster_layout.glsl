@@ -23,6 +23,14 @@ const uint kItemsPerScanGroup = 64u;
 // kClustersPerBoundsInvocation): the host dispatches
 // ceil(clusters / (kItemsPerScanGroup x this)) workgroups per query.
 const uint kClustersPerBoundsInvocation = 8u;
+// Blocks scan round 0 evaluates per query (cluster_select): those of least
+// bound among the blocks of the kSeedClusters nearest clusters. Bandai
+// volume set, transition: 2 blocks of 2 clusters visited 4.38% of the
+// rows, 4 blocks 4.14%, 8 blocks 4.14%; 4 blocks of 3 or 4 clusters 3.91%
+// and 3.82% but took as long (cluster_select ranks more blocks).
+const uint kSeedBlocks = 4u;
+// Nearest clusters (by centroid) whose blocks cluster_select ranks.
+const uint kSeedClusters = 2u;
 // Most workgroups of an indirect cluster dispatch (Vulkan's minimum of
 // maxComputeWorkGroupCount[0], cluster_layout.hpp: kMaxIndirectGroups);
 // past it, invocations take several items (a grid-stride loop), so a
@@ -36,7 +44,7 @@ layout(push_constant) uniform ClusterPush {
   uint query_base;     // first query of this chunk in the query buffers
   uint query_count;    // queries in this chunk
   uint k;              // the search's k (<= K)
-  uint round;          // 0: the seed cluster, 1: every other cluster that can win
+  uint round;          // 0: cluster_select's blocks, 1: every other block that can win
   uint cluster_count;
   uint block_count;    // member blocks over all clusters
   uint nprobe;         // 0: exact; else clusters probed per query (< cluster_count)
@@ -45,8 +53,8 @@ layout(push_constant) uniform ClusterPush {
 
 // cluster_layout.hpp: ClusterQueryState (48 bytes, std430).
 struct ClusterQueryState {
-  uint seed;              // cluster evaluated first (nearest centroid), kNone if none
-  uint upper_key;         // orderable key of the k-th best after the seed, kSkip if fewer than k
+  uint seed;              // nearest eligible cluster (centroid), kNone if none
+  uint upper_key;         // orderable key of the k-th best after round 0, kSkip if fewer than k
   uint rows;              // rows evaluated (statistics)
   uint pad0;
   uvec2 continuing_pair;  // (key, frame) of the continuing frame, (kNone, kNone) when not a candidate

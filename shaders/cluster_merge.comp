@@ -1,10 +1,10 @@
 // Cluster search, pass 4 (twice per chunk): one invocation per query merges
 // the continuing frame's pair and the per-lane best pairs of its work items
 // into the query's best K, in the strict (cost, frame) order.
-//  round 0: the seed cluster's items; the k-th best key is the upper bound
+//  round 0: cluster_select's items; the k-th best key is the upper bound
 //           of round 1 (kSkip while fewer than k were found); lists, of the
-//           other clusters whose bound key is <= it, the blocks whose own
-//           bound key is <= it (block-level culling: a block's box is much
+//           clusters whose bound key is <= it, the blocks not scanned in
+//           round 0 whose own bound key is <= it (block-level culling: a block's box is much
 //           tighter than its cluster's) for scan round 1.
 //  round 1: the items of both rounds; writes the results and the number of
 //           rows evaluated.
@@ -34,8 +34,9 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 }
 
 // Lists, in the query's row of `listed`, the blocks whose bound key is <=
-// upper of the other clusters whose bound key is <= upper (list_blocks'
-// rule); returns how many. Two loops: the clusters that can win go to the
+// upper (strictly greater cannot win; equal may still win on a lower frame
+// id) of the clusters whose bound key is <= upper, except round 0's
+// (items0); returns how many. Two loops: the clusters that can win go to the
 // row's tail (the i-th at block_count - 1 - i), then one flat loop takes
 // them from the last and tests their blocks, each iteration either moving
 // to the next cluster or testing one block. The lanes of a SIMD group
@@ -44,18 +45,22 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 // over their blocks ran the union of the lanes' blocks (the largest cost of
 // small blocks on lavapipe). Blocks are listed at the row's front: before
 // the m-th cluster taken is tested, at most (its blocks and the earlier
-// ones') <= block_count - (clusters left) - (seed's blocks) entries are
-// written, so the front never reaches a tail entry still to be read. The
+// ones') <= block_count - (clusters left) entries are written, so the front never reaches a tail entry still to be read. The
 // order of the items does not change the results (the merges insert pairs
 // in a strict total order). At most cluster_count, then cluster_count +
 // block_count iterations.
-uint list_other_blocks(uint local_query, uint seed, uint upper, vec4 q[DV], float w[CHANNELS]) {
+uint list_other_blocks(uint local_query, uvec2 items0, uint upper, vec4 q[DV], float w[CHANNELS]) {
+  // Round 0's blocks (at most kSeedBlocks), kNone where fewer.
+  uint seed_blocks[kSeedBlocks];
+  [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) {
+    seed_blocks[j] = j < items0.y ? work_items[items0.x + j].y : kNone;
+  }
   const uint key_base = local_query * pc.cluster_count;
   const uint row = local_query * pc.block_count;
   uint tail = pc.block_count;
   for (uint c = 0u; c < pc.cluster_count; ++c) {
     const uint key = bound_keys[key_base + c].x;
-    if (c != seed && key != kSkip && key <= upper) {
+    if (key != kSkip && key <= upper) {
       --tail;
       listed[row + tail] = c;
     }
@@ -65,7 +70,9 @@ uint list_other_blocks(uint local_query, uint seed, uint upper, vec4 q[DV], floa
   uint end = 0u;
   while (b < end || tail < pc.block_count) {
     if (b < end) {
-      const uint key = block_key(b, q, w);
+      bool scanned = false;
+      [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) scanned = scanned || b == seed_blocks[j];
+      const uint key = scanned ? kSkip : block_key(b, q, w);
       if (key != kSkip && key <= upper) {
         listed[row + count] = b;
         ++count;
@@ -101,7 +108,7 @@ void main() {
     vec4 q[DV];
     float w[CHANNELS];
     load_query(query, q, w);
-    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.seed, upper, q, w));
+    states[query].items1 = move_listed(1u, local_query, list_other_blocks(local_query, state.items0, upper, q, w));
     return;
   }
 

@@ -8,7 +8,7 @@
 // (query, block) was gather-bound (about 7M rows/s on lavapipe). Lanes of a
 // SIMD group work on different blocks (splitting a block over 8 lanes and
 // merging through shared memory was 1.35x slower on lavapipe).
-//  round 0: the seed cluster's blocks (listed by cluster_select);
+//  round 0: the kSeedBlocks blocks listed by cluster_select;
 //  round 1: the blocks, of every other cluster, whose bound key is <= the
 //           k-th best key after round 0 (listed by cluster_merge round 0).
 // Rows are read in cluster order (member_rows: a block's rows are

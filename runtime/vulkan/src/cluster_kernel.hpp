@@ -5,20 +5,22 @@
 // Per chunk of queries, twelve dispatches (eight indirect):
 //   cluster_bounds  (cluster, query): lower bound key per cluster, kSkip for
 //                   clusters without candidates; centroid distance (nprobe)
-//   cluster_select  (query): nprobe selection, the seed cluster (least
-//                   bound), the continuing frame's pair
+//   cluster_select  (query): nprobe selection, the continuing frame's
+//                   pair, the 4 blocks of least bound among the blocks
+//                   of the 2 nearest clusters (by centroid)
 //   cluster_sort    per round, 3 steps: the listed work items sorted by
 //                   block (a counting sort), tiles of up to scan_tile(K)
 //                   items of one block
-//   cluster_scan    round 0 (one invocation per tile, indirect): the seed
-//                   cluster's blocks (listed by cluster_select)
+//   cluster_scan    round 0 (one invocation per tile, indirect): those
+//                   blocks (listed by cluster_select)
 //   cluster_merge   round 0 (query): the k-th best so far = upper bound;
-//                   lists the blocks of clusters with bound <= upper bound
+//                   lists the other blocks with bound <= upper bound, of
+//                   the clusters with bound <= upper bound
 //   cluster_scan    round 1: the listed blocks
 //   cluster_merge   round 1: final best K, rows evaluated
-// Exactness: the seed's k-th best is >= the true k-th best, and a cluster
-// whose bound is strictly above it holds no member that can enter the best
-// k (ClusterSearch's argument, mmvk/cluster_search.hpp); the rows are
+// Exactness: round 0's k-th best is >= the true k-th best, and a cluster
+// or block whose bound is strictly above it holds no member that can enter
+// the best k (ClusterSearch's argument, mmvk/cluster_search.hpp); the rows are
 // evaluated with the brute-force arithmetic, so costs are the reference's.
 #pragma once
 

@@ -56,6 +56,16 @@ layout(constant_id = 3) const uint T = 1;  // queries per tile
 // last query (their results are not written).
 uint query_index(uint local) { return pc.query_base + min(local, pc.query_count - 1u); }
 
+// Query p's tag rules as one test per tag word w < TAG_WORDS: a row passes
+// when (row tags & mask) == wanted, with mask = require | exclude and
+// wanted = require. rejects_all: no row can pass (a tag both required and
+// excluded, or required in a word no frame uses).
+uvec4 tag_rule(QueryGpu p, out bool rejects_all) {
+  rejects_all = (p.require_lo & p.exclude_lo) != 0u || (p.require_hi & p.exclude_hi) != 0u ||
+                (TAG_WORDS < 1u && p.require_lo != 0u) || (TAG_WORDS < 2u && p.require_hi != 0u);
+  return uvec4(p.require_lo | p.exclude_lo, p.require_hi | p.exclude_hi, p.require_lo, p.require_hi);
+}
+
 void main() {
   const uint lane = gl_LocalInvocationID.x;
   const uint block = gl_WorkGroupID.y * gl_WorkGroupSize.x + lane;
@@ -66,8 +76,8 @@ void main() {
   float w[T][CHANNELS];
   // In registers: reading a storage buffer inside the row loop made the
   // kernel 2x slower on lavapipe.
-  uvec4 tags[T];     // (require lo, require hi, exclude lo, exclude hi)
-  uvec4 skipped[T];  // skipped_ranges()
+  uvec4 tags[T];     // tag_rule(): (mask lo, mask hi, wanted lo, wanted hi)
+  uvec4 skipped[T];  // skipped_ranges(), or every row when tag_rule() rejects all
   // K = 1: the running best; a frame of kNone is an empty slot.
   float best_cost[T];
   uint best_frame[T];
@@ -79,8 +89,10 @@ void main() {
     const uint query = query_index(tile_first + t);
     load_query(query, q[t], w[t]);
     const QueryGpu p = query_params[query];
-    tags[t] = uvec4(p.require_lo, p.require_hi, p.exclude_lo, p.exclude_hi);
-    skipped[t] = skipped_ranges(p);
+    bool rejects_all;
+    tags[t] = tag_rule(p, rejects_all);
+    // Row r is skipped when r - 0 <= kNone: every row.
+    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : skipped_ranges(p);
     best_cost[t] = kInfinity;
     best_frame[t] = kNone;
     clear_pairs(best[t]);
@@ -103,14 +115,20 @@ void main() {
 
     [[unroll]] for (uint t = 0; t < T; ++t) {
       const float cost = row_cost(x, q[t], w[t], scale_bias);
-      // The candidate rules as integer operations, no short-circuit branch.
-      const uint tag_bits = ((terms.x & tags[t].x) ^ tags[t].x) | ((terms.y & tags[t].y) ^ tags[t].y) |
-                            (terms.x & tags[t].z) | (terms.y & tags[t].w);
-      const bool rejected = tag_bits != 0u || r - skipped[t].x <= skipped[t].y || r - skipped[t].z <= skipped[t].w;
+      // The candidate rules as integer operations. Every operand of || and
+      // && is a named bool: glslang compiles a short-circuit operator whose
+      // right side is an expression into a branch.
+      const bool tag_rejected_lo = TAG_WORDS >= 1u && (terms.x & tags[t].x) != tags[t].z;
+      const bool tag_rejected_hi = TAG_WORDS >= 2u && (terms.y & tags[t].y) != tags[t].w;
+      const bool skipped_a = r - skipped[t].x <= skipped[t].y;
+      const bool skipped_b = r - skipped[t].z <= skipped[t].w;
+      const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b;
       if (K == 1u) {
-        const bool better = !rejected && cost <= best_cost[t];
-        best_cost[t] = better ? cost : best_cost[t];
-        best_frame[t] = better ? r : best_frame[t];
+        const bool cheaper = cost <= best_cost[t];
+        const bool better = !rejected && cheaper;
+        // mix() with a bool is OpSelect; `?:` on an array element is a branch.
+        best_cost[t] = mix(best_cost[t], cost, better);
+        best_frame[t] = mix(best_frame[t], r, better);
       } else if (!rejected && !(cost > worst[t])) {
         // Rare once good rows were seen (but lavapipe masks, not skips, it).
         insert_row(best[t], worst[t], cost, r);

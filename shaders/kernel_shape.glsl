@@ -16,5 +16,8 @@ layout(constant_id = 6) const uint END_MASK_0 = 0u;
 layout(constant_id = 7) const uint END_MASK_1 = 0u;
 layout(constant_id = 8) const uint END_MASK_2 = 0u;
 layout(constant_id = 9) const uint END_MASK_3 = 0u;
+// 32-bit words of the tag masks that any frame uses: 0 (no frame has a tag),
+// 1 (only tags 0-31) or 2. The brute-force scan tests only those words.
+layout(constant_id = 12) const uint TAG_WORDS = 2;
 
 #endif

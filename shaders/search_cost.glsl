@@ -33,19 +33,29 @@ bool frame_is_candidate(uint r, uvec4 meta, bool continuing, QueryGpu p) {
   return true;
 }
 
+// Constant-folds once d is a constant, as ends_channel().
+bool starts_channel(uint d) { return d == 0u || ends_channel(d - 1u); }
+
 // mmvk::frame_cost without the continuing bias: per channel a sum of
 // squared differences in dim order from 0, total += w_c * sum in channel
-// order, multiplier * total + bias; `precise` forbids fusing.
+// order, multiplier * total + bias; `precise` forbids fusing. A channel's
+// sum starts at its first square, not at 0 + that square: the same bits (a
+// square is never -0.0; NaN stays NaN) and one addition fewer per channel,
+// which `precise` keeps the compiler from removing. The total keeps its
+// 0 + w_0 x sum: a weight of -0.0 passes validation and would give -0.0.
 float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
   precise float total = 0.0;
   precise float channel_sum = 0.0;
   uint c = 0u;
   [[unroll]] for (uint d = 0; d < DIMS; ++d) {
     precise float diff = x[d >> 2u][d & 3u] - q[d >> 2u][d & 3u];
-    channel_sum = channel_sum + diff * diff;
+    if (starts_channel(d)) {
+      channel_sum = diff * diff;
+    } else {
+      channel_sum = channel_sum + diff * diff;
+    }
     if (ends_channel(d)) {
       total = total + w[c] * channel_sum;
-      channel_sum = 0.0;
       ++c;
     }
   }

@@ -82,7 +82,7 @@ uvec2 continuing_pair(uint query) {
   vec4 x[DV];
   vec4 q[DV];
   float w[CHANNELS];
-  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(frame, v));
+  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(p.continuing_row, v));
   load_query(query, q, w);
   // mmvk::frame_cost's order: (multiplier * total + bias) * continuing_multiplier
   // + continuing_bias, each step rounded (precise: no fused multiply-add).

@@ -106,10 +106,11 @@ TEST(VulkanSetup, AllocatesAndWritesSets) {
 
 // The table is checked in full (validate_cluster_table) even in BruteForce
 // mode, where it goes unused: one check, whatever the mode.
-// Scan rows {1, 2, 5} of 7 frames: the features hold frames 1, 2, 5, then
-// 0, 3, 4, 6; no scan rows (the cluster modes) leave every frame in place.
+// Scan rows {1, 2, 5} of 7 frames (rows_before, scan_rows.hpp): the
+// features hold frames 1, 2, 5, then 0, 3, 4, 6; no table (the cluster
+// modes) leaves every frame in place.
 TEST(VulkanSetup, FeatureRowsPutTheScanRowsFirst) {
-  const std::array<std::uint32_t, 3> scan = {1, 2, 5};
+  const std::array<std::uint32_t, 8> scan = {0, 0, 1, 2, 2, 2, 3, 3};
   const std::array<std::uint32_t, 7> rows = {3, 0, 1, 4, 5, 2, 6};
   for (std::uint32_t f = 0; f < rows.size(); ++f) {
     EXPECT_EQ(feature_row(scan, f), rows[f]) << "frame " << f;
@@ -120,7 +121,7 @@ TEST(VulkanSetup, FeatureRowsPutTheScanRowsFirst) {
 // A query's skipped frames as scan rows (first, last - first), (kNoFrame, 0)
 // when no scan row is among them.
 TEST(VulkanSetup, SkippedFramesBecomeScanRows) {
-  const std::array<std::uint32_t, 4> scan = {1, 2, 5, 6};  // of one 7-frame clip at frame 0
+  const std::array<std::uint32_t, 8> scan = {0, 0, 1, 2, 2, 2, 3, 4};  // rows_before of frames 1, 2, 5, 6 of 7
   using Ranges = std::array<std::uint32_t, 4>;
   QueryGpu p{};
   p.continuing_frame = kNoFrame;

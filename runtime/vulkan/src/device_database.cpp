@@ -67,9 +67,9 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
   const std::size_t frames = device.frame_count;
   const std::size_t padded = std::size_t{device.dim_vec4s} * 4;
 
-  // The brute force's scan rows; the host keeps them to map frames to rows.
-  if (with_scan) device.scan_frame_list = scan_frame_list(database);
-  const std::vector<std::uint32_t>& scan = device.scan_frame_list;
+  // The brute force's scan rows, and the host's map from frames to them.
+  const std::vector<std::uint32_t> scan = with_scan ? scan_frame_list(database) : std::vector<std::uint32_t>{};
+  if (with_scan) device.scan_rows_before = scan_rows_before(database);
 
   // Host copies in the kernels' layouts; creation-time only.
   {
@@ -80,7 +80,7 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
     std::vector<float> features(groups * kRowGroup * padded, 0.0f);
     const std::span<const float> source = database.features();
     for (std::uint32_t f = 0; f < frames; ++f) {
-      const std::uint32_t row = feature_row(scan, f);
+      const std::uint32_t row = feature_row(device.scan_rows_before, f);
       for (std::size_t d = 0; d < device.dims; ++d) {
         features[feature_texel(row, static_cast<std::uint32_t>(d / 4), device.dim_vec4s) * 4 + d % 4] =
             source[std::size_t{f} * device.dims + d];

@@ -54,7 +54,7 @@ struct DeviceDatabase {
   TexelBuffer frame_cost;
   TexelBuffer scan_frames;  // at least one texel, even with no scan rows
   TexelBuffer scan_terms;   // as many texels as scan_frames
-  std::vector<std::uint32_t> scan_frame_list;  // host copy of the scan rows' frames (empty without the scan)
+  std::vector<std::uint32_t> scan_rows_before;  // host: scan_rows.hpp, scan_rows_before(); empty without the scan
 };
 
 // force_staging: copy through a staging buffer even into mappable memory.

@@ -1,6 +1,7 @@
 #include "scan_rows.hpp"
 
 #include <algorithm>
+#include <cstddef>
 
 #include "device_database.hpp"
 #include "mmvk/search.hpp"
@@ -51,25 +52,32 @@ std::vector<std::uint32_t> scan_frame_list(const Database& database) {
   return frames;
 }
 
-std::uint32_t feature_row(std::span<const std::uint32_t> scan_frames, std::uint32_t frame) {
-  const auto at = std::lower_bound(scan_frames.begin(), scan_frames.end(), frame);
-  const auto below = static_cast<std::uint32_t>(at - scan_frames.begin());  // scan rows before the frame
-  if (at != scan_frames.end() && *at == frame) return below;
-  return static_cast<std::uint32_t>(scan_frames.size()) + (frame - below);
+std::vector<std::uint32_t> scan_rows_before(const Database& database) {
+  std::vector<std::uint32_t> before(std::size_t{database.frame_count()} + 1, 0);
+  for (std::uint32_t f = 0; f < database.frame_count(); ++f) {
+    before[f + 1] = before[f] + (scanned_by_brute_force(database.frame_flags()[f]) ? 1 : 0);
+  }
+  return before;
 }
 
-std::array<std::uint32_t, 4> skipped_scan_rows(std::span<const std::uint32_t> scan_frames, const QueryGpu& p) {
+std::uint32_t feature_row(std::span<const std::uint32_t> rows_before, std::uint32_t frame) {
+  if (rows_before.empty()) return frame;
+  const std::uint32_t below = rows_before[frame];
+  if (rows_before[frame + 1] != below) return below;  // a scan row
+  return rows_before.back() + (frame - below);
+}
+
+std::array<std::uint32_t, 4> skipped_scan_rows(std::span<const std::uint32_t> rows_before, const QueryGpu& p) {
   const std::array<std::uint32_t, 4> frames = skipped_frames(p);
   std::array<std::uint32_t, 4> rows = {kNoFrame, 0, kNoFrame, 0};
-  for (std::size_t r = 0; r < 2; ++r) {
+  for (std::size_t r = 0; r < 2 && !rows_before.empty(); ++r) {
     if (frames[2 * r] == kNoFrame) continue;
     // Scan rows [lo, hi) hold the frames [first, first + span].
-    const std::uint64_t last = std::uint64_t{frames[2 * r]} + frames[2 * r + 1];
-    const auto lo = std::lower_bound(scan_frames.begin(), scan_frames.end(), frames[2 * r]);
-    const auto hi = std::upper_bound(lo, scan_frames.end(), last, [](std::uint64_t v, std::uint32_t f) { return v < f; });
+    const std::uint32_t lo = rows_before[frames[2 * r]];
+    const std::uint32_t hi = rows_before[std::size_t{frames[2 * r]} + frames[2 * r + 1] + 1];
     if (lo == hi) continue;
-    rows[2 * r] = static_cast<std::uint32_t>(lo - scan_frames.begin());
-    rows[2 * r + 1] = static_cast<std::uint32_t>(hi - lo) - 1;
+    rows[2 * r] = lo;
+    rows[2 * r + 1] = hi - lo - 1;
   }
   return rows;
 }

@@ -21,14 +21,19 @@ namespace mmvk::vulkan::detail {
 // The frames the brute-force scan visits, ascending.
 std::vector<std::uint32_t> scan_frame_list(const Database& database);
 
-// The feature-matrix row of `frame` when the scan rows come first:
-// its scan row, or scan_frames.size() + its rank among the other frames.
-// With no scan rows (the cluster modes upload none) it is the frame itself.
-std::uint32_t feature_row(std::span<const std::uint32_t> scan_frames, std::uint32_t frame);
+// rows_before[f]: the scan rows whose frame is below f, for f in
+// [0, frames] (frames + 1 entries; the last is the scan's row count): the
+// host's O(1) map from frames to scan rows, for every query of every batch.
+std::vector<std::uint32_t> scan_rows_before(const Database& database);
+
+// The feature-matrix row of `frame` when the scan rows come first: its scan
+// row, or the scan's row count + its rank among the other frames. With an
+// empty table (the cluster modes, which upload no scan) it is the frame.
+std::uint32_t feature_row(std::span<const std::uint32_t> rows_before, std::uint32_t frame);
 
 // The two frame ranges the scan skips for query p (the continuing frame and
 // its exclusion window; search_cost.glsl: skipped_ranges(), the same rule),
-// as scan-row ranges: (first, last - first) each, (kNone, 0) when empty.
-std::array<std::uint32_t, 4> skipped_scan_rows(std::span<const std::uint32_t> scan_frames, const QueryGpu& p);
+// as scan-row ranges: (first, last - first) each, (kNoFrame, 0) when empty.
+std::array<std::uint32_t, 4> skipped_scan_rows(std::span<const std::uint32_t> rows_before, const QueryGpu& p);
 
 }  // namespace mmvk::vulkan::detail

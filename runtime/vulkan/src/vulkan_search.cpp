@@ -424,7 +424,7 @@ void VulkanSearch::Impl::stage_queries(Slot& slot, const QueryBatch& batch) {
     }
     gpu.continuing_bias = p.continuing_bias;
     gpu.continuing_multiplier = p.continuing_multiplier;
-    const std::span<const std::uint32_t> scan = device_database.scan_frame_list;
+    const std::span<const std::uint32_t> scan = device_database.scan_rows_before;
     gpu.continuing_row = p.continuing_frame == kNoFrame ? kNoFrame : feature_row(scan, p.continuing_frame);
     const std::array<std::uint32_t, 4> skipped = skipped_scan_rows(scan, gpu);
     gpu.skip_first_a = skipped[0];

@@ -116,13 +116,16 @@ void main() {
   for (uint j = steps; j > 0u;) {
     --j;
     const uint row = first + j * step;
-    const uvec4 terms = texelFetch(scan_terms, int(row));  // (tags lo, tags hi, multiplier, bias)
+    // (tags lo, tags hi, multiplier, bias), not read when no tag and no
+    // cost term can matter (a database without tags, multipliers or biases).
+    uvec4 terms = uvec4(0u);
+    if (TAG_WORDS != 0u || UNIT_COST_TERMS == 0u) terms = texelFetch(scan_terms, int(row));
     const vec2 scale_bias = uintBitsToFloat(terms.zw);
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(row, v));
 
     [[unroll]] for (uint t = 0; t < T; ++t) {
-      const float cost = row_cost(x, q[t], w[t], scale_bias);
+      const float cost = UNIT_COST_TERMS != 0u ? row_total(x, q[t], w[t]) : row_cost(x, q[t], w[t], scale_bias);
       // The candidate rules as integer operations. Every operand of || and
       // && is a named bool: glslang compiles a short-circuit operator whose
       // right side is an expression into a branch.

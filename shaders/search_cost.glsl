@@ -43,7 +43,8 @@ bool starts_channel(uint d) { return d == 0u || ends_channel(d - 1u); }
 // square is never -0.0; NaN stays NaN) and one addition fewer per channel,
 // which `precise` keeps the compiler from removing. The total keeps its
 // 0 + w_0 x sum: a weight of -0.0 passes validation and would give -0.0.
-float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
+// row_total() is the weighted sum, row_cost() the whole cost.
+float row_total(vec4 x[DV], vec4 q[DV], float w[CHANNELS]) {
   precise float total = 0.0;
   precise float channel_sum = 0.0;
   uint c = 0u;
@@ -59,7 +60,11 @@ float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
       ++c;
     }
   }
-  precise float cost = scale_bias.x * total + scale_bias.y;
+  return total;
+}
+
+float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
+  precise float cost = scale_bias.x * row_total(x, q, w) + scale_bias.y;
   return cost;
 }
 

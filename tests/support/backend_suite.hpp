@@ -179,14 +179,23 @@ TYPED_TEST_P(BackendSuite, TagMasks) {
 
 // Tags in either 32-bit word, or on no frame at all (the Vulkan scan tests
 // only the words some frame uses), with rules no row can pass: a tag both
-// required and excluded, a required tag no frame holds in either word.
+// required and excluded, a required tag no frame holds in either word. Once
+// with every cost multiplier 1 and bias 0 (the Vulkan scan then skips the
+// cost terms).
 TYPED_TEST_P(BackendSuite, TagsInEitherWordOrNone) {
-  for (const int shift : {-1, 30, 32}) {  // -1: no frame is tagged
-    SCOPED_TRACE("tag shift " + std::to_string(shift));
+  const std::pair<int, bool> cases[] = {{-1, false}, {30, false}, {32, false}, {30, true}};  // -1: no frame is tagged
+  for (const auto& [shift, unit_terms] : cases) {
+    SCOPED_TRACE("tag shift " + std::to_string(shift) + (unit_terms ? ", unit cost terms" : ""));
     DatabaseParts parts = synthetic_parts({.frames = 2000, .seed = 45, .constraints = true});
     parts.tag_names.clear();
     for (int t = 0; t < 64; ++t) parts.tag_names.push_back("tag" + std::to_string(t));
-    for (Clip& clip : parts.clips) clip.tags = shift < 0 ? 0 : clip.tags << shift;
+    for (Clip& clip : parts.clips) {
+      clip.tags = shift < 0 ? 0 : clip.tags << shift;
+      if (unit_terms) {
+        clip.cost_multiplier = 1.0f;
+        clip.cost_bias = 0.0f;
+      }
+    }
     const Database db = make_database(std::move(parts));
     const int s = std::max(shift, 0);
     const TagMask walk = kTagWalk << s, run = kTagRun << s, idle = kTagIdle << s;

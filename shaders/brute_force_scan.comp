@@ -34,10 +34,15 @@
 // - Per-row flags exclude a row for every query alike, so the scan visits
 //   only the frames of scan_frames, the rows no flag excludes (11% fewer on
 //   the Bandai volume set), as the CPU tile store does.
+// - In this mode the feature matrix holds those rows first, in scan order
+//   (runtime/vulkan/src/scan_rows.hpp): the loop reads row j's features and
+//   terms at j and never fetches its frame (that fetch, and the features'
+//   wait for it, were 10% of the time); a block looks up the frames of
+//   only the rows it keeps, at its end.
 // - The exclusion window is at most two row ranges per query (a looping
-//   clip wraps), computed once per invocation.
-// - Rows are scanned in descending order, so `cost <= best` keeps the
-//   lowest frame among equal costs (the reference's order), accepts an
+//   clip wraps), mapped to scan rows by the host (QueryGpu).
+// - Rows are scanned in descending order (their frames ascend with them),
+//   so `cost <= best` keeps the lowest frame among equal costs (the reference's order), accepts an
 //   infinite cost into an empty slot and rejects NaN, in one comparison.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -56,6 +61,19 @@ layout(constant_id = 3) const uint T = 1;  // queries per tile
 // last query (their results are not written).
 uint query_index(uint local) { return pc.query_base + min(local, pc.query_count - 1u); }
 
+// Query p's tag rules as one test per tag word w < TAG_WORDS: a row passes
+// when (row tags & mask) == wanted, with mask = require | exclude and
+// wanted = require. rejects_all: no row can pass (a tag both required and
+// excluded, or required in a word no frame uses).
+uvec4 tag_rule(QueryGpu p, out bool rejects_all) {
+  rejects_all = (p.require_lo & p.exclude_lo) != 0u || (p.require_hi & p.exclude_hi) != 0u ||
+                (TAG_WORDS < 1u && p.require_lo != 0u) || (TAG_WORDS < 2u && p.require_hi != 0u);
+  return uvec4(p.require_lo | p.exclude_lo, p.require_hi | p.exclude_hi, p.require_lo, p.require_hi);
+}
+
+// The frame of scan row `row`.
+uint frame_of_row(uint row) { return texelFetch(scan_frames, int(row)).x; }
+
 void main() {
   const uint lane = gl_LocalInvocationID.x;
   const uint block = gl_WorkGroupID.y * gl_WorkGroupSize.x + lane;
@@ -66,23 +84,26 @@ void main() {
   float w[T][CHANNELS];
   // In registers: reading a storage buffer inside the row loop made the
   // kernel 2x slower on lavapipe.
-  uvec4 tags[T];     // (require lo, require hi, exclude lo, exclude hi)
-  uvec4 skipped[T];  // skipped_ranges()
-  // K = 1: the running best; a frame of kNone is an empty slot.
+  uvec4 tags[T];     // tag_rule(): (mask lo, mask hi, wanted lo, wanted hi)
+  uvec4 skipped[T];  // QueryGpu's skipped scan rows, or every row when tag_rule() rejects all
+  // K = 1: the running best; a row of kNone is an empty slot.
   float best_cost[T];
-  uint best_frame[T];
-  // K > 1: the best K as (orderable cost bits, frame), sorted, and the cost
-  // of the last one (+inf while it is empty).
+  uint best_row[T];
+  // K > 1: the best K as (orderable cost bits, scan row), sorted, and the
+  // cost of the last one (+inf while it is empty). Scan rows ascend with
+  // their frames, so the order is the frames' order.
   uvec2 best[T][K];
   float worst[T];
   [[unroll]] for (uint t = 0; t < T; ++t) {
     const uint query = query_index(tile_first + t);
     load_query(query, q[t], w[t]);
     const QueryGpu p = query_params[query];
-    tags[t] = uvec4(p.require_lo, p.require_hi, p.exclude_lo, p.exclude_hi);
-    skipped[t] = skipped_ranges(p);
+    bool rejects_all;
+    tags[t] = tag_rule(p, rejects_all);
+    // Row r is skipped when r - 0 <= kNone: every row.
+    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : uvec4(p.skip_first_a, p.skip_span_a, p.skip_first_b, p.skip_span_b);
     best_cost[t] = kInfinity;
-    best_frame[t] = kNone;
+    best_row[t] = kNone;
     clear_pairs(best[t]);
     worst[t] = kInfinity;
   }
@@ -95,25 +116,33 @@ void main() {
   for (uint j = steps; j > 0u;) {
     --j;
     const uint row = first + j * step;
-    const uint r = texelFetch(scan_frames, int(row)).x;
-    const uvec4 terms = texelFetch(scan_terms, int(row));  // (tags lo, tags hi, multiplier, bias)
+    // (tags lo, tags hi, multiplier, bias), not read when no tag and no
+    // cost term can matter (a database without tags, multipliers or biases).
+    uvec4 terms = uvec4(0u);
+    if (TAG_WORDS != 0u || UNIT_COST_TERMS == 0u) terms = texelFetch(scan_terms, int(row));
     const vec2 scale_bias = uintBitsToFloat(terms.zw);
     vec4 x[DV];
-    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(r, v));
+    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(row, v));
 
     [[unroll]] for (uint t = 0; t < T; ++t) {
-      const float cost = row_cost(x, q[t], w[t], scale_bias);
-      // The candidate rules as integer operations, no short-circuit branch.
-      const uint tag_bits = ((terms.x & tags[t].x) ^ tags[t].x) | ((terms.y & tags[t].y) ^ tags[t].y) |
-                            (terms.x & tags[t].z) | (terms.y & tags[t].w);
-      const bool rejected = tag_bits != 0u || r - skipped[t].x <= skipped[t].y || r - skipped[t].z <= skipped[t].w;
+      const float cost = UNIT_COST_TERMS != 0u ? row_total(x, q[t], w[t]) : row_cost(x, q[t], w[t], scale_bias);
+      // The candidate rules as integer operations. Every operand of || and
+      // && is a named bool: glslang compiles a short-circuit operator whose
+      // right side is an expression into a branch.
+      const bool tag_rejected_lo = TAG_WORDS >= 1u && (terms.x & tags[t].x) != tags[t].z;
+      const bool tag_rejected_hi = TAG_WORDS >= 2u && (terms.y & tags[t].y) != tags[t].w;
+      const bool skipped_a = row - skipped[t].x <= skipped[t].y;
+      const bool skipped_b = row - skipped[t].z <= skipped[t].w;
+      const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b;
       if (K == 1u) {
-        const bool better = !rejected && cost <= best_cost[t];
-        best_cost[t] = better ? cost : best_cost[t];
-        best_frame[t] = better ? r : best_frame[t];
+        const bool cheaper = cost <= best_cost[t];
+        const bool better = !rejected && cheaper;
+        // mix() with a bool is OpSelect; `?:` on an array element is a branch.
+        best_cost[t] = mix(best_cost[t], cost, better);
+        best_row[t] = mix(best_row[t], row, better);
       } else if (!rejected && !(cost > worst[t])) {
         // Rare once good rows were seen (but lavapipe masks, not skips, it).
-        insert_row(best[t], worst[t], cost, r);
+        insert_row(best[t], worst[t], cost, row);
       }
     }
   }
@@ -123,9 +152,11 @@ void main() {
     if (local_query >= pc.query_count) break;
     const uint base = (local_query * pc.block_count + block) * K;
     if (K == 1u) {
-      scratch[base] = best_frame[t] == kNone ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost[t]), best_frame[t]);
+      scratch[base] = best_row[t] == kNone ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost[t]), frame_of_row(best_row[t]));
     } else {
-      [[unroll]] for (uint j = 0; j < K; ++j) scratch[base + j] = best[t][j];
+      [[unroll]] for (uint j = 0; j < K; ++j) {
+        scratch[base + j] = best[t][j].y == kNone ? best[t][j] : uvec2(best[t][j].x, frame_of_row(best[t][j].y));
+      }
     }
   }
 }

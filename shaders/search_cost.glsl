@@ -33,23 +33,38 @@ bool frame_is_candidate(uint r, uvec4 meta, bool continuing, QueryGpu p) {
   return true;
 }
 
+// Constant-folds once d is a constant, as ends_channel().
+bool starts_channel(uint d) { return d == 0u || ends_channel(d - 1u); }
+
 // mmvk::frame_cost without the continuing bias: per channel a sum of
 // squared differences in dim order from 0, total += w_c * sum in channel
-// order, multiplier * total + bias; `precise` forbids fusing.
-float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
+// order, multiplier * total + bias; `precise` forbids fusing. A channel's
+// sum starts at its first square, not at 0 + that square: the same bits (a
+// square is never -0.0; NaN stays NaN) and one addition fewer per channel,
+// which `precise` keeps the compiler from removing. The total keeps its
+// 0 + w_0 x sum: a weight of -0.0 passes validation and would give -0.0.
+// row_total() is the weighted sum, row_cost() the whole cost.
+float row_total(vec4 x[DV], vec4 q[DV], float w[CHANNELS]) {
   precise float total = 0.0;
   precise float channel_sum = 0.0;
   uint c = 0u;
   [[unroll]] for (uint d = 0; d < DIMS; ++d) {
     precise float diff = x[d >> 2u][d & 3u] - q[d >> 2u][d & 3u];
-    channel_sum = channel_sum + diff * diff;
+    if (starts_channel(d)) {
+      channel_sum = diff * diff;
+    } else {
+      channel_sum = channel_sum + diff * diff;
+    }
     if (ends_channel(d)) {
       total = total + w[c] * channel_sum;
-      channel_sum = 0.0;
       ++c;
     }
   }
-  precise float cost = scale_bias.x * total + scale_bias.y;
+  return total;
+}
+
+float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
+  precise float cost = scale_bias.x * row_total(x, q, w) + scale_bias.y;
   return cost;
 }
 
@@ -72,7 +87,7 @@ uvec2 continuing_pair(uint query) {
   vec4 x[DV];
   vec4 q[DV];
   float w[CHANNELS];
-  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(frame, v));
+  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(p.continuing_row, v));
   load_query(query, q, w);
   // mmvk::frame_cost's order: (multiplier * total + bias) * continuing_multiplier
   // + continuing_bias, each step rounded (precise: no fused multiply-add).

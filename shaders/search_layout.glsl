@@ -12,7 +12,7 @@ const uint kFrameDoNotUse = 1u;
 const uint kFrameBlockTransition = 2u;
 const uint kFrameEdgeExcluded = 4u;
 
-// search_layout.hpp: QueryGpu (48 bytes, std430).
+// search_layout.hpp: QueryGpu (68 bytes, std430).
 struct QueryGpu {
   uint continuing_frame;   // kNone: no continuing frame
   uint exclusion_window;
@@ -26,6 +26,13 @@ struct QueryGpu {
   uint clip_loop;          // 1 when that clip loops
   float continuing_bias;
   float continuing_multiplier;
+  uint continuing_row;     // the continuing frame's row of `features`
+  // The brute force: the scan rows it skips, (first, last - first) twice,
+  // (kNone, 0) when empty: the continuing frame and its exclusion window.
+  uint skip_first_a;
+  uint skip_span_a;
+  uint skip_first_b;
+  uint skip_span_b;
 };
 
 // search_layout.hpp: SearchPush (32 bytes). Kernels with their own push
@@ -52,7 +59,10 @@ const uint kRowGroup = 8u;
 
 // [ceil(frames / kRowGroup) x dims/4 x kRowGroup] texels: the feature matrix,
 // dims padded to 4 with zeros, rows interleaved (feature_texel()); rows past
-// the last frame are zeros.
+// the last frame are zeros. Row r is frame r, except in brute-force mode:
+// the scan rows first, in scan_frames' order, then the other frames
+// (runtime/vulkan/src/scan_rows.hpp); QueryGpu.continuing_row says where
+// the continuing frame is.
 layout(set = 0, binding = 0) uniform samplerBuffer features;
 // [frames] texels: (flags, tags low 32 bits, tags high 32 bits, clip index).
 layout(set = 0, binding = 1) uniform usamplerBuffer frame_meta;

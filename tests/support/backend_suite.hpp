@@ -177,6 +177,41 @@ TYPED_TEST_P(BackendSuite, TagMasks) {
   }
 }
 
+// Tags in either 32-bit word, or on no frame at all (the Vulkan scan tests
+// only the words some frame uses), with rules no row can pass: a tag both
+// required and excluded, a required tag no frame holds in either word. Once
+// with every cost multiplier 1 and bias 0 (the Vulkan scan then skips the
+// cost terms).
+TYPED_TEST_P(BackendSuite, TagsInEitherWordOrNone) {
+  const std::pair<int, bool> cases[] = {{-1, false}, {30, false}, {32, false}, {30, true}};  // -1: no frame is tagged
+  for (const auto& [shift, unit_terms] : cases) {
+    SCOPED_TRACE("tag shift " + std::to_string(shift) + (unit_terms ? ", unit cost terms" : ""));
+    DatabaseParts parts = synthetic_parts({.frames = 2000, .seed = 45, .constraints = true});
+    parts.tag_names.clear();
+    for (int t = 0; t < 64; ++t) parts.tag_names.push_back("tag" + std::to_string(t));
+    for (Clip& clip : parts.clips) {
+      clip.tags = shift < 0 ? 0 : clip.tags << shift;
+      if (unit_terms) {
+        clip.cost_multiplier = 1.0f;
+        clip.cost_bias = 0.0f;
+      }
+    }
+    const Database db = make_database(std::move(parts));
+    const int s = std::max(shift, 0);
+    const TagMask walk = kTagWalk << s, run = kTagRun << s, idle = kTagIdle << s;
+    const std::vector<std::pair<TagMask, TagMask>> masks = {
+        {walk, 0}, {idle | run, 0}, {0, run}, {walk, walk}, {TagMask{1} << 63, 0}, {TagMask{1} << 5, idle}, {0, 0}};
+    std::vector<QueryParams> params(64);
+    for (std::size_t q = 0; q < params.size(); ++q) {
+      params[q].require_all = masks[q % masks.size()].first;
+      params[q].exclude_any = masks[q % masks.size()].second;
+    }
+    const std::vector<float> queries = synthetic_queries(db, params.size(), 46);
+    this->check(db, queries, params, params.size(), 1);
+    this->check(db, queries, params, params.size(), 4);
+  }
+}
+
 TYPED_TEST_P(BackendSuite, ExclusionWindowWrapsInLoopingClips) {
   const Database db = synthetic_database({.frames = 3000, .seed = 23, .constraints = true});
   std::unique_ptr<SearchBackend> backend = this->make(db);
@@ -492,7 +527,7 @@ TYPED_TEST_P(BackendSuite, BadInputIsAnError) {
 
 REGISTER_TYPED_TEST_SUITE_P(BackendSuite, RandomDataMatchesReference, OddChannelSizesMatchReference,
                             FindsTheUniqueMinimum, FlagsAreNeverResultsUnlessContinued,
-                            BlockTransitionWithAndWithoutContinuingFrame, TagMasks,
+                            BlockTransitionWithAndWithoutContinuingFrame, TagMasks, TagsInEitherWordOrNone,
                             ExclusionWindowWrapsInLoopingClips, MultiplierAndBiasEnterTheCost,
                             ContinuingBiasNegativeAndPositive, ContinuingMultiplierScalesBeforeTheBias,
                             ChannelWeightsIncludingZero, TiesGoToTheLowerFrameId,

@@ -1,7 +1,8 @@
 // The Vulkan backend's setup helpers (runtime/vulkan/src: descriptors.hpp,
-// pipeline.hpp; white-box, through the private headers): what they refuse
-// before anything reaches the driver. And VulkanSearch::create validating a
-// cluster table once, whatever the mode.
+// pipeline.hpp, scan_rows.hpp; white-box, through the private headers): what
+// they refuse before anything reaches the driver, and the brute force's
+// frame-to-row maps. And VulkanSearch::create validating a cluster table
+// once, whatever the mode.
 #include <array>
 #include <cstdint>
 #include <utility>
@@ -12,6 +13,7 @@
 #include "mmvk/thread_pool.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "pipeline.hpp"
+#include "scan_rows.hpp"
 #include "support/search_test_data.hpp"
 #include "vulkan_test_env.hpp"
 
@@ -104,6 +106,41 @@ TEST(VulkanSetup, AllocatesAndWritesSets) {
 
 // The table is checked in full (validate_cluster_table) even in BruteForce
 // mode, where it goes unused: one check, whatever the mode.
+// Scan rows {1, 2, 5} of 7 frames (rows_before, scan_rows.hpp): the
+// features hold frames 1, 2, 5, then 0, 3, 4, 6; no table (the cluster
+// modes) leaves every frame in place.
+TEST(VulkanSetup, FeatureRowsPutTheScanRowsFirst) {
+  const std::array<std::uint32_t, 8> scan = {0, 0, 1, 2, 2, 2, 3, 3};
+  const std::array<std::uint32_t, 7> rows = {3, 0, 1, 4, 5, 2, 6};
+  for (std::uint32_t f = 0; f < rows.size(); ++f) {
+    EXPECT_EQ(feature_row(scan, f), rows[f]) << "frame " << f;
+    EXPECT_EQ(feature_row({}, f), f);
+  }
+}
+
+// A query's skipped frames as scan rows (first, last - first), (kNoFrame, 0)
+// when no scan row is among them.
+TEST(VulkanSetup, SkippedFramesBecomeScanRows) {
+  const std::array<std::uint32_t, 8> scan = {0, 0, 1, 2, 2, 2, 3, 4};  // rows_before of frames 1, 2, 5, 6 of 7
+  using Ranges = std::array<std::uint32_t, 4>;
+  QueryGpu p{};
+  p.continuing_frame = kNoFrame;
+  p.window_clip = kNoFrame;
+  EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{kNoFrame, 0, kNoFrame, 0}));
+  p.continuing_frame = 5;  // no window: only itself
+  EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{2, 0, kNoFrame, 0}));
+  p.continuing_frame = 3;  // not a scan row
+  EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{kNoFrame, 0, kNoFrame, 0}));
+  p.window_clip = 0;
+  p.clip_first = 0;
+  p.clip_count = 7;
+  p.exclusion_window = 2;  // frames 1..5: rows 0..2
+  EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{0, 2, kNoFrame, 0}));
+  p.continuing_frame = 0;  // frames 0..2, and through the loop 5..6: rows 0..1 and 2..3
+  p.clip_loop = 1;
+  EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{0, 1, 2, 1}));
+}
+
 TEST(VulkanSetup, CreateValidatesTheClusterTableInEveryMode) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 1000, .seed = 71});

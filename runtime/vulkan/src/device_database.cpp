@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "scan_rows.hpp"
 #include "search_layout.hpp"
 
 namespace mmvk::vulkan::detail {
@@ -66,17 +67,23 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
   const std::size_t frames = device.frame_count;
   const std::size_t padded = std::size_t{device.dim_vec4s} * 4;
 
+  // The brute force's scan rows, and the host's map from frames to them.
+  const std::vector<std::uint32_t> scan = with_scan ? scan_frame_list(database) : std::vector<std::uint32_t>{};
+  if (with_scan) device.scan_rows_before = scan_rows_before(database);
+
   // Host copies in the kernels' layouts; creation-time only.
   {
     // Rows interleaved by kRowGroup (search_layout.hpp), the last group
-    // padded with zero rows.
+    // padded with zero rows; in brute-force mode the scan rows come first
+    // (scan_rows.hpp: feature_row()).
     const std::size_t groups = (frames + kRowGroup - 1) / kRowGroup;
     std::vector<float> features(groups * kRowGroup * padded, 0.0f);
     const std::span<const float> source = database.features();
-    for (std::size_t f = 0; f < frames; ++f) {
+    for (std::uint32_t f = 0; f < frames; ++f) {
+      const std::uint32_t row = feature_row(device.scan_rows_before, f);
       for (std::size_t d = 0; d < device.dims; ++d) {
-        features[feature_texel(f, static_cast<std::uint32_t>(d / 4), device.dim_vec4s) * 4 + d % 4] =
-            source[f * device.dims + d];
+        features[feature_texel(row, static_cast<std::uint32_t>(d / 4), device.dim_vec4s) * 4 + d % 4] =
+            source[std::size_t{f} * device.dims + d];
       }
     }
     Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32G32B32A32_SFLOAT, 16, bytes_of(features),
@@ -107,19 +114,16 @@ Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool poo
     device.frame_cost = std::move(*buffer);
   }
   {
-    std::vector<std::uint32_t> scan;
-    for (std::uint32_t f = 0; with_scan && f < device.frame_count; ++f) {
-      if (scanned_by_brute_force(database.frame_flags()[f])) scan.push_back(f);
-    }
     device.scan_rows = static_cast<std::uint32_t>(scan.size());
-    if (scan.empty()) scan.push_back(0);  // a buffer is never empty; the scan reads none of it
-    Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32_UINT, 4, bytes_of(scan),
+    // A buffer is never empty; with no scan rows the scan reads none of it.
+    const std::vector<std::uint32_t> scan_texels = scan.empty() ? std::vector<std::uint32_t>{0} : scan;
+    Result<TexelBuffer> buffer = make_texel_buffer(context, pool, VK_FORMAT_R32_UINT, 4, bytes_of(scan_texels),
                                                    "the scanned frames", force_staging);
     if (!buffer) return buffer.error();
     device.scan_frames = std::move(*buffer);
     // The scan's per-row terms in the same order: one fetch in place of the
     // metadata and cost texels, independent of the frame index.
-    std::vector<std::array<std::uint32_t, 4>> terms(scan.size());
+    std::vector<std::array<std::uint32_t, 4>> terms(scan_texels.size());
     for (std::size_t i = 0; i < device.scan_rows; ++i) {
       const std::uint32_t f = scan[i];
       const TagMask tags = database.frame_tags()[f];

@@ -2,7 +2,8 @@
 //  features   [ceil(frames / kRowGroup) x dims/4 x kRowGroup] RGBA32F texels,
 //             dims padded to 4 with zeros, rows interleaved in groups of
 //             kRowGroup (search_layout.hpp: feature_texel()), zero rows past
-//             the last frame
+//             the last frame; row f is frame f, or with the scan the scan
+//             rows first (scan_rows.hpp: feature_row())
 //  frame_meta [frames] RGBA32UI texels (flags, tags low, tags high, clip)
 //  frame_cost [frames] RG32F texels (cost multiplier, cost bias)
 //  scan_frames [scan rows] R32UI texels: the frames the brute-force scan
@@ -53,6 +54,7 @@ struct DeviceDatabase {
   TexelBuffer frame_cost;
   TexelBuffer scan_frames;  // at least one texel, even with no scan rows
   TexelBuffer scan_terms;   // as many texels as scan_frames
+  std::vector<std::uint32_t> scan_rows_before;  // host: scan_rows.hpp, scan_rows_before(); empty without the scan
 };
 
 // force_staging: copy through a staging buffer even into mappable memory.
@@ -68,8 +70,8 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
                                       std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
                                       bool force_staging);
 
-// with_scan: fill scan_frames and scan_terms (the brute force); else they
-// hold one unused texel each.
+// with_scan: fill scan_frames and scan_terms and put the scan rows first in
+// features (the brute force); else they hold one unused texel each.
 Result<DeviceDatabase> upload_database(const Context& context, VkCommandPool pool, const Database& database,
                                        bool with_scan, bool force_staging);
 

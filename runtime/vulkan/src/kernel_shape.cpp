@@ -45,6 +45,22 @@ Result<std::uint32_t> rows_per_invocation(std::uint32_t frames, const VulkanSear
   return rows;
 }
 
+// The 32-bit words of the tag masks that some frame uses: a query's tag
+// rules on the other words are decided without reading any row.
+std::uint32_t tag_words(const Database& database) {
+  TagMask used = 0;
+  for (const TagMask tags : database.frame_tags()) used |= tags;
+  return (used >> 32) != 0 ? 2 : used != 0 ? 1 : 0;
+}
+
+// Whether every frame's cost is its weighted sum: multiplier 1, bias 0.
+bool unit_cost_terms(const Database& database) {
+  const auto one = [](float m) { return m == 1.0f; };
+  const auto zero = [](float b) { return b == 0.0f; };
+  return std::all_of(database.frame_multiplier().begin(), database.frame_multiplier().end(), one) &&
+         std::all_of(database.frame_bias().begin(), database.frame_bias().end(), zero);
+}
+
 }  // namespace
 
 Result<KernelShape> make_kernel_shape(const Context& context, const Database& database,
@@ -64,6 +80,8 @@ Result<KernelShape> make_kernel_shape(const Context& context, const Database& da
     shape.end_mask[(end - 1) / 32] |= 1u << ((end - 1) % 32);
   }
   shape.channels = static_cast<std::uint32_t>(channels.size());
+  shape.tag_words = tag_words(database);
+  shape.unit_cost_terms = unit_cost_terms(database) ? 1 : 0;
   shape.workgroup_size = workgroup_size(context);
   MMVK_ASSIGN_OR_RETURN(shape.rows_per_invocation, rows_per_invocation(shape.scan_rows, options));
   // The scan's invocations are its blocks; a workgroup's lanes take its
@@ -90,6 +108,8 @@ std::vector<SpecValue> shape_spec(const KernelShape& shape, std::uint32_t k) {
       {kSpecEndMask0 + 1, shape.end_mask[1]},
       {kSpecEndMask0 + 2, shape.end_mask[2]},
       {kSpecEndMask0 + 3, shape.end_mask[3]},
+      {kSpecTagWords, shape.tag_words},
+      {kSpecUnitCostTerms, shape.unit_cost_terms},
   };
 }
 

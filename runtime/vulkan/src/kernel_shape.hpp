@@ -28,6 +28,8 @@ enum SpecId : std::uint32_t {
   kSpecEndMask0 = 6,  // .. kSpecEndMask0 + 3
   kSpecMergeContinuing = 10,  // topk_merge only: evaluate the continuing frame
   kSpecSortStep = 11,         // cluster_sort only: which of its steps
+  kSpecTagWords = 12,
+  kSpecUnitCostTerms = 13,
 };
 inline constexpr std::uint32_t kMaxKernelDims = 128;            // four 32-bit end masks
 inline constexpr std::uint32_t kMaxRowsPerInvocation = 32768;  // llvmpipe's loop limit is 65,535
@@ -40,6 +42,8 @@ struct KernelShape {
   std::uint32_t dim_vec4s = 0;
   std::uint32_t channels = 0;        // non-empty schema channels
   std::uint32_t end_mask[4] = {};    // bit d: dim d ends a channel
+  std::uint32_t tag_words = 2;       // 32-bit tag words any frame uses: 0, 1 (tags 0-31 only) or 2
+  std::uint32_t unit_cost_terms = 0; // 1: every frame's cost multiplier is 1 and its bias 0
   std::uint32_t workgroup_size = 1;
   std::uint32_t rows_per_invocation = 1;
   std::uint32_t block_count = 1;     // scan invocations: ceil(scan_rows / (rows_per_invocation x workgroup)) x workgroup, >= 1 workgroup

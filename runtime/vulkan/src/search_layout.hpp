@@ -24,11 +24,20 @@ struct QueryGpu {
   std::uint32_t clip_loop;
   float continuing_bias;
   float continuing_multiplier;
+  std::uint32_t continuing_row;  // the continuing frame's feature-matrix row (scan_rows.hpp: feature_row())
+  // The brute force: the scan rows it skips, (first, last - first) twice,
+  // (kNoFrame, 0) when empty (scan_rows.hpp: skipped_scan_rows()).
+  std::uint32_t skip_first_a;
+  std::uint32_t skip_span_a;
+  std::uint32_t skip_first_b;
+  std::uint32_t skip_span_b;
 };
-static_assert(sizeof(QueryGpu) == 48);
+static_assert(sizeof(QueryGpu) == 68);
 static_assert(offsetof(QueryGpu, window_clip) == 24);
 static_assert(offsetof(QueryGpu, continuing_bias) == 40);
 static_assert(offsetof(QueryGpu, continuing_multiplier) == 44);
+static_assert(offsetof(QueryGpu, continuing_row) == 48);
+static_assert(offsetof(QueryGpu, skip_span_b) == 64);
 
 // GLSL: SearchPush (push constants of every search kernel).
 struct SearchPush {

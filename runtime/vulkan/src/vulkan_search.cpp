@@ -15,6 +15,7 @@
 #include "kernel_shape.hpp"
 #include "memory.hpp"
 #include "pipeline.hpp"
+#include "scan_rows.hpp"
 #include "search_fit.hpp"
 #include "search_layout.hpp"
 
@@ -423,6 +424,13 @@ void VulkanSearch::Impl::stage_queries(Slot& slot, const QueryBatch& batch) {
     }
     gpu.continuing_bias = p.continuing_bias;
     gpu.continuing_multiplier = p.continuing_multiplier;
+    const std::span<const std::uint32_t> scan = device_database.scan_rows_before;
+    gpu.continuing_row = p.continuing_frame == kNoFrame ? kNoFrame : feature_row(scan, p.continuing_frame);
+    const std::array<std::uint32_t, 4> skipped = skipped_scan_rows(scan, gpu);
+    gpu.skip_first_a = skipped[0];
+    gpu.skip_span_a = skipped[1];
+    gpu.skip_first_b = skipped[2];
+    gpu.skip_span_b = skipped[3];
     params[q] = gpu;
     for (std::uint32_t c = 0; c < shape.channels; ++c) {
       weights[std::size_t{q} * shape.channels + c] = p.channel_weights[channel_of_weight[c]];

@@ -61,16 +61,6 @@ layout(constant_id = 3) const uint T = 1;  // queries per tile
 // last query (their results are not written).
 uint query_index(uint local) { return pc.query_base + min(local, pc.query_count - 1u); }
 
-// Query p's tag rules as one test per tag word w < TAG_WORDS: a row passes
-// when (row tags & mask) == wanted, with mask = require | exclude and
-// wanted = require. rejects_all: no row can pass (a tag both required and
-// excluded, or required in a word no frame uses).
-uvec4 tag_rule(QueryGpu p, out bool rejects_all) {
-  rejects_all = (p.require_lo & p.exclude_lo) != 0u || (p.require_hi & p.exclude_hi) != 0u ||
-                (TAG_WORDS < 1u && p.require_lo != 0u) || (TAG_WORDS < 2u && p.require_hi != 0u);
-  return uvec4(p.require_lo | p.exclude_lo, p.require_hi | p.exclude_hi, p.require_lo, p.require_hi);
-}
-
 // The frame of scan row `row`.
 uint frame_of_row(uint row) { return texelFetch(scan_frames, int(row)).x; }
 

@@ -58,8 +58,8 @@ void scan_tile(uint tile) {
   uint item[T];
   vec4 q[T][DV];
   float w[T][CHANNELS];
-  uvec4 tags[T];     // (require lo, require hi, exclude lo, exclude hi)
-  uvec4 skipped[T];  // skipped_ranges(): the exclusion window and the continuing frame
+  uvec4 tags[T];     // tag_rule(): (mask lo, mask hi, wanted lo, wanted hi)
+  uvec4 skipped[T];  // skipped_ranges() (the exclusion window and the continuing frame), or every frame
   // K = 1: the running best; a frame of kNone is an empty slot. Rows run in
   // descending frame order (a block's members ascend), so `cost <= best`
   // keeps the lowest frame among ties, accepts an infinite cost into an
@@ -74,8 +74,10 @@ void scan_tile(uint tile) {
     const uint query = pc.query_base + work_items[item[t]].x;
     load_query(query, q[t], w[t]);
     const QueryGpu p = query_params[query];
-    tags[t] = uvec4(p.require_lo, p.require_hi, p.exclude_lo, p.exclude_hi);
-    skipped[t] = skipped_ranges(p);
+    bool rejects_all;
+    tags[t] = tag_rule(p, rejects_all);
+    // Frame r is skipped when r - 0 <= kNone: every frame.
+    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : skipped_ranges(p);
     best_cost[t] = kInfinity;
     best_frame[t] = kNone;
     clear_pairs(best[t]);
@@ -86,23 +88,32 @@ void scan_tile(uint tile) {
     --m;
     const uvec4 meta = texelFetch(member_meta, int(m));  // (frame, flags, tags lo, tags hi)
     const uint r = meta.x;
-    vec2 scale_bias = texelFetch(member_cost, int(m)).xy;
-    // The candidate rules as in the brute force, branch-free: flagged rows
-    // get a NaN bias, the tags and the exclusion window are integer
-    // operations.
-    if ((meta.y & kNeverCandidate) != 0u) scale_bias.y = uintBitsToFloat(0x7FC00000u);
+    // The candidate rules as in the brute force, branch-free: a flagged row
+    // gets a NaN bias (with unit cost terms, which add no bias, it is
+    // rejected instead), the tags and the exclusion window are integer
+    // operations on named bools (glslang compiles a short-circuit operator
+    // whose right side is an expression into a branch).
+    const bool never = (meta.y & kNeverCandidate) != 0u;
+    const bool never_unit = UNIT_COST_TERMS != 0u && never;
+    vec2 scale_bias = vec2(1.0, 0.0);
+    if (UNIT_COST_TERMS == 0u) scale_bias = texelFetch(member_cost, int(m)).xy;
+    scale_bias.y = mix(scale_bias.y, uintBitsToFloat(0x7FC00000u), UNIT_COST_TERMS == 0u && never);
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(member_rows, int(m * DV + v));
     [[unroll]] for (uint t = 0; t < T; ++t) {
-      const float cost = row_cost(x, q[t], w[t], scale_bias);
-      const uint rejected = ((meta.z & tags[t].x) ^ tags[t].x) | ((meta.w & tags[t].y) ^ tags[t].y) |
-                            (meta.z & tags[t].z) | (meta.w & tags[t].w) |
-                            uint(r - skipped[t].x <= skipped[t].y) | uint(r - skipped[t].z <= skipped[t].w);
+      const float cost = UNIT_COST_TERMS != 0u ? row_total(x, q[t], w[t]) : row_cost(x, q[t], w[t], scale_bias);
+      const bool tag_rejected_lo = TAG_WORDS >= 1u && (meta.z & tags[t].x) != tags[t].z;
+      const bool tag_rejected_hi = TAG_WORDS >= 2u && (meta.w & tags[t].y) != tags[t].w;
+      const bool skipped_a = r - skipped[t].x <= skipped[t].y;
+      const bool skipped_b = r - skipped[t].z <= skipped[t].w;
+      const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b || never_unit;
       if (K == 1u) {
-        const bool better = rejected == 0u && cost <= best_cost[t];
-        best_cost[t] = better ? cost : best_cost[t];
-        best_frame[t] = better ? r : best_frame[t];
-      } else if (rejected == 0u && !(cost > worst[t])) {
+        const bool cheaper = cost <= best_cost[t];
+        const bool better = !rejected && cheaper;
+        // mix() with a bool is OpSelect; `?:` on an array element is a branch.
+        best_cost[t] = mix(best_cost[t], cost, better);
+        best_frame[t] = mix(best_frame[t], r, better);
+      } else if (!rejected && !(cost > worst[t])) {
         insert_row(best[t], worst[t], cost, r);
       }
     }

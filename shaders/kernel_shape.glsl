@@ -17,7 +17,7 @@ layout(constant_id = 7) const uint END_MASK_1 = 0u;
 layout(constant_id = 8) const uint END_MASK_2 = 0u;
 layout(constant_id = 9) const uint END_MASK_3 = 0u;
 // 32-bit words of the tag masks that any frame uses: 0 (no frame has a tag),
-// 1 (only tags 0-31) or 2. The brute-force scan tests only those words.
+// 1 (only tags 0-31) or 2. The scans test only those words.
 layout(constant_id = 12) const uint TAG_WORDS = 2;
 // 1: every frame's cost multiplier is 1 and its bias 0 (or -0), so a row's
 // cost is its weighted sum, bit for bit (1 x t + 0 is t for every t the

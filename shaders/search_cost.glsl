@@ -68,6 +68,16 @@ float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
   return cost;
 }
 
+// Query p's tag rules as one test per tag word w < TAG_WORDS: a row passes
+// when (row tags & mask) == wanted, with mask = require | exclude and
+// wanted = require (the scans' one test per word and row). rejects_all: no row can pass (a tag both required and
+// excluded, or required in a word no frame uses).
+uvec4 tag_rule(QueryGpu p, out bool rejects_all) {
+  rejects_all = (p.require_lo & p.exclude_lo) != 0u || (p.require_hi & p.exclude_hi) != 0u ||
+                (TAG_WORDS < 1u && p.require_lo != 0u) || (TAG_WORDS < 2u && p.require_hi != 0u);
+  return uvec4(p.require_lo | p.exclude_lo, p.require_hi | p.exclude_hi, p.require_lo, p.require_hi);
+}
+
 // The features (padded like the rows) and channel weights of query `query`.
 void load_query(uint query, out vec4 q[DV], out float w[CHANNELS]) {
   [[unroll]] for (uint v = 0; v < DV; ++v) q[v] = query_features[query * DV + v];

@@ -22,7 +22,7 @@ const uint kItemsPerScanGroup = 64u;
 // Clusters per cluster_bounds invocation (cluster_layout.hpp:
 // kClustersPerBoundsInvocation): the host dispatches
 // ceil(clusters / (kItemsPerScanGroup x this)) workgroups per query.
-const uint kClustersPerBoundsInvocation = 8u;
+const uint kClustersPerBoundsInvocation = 32u;
 // Blocks scan round 0 evaluates per query (cluster_select): those of least
 // bound among the blocks of the kSeedClusters nearest clusters. Bandai
 // volume set, transition: 2 blocks of 2 clusters visited 4.38% of the

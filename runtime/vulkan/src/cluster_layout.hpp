@@ -72,8 +72,12 @@ static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() =
 inline constexpr std::uint32_t kScanWorkgroup = 64;
 inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup;
 // Clusters per cluster_bounds invocation (GLSL: the same name): the query's
-// loads are shared by them.
-inline constexpr std::uint32_t kClustersPerBoundsInvocation = 8;
+// loads (storage-buffer loads, scalar loops over the lanes on lavapipe) are
+// shared by them. Bandai volume set, transition, B = 1024, the pass alone:
+// 8 clusters took about 15 ms a batch with lavapipe's AVX2 code and 7 ms
+// with its AVX-512 code, 32 clusters about 10 and 6 ms (128 was slower
+// again; bench/RESULTS.md, 2026-11-27, "lavapipe on an AVX2 host").
+inline constexpr std::uint32_t kClustersPerBoundsInvocation = 32;
 
 // GLSL: ScanDispatch, (groups x, 1, 1, count) per scan round for the
 // per-item sort steps, then per round for the tiled scan; reset by the

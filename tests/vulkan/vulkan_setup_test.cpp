@@ -104,8 +104,6 @@ TEST(VulkanSetup, AllocatesAndWritesSets) {
   }
 }
 
-// The table is checked in full (validate_cluster_table) even in BruteForce
-// mode, where it goes unused: one check, whatever the mode.
 // Scan rows {1, 2, 5} of 7 frames (rows_before, scan_rows.hpp): the
 // features hold frames 1, 2, 5, then 0, 3, 4, 6; no table (the cluster
 // modes) leaves every frame in place.
@@ -141,6 +139,8 @@ TEST(VulkanSetup, SkippedFramesBecomeScanRows) {
   EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{0, 1, 2, 1}));
 }
 
+// The table is checked in full (validate_cluster_table) even in BruteForce
+// mode, where it goes unused: one check, whatever the mode.
 TEST(VulkanSetup, CreateValidatesTheClusterTableInEveryMode) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 1000, .seed = 71});

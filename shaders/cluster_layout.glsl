@@ -53,14 +53,14 @@ layout(push_constant) uniform ClusterPush {
 
 // cluster_layout.hpp: ClusterQueryState (48 bytes, std430).
 struct ClusterQueryState {
-  uint seed;              // nearest eligible cluster (centroid), kNone if none
+  uint pad0;
   uint upper_key;         // orderable key of the k-th best after round 0, kSkip if fewer than k
   uint rows;              // rows evaluated (statistics)
-  uint pad0;
+  uint pad1;
   uvec2 continuing_pair;  // (key, frame) of the continuing frame, (kNone, kNone) when not a candidate
   uvec2 items0;           // (first work item, count) of the query's blocks in scan round 0
   uvec2 items1;           // the same for round 1 (first counts from item 0 of round 0)
-  uvec2 pad1;
+  uvec2 pad2;
 };
 
 // The rows in cluster order (ClusterTable::members, cluster by cluster),

@@ -71,7 +71,10 @@ uint list_other_blocks(uint local_query, uvec2 items0, uint upper, vec4 q[DV], f
   while (b < end || tail < pc.block_count) {
     if (b < end) {
       bool scanned = false;
-      [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) scanned = scanned || b == seed_blocks[j];
+      [[unroll]] for (uint j = 0u; j < kSeedBlocks; ++j) {
+        const bool in_round_0 = b == seed_blocks[j];  // a named bool: no branch for ||
+        scanned = scanned || in_round_0;
+      }
       const uint key = scanned ? kSkip : block_key(b, q, w);
       if (key != kSkip && key <= upper) {
         listed[row + count] = b;

@@ -59,7 +59,7 @@ void scan_tile(uint tile) {
   vec4 q[T][DV];
   float w[T][CHANNELS];
   uvec4 tags[T];     // tag_rule(): (mask lo, mask hi, wanted lo, wanted hi)
-  uvec4 skipped[T];  // skipped_ranges() (the exclusion window and the continuing frame), or every frame
+  uvec4 skipped[T];  // QueryGpu's skipped frames (the continuing frame and its window), or every frame
   // K = 1: the running best; a frame of kNone is an empty slot. Rows run in
   // descending frame order (a block's members ascend), so `cost <= best`
   // keeps the lowest frame among ties, accepts an infinite cost into an
@@ -77,7 +77,7 @@ void scan_tile(uint tile) {
     bool rejects_all;
     tags[t] = tag_rule(p, rejects_all);
     // Frame r is skipped when r - 0 <= kNone: every frame.
-    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : skipped_ranges(p);
+    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : uvec4(p.skip_first_a, p.skip_span_a, p.skip_first_b, p.skip_span_b);
     best_cost[t] = kInfinity;
     best_frame[t] = kNone;
     clear_pairs(best[t]);

@@ -139,7 +139,6 @@ void main() {
     const uint upper = pc.k == 1u && continuing.y != kNone ? continuing.x : kSkip;
     items = move_listed(0u, local_query, least_blocks(local_query, seeds, upper, q, w));
   }
-  states[query].seed = seeds[0];
   states[query].continuing_pair = continuing;
   states[query].items0 = items;
 }

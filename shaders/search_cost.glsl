@@ -106,36 +106,4 @@ uvec2 continuing_pair(uint query) {
   return isnan(cost) ? uvec2(kNone, kNone) : uvec2(orderable_bits(cost), frame);
 }
 
-// The rows the scans skip for query p, as two ranges (first, last - first):
-// row r is skipped when r - first <= last - first (unsigned). They hold the
-// continuing frame and, when an exclusion window applies, every frame of its
-// clip within the window (mmvk::is_candidate); an empty range is
-// (kNone, 0), which no row reaches.
-uvec4 skipped_ranges(QueryGpu p) {
-  uvec4 ranges = uvec4(kNone, 0u, kNone, 0u);
-  if (p.continuing_frame == kNone) return ranges;
-  ranges.xy = uvec2(p.continuing_frame, 0u);
-  if (p.window_clip == kNone) return ranges;
-  // Offsets inside the clip: b is the continuing frame, w the window; a row
-  // at offset a is excluded when |a - b| <= w, or, in a looping clip, when
-  // count - |a - b| <= w (the distance through the wrap).
-  const uint count = p.clip_count;
-  const uint b = p.continuing_frame - p.clip_first;
-  const uint w = p.exclusion_window;
-  const uint first = w >= b ? 0u : b - w;
-  const uint last = w >= count - 1u - b ? count - 1u : b + w;
-  ranges.xy = uvec2(p.clip_first + first, last - first);
-  if (p.clip_loop != 0u) {
-    if (w > b) {
-      // a > b: a >= b + count - w, a suffix of the clip.
-      const uint suffix = w - b >= count ? 0u : count - (w - b);
-      ranges.zw = uvec2(p.clip_first + suffix, count - 1u - suffix);
-    } else if (w >= count - b) {
-      // a < b: a <= b + w - count, a prefix of the clip.
-      ranges.zw = uvec2(p.clip_first, min(w - (count - b), count - 1u));
-    }
-  }
-  return ranges;
-}
-
 #endif

@@ -27,8 +27,9 @@ struct QueryGpu {
   float continuing_bias;
   float continuing_multiplier;
   uint continuing_row;     // the continuing frame's row of `features`
-  // The brute force: the scan rows it skips, (first, last - first) twice,
-  // (kNone, 0) when empty: the continuing frame and its exclusion window.
+  // The rows the scans skip (scan rows in brute-force mode, frames in the
+  // cluster modes), (first, last - first) twice, (kNone, 0) when empty: the
+  // continuing frame and its exclusion window.
   uint skip_first_a;
   uint skip_span_a;
   uint skip_first_b;

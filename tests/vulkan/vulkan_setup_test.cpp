@@ -117,7 +117,7 @@ TEST(VulkanSetup, FeatureRowsPutTheScanRowsFirst) {
 }
 
 // A query's skipped frames as scan rows (first, last - first), (kNoFrame, 0)
-// when no scan row is among them.
+// when no scan row is among them; as frames when there is no table.
 TEST(VulkanSetup, SkippedFramesBecomeScanRows) {
   const std::array<std::uint32_t, 8> scan = {0, 0, 1, 2, 2, 2, 3, 4};  // rows_before of frames 1, 2, 5, 6 of 7
   using Ranges = std::array<std::uint32_t, 4>;
@@ -137,6 +137,8 @@ TEST(VulkanSetup, SkippedFramesBecomeScanRows) {
   p.continuing_frame = 0;  // frames 0..2, and through the loop 5..6: rows 0..1 and 2..3
   p.clip_loop = 1;
   EXPECT_EQ(skipped_scan_rows(scan, p), (Ranges{0, 1, 2, 1}));
+  // No table (the cluster modes): the frame ranges themselves.
+  EXPECT_EQ(skipped_scan_rows({}, p), (Ranges{0, 2, 5, 1}));
 }
 
 // The table is checked in full (validate_cluster_table) even in BruteForce

@@ -30,14 +30,14 @@ static_assert(offsetof(ClusterPush, nprobe) == 24);
 
 // GLSL: ClusterQueryState (std430 array element; uvec2 aligned to 8).
 struct ClusterQueryState {
-  std::uint32_t seed;                // cluster evaluated first (nearest centroid), kNoFrame if none
-  std::uint32_t upper_key;           // orderable key of the k-th best after the seed
-  std::uint32_t rows;                // rows evaluated, read back for SearchStats
   std::uint32_t pad0;
+  std::uint32_t upper_key;           // orderable key of the k-th best after scan round 0
+  std::uint32_t rows;                // rows evaluated, read back for SearchStats
+  std::uint32_t pad1;
   std::uint32_t continuing_pair[2];  // (key, frame) of the continuing frame
   std::uint32_t items0[2];           // (first work item, count) of scan round 0
   std::uint32_t items1[2];           // the same for round 1
-  std::uint32_t pad1[2];
+  std::uint32_t pad2[2];
 };
 static_assert(sizeof(ClusterQueryState) == 48);
 static_assert(offsetof(ClusterQueryState, rows) == 8);

@@ -10,8 +10,9 @@ namespace mmvk::vulkan::detail {
 
 namespace {
 
-// search_cost.glsl: skipped_ranges(), in frames: (first, last - first) twice,
-// (kNoFrame, 0) when empty.
+// The frames no scan evaluates for query p (the continuing frame, which the
+// merges add with its bias, and its exclusion window: mmvk::is_candidate),
+// (first, last - first) twice, (kNoFrame, 0) when empty.
 std::array<std::uint32_t, 4> skipped_frames(const QueryGpu& p) {
   std::array<std::uint32_t, 4> ranges = {kNoFrame, 0, kNoFrame, 0};
   if (p.continuing_frame == kNoFrame) return ranges;
@@ -69,8 +70,9 @@ std::uint32_t feature_row(std::span<const std::uint32_t> rows_before, std::uint3
 
 std::array<std::uint32_t, 4> skipped_scan_rows(std::span<const std::uint32_t> rows_before, const QueryGpu& p) {
   const std::array<std::uint32_t, 4> frames = skipped_frames(p);
+  if (rows_before.empty()) return frames;
   std::array<std::uint32_t, 4> rows = {kNoFrame, 0, kNoFrame, 0};
-  for (std::size_t r = 0; r < 2 && !rows_before.empty(); ++r) {
+  for (std::size_t r = 0; r < 2; ++r) {
     if (frames[2 * r] == kNoFrame) continue;
     // Scan rows [lo, hi) hold the frames [first, first + span].
     const std::uint32_t lo = rows_before[frames[2 * r]];

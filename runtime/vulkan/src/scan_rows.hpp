@@ -31,9 +31,10 @@ std::vector<std::uint32_t> scan_rows_before(const Database& database);
 // empty table (the cluster modes, which upload no scan) it is the frame.
 std::uint32_t feature_row(std::span<const std::uint32_t> rows_before, std::uint32_t frame);
 
-// The two frame ranges the scan skips for query p (the continuing frame and
-// its exclusion window; search_cost.glsl: skipped_ranges(), the same rule),
-// as scan-row ranges: (first, last - first) each, (kNoFrame, 0) when empty.
+// The two frame ranges the scans skip for query p (the continuing frame and
+// its exclusion window), as scan-row ranges: (first, last - first) each,
+// (kNoFrame, 0) when empty. With an empty table (the cluster modes, whose
+// scans index rows by frame) they stay frame ranges.
 std::array<std::uint32_t, 4> skipped_scan_rows(std::span<const std::uint32_t> rows_before, const QueryGpu& p);
 
 }  // namespace mmvk::vulkan::detail

@@ -25,8 +25,9 @@ struct QueryGpu {
   float continuing_bias;
   float continuing_multiplier;
   std::uint32_t continuing_row;  // the continuing frame's feature-matrix row (scan_rows.hpp: feature_row())
-  // The brute force: the scan rows it skips, (first, last - first) twice,
-  // (kNoFrame, 0) when empty (scan_rows.hpp: skipped_scan_rows()).
+  // The rows the scans skip (scan rows in brute-force mode, frames in the
+  // cluster modes), (first, last - first) twice, (kNoFrame, 0) when empty
+  // (scan_rows.hpp: skipped_scan_rows()).
   std::uint32_t skip_first_a;
   std::uint32_t skip_span_a;
   std::uint32_t skip_first_b;

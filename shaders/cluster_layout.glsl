@@ -87,24 +87,29 @@ layout(set = 1, binding = 5) uniform samplerBuffer member_rows;
 // [members] RG32F: (cost multiplier, cost bias).
 layout(set = 1, binding = 6) uniform samplerBuffer member_cost;
 // [chunk x clusters]: (bound key, centroid distance key), kSkip when skipped.
-layout(std430, set = 1, binding = 7) buffer BoundKeys { uvec2 bound_keys[]; };
+// Written by cluster_bounds (and cluster_select in nprobe mode) through the
+// storage binding; the per-query loops over the clusters read it through
+// the texel view, a vectorized gather on lavapipe where a storage-buffer
+// load is a scalar loop over the lanes (shared/LAVAPIPE.md).
+layout(set = 1, binding = 7) uniform usamplerBuffer bound_key_texels;
+layout(std430, set = 1, binding = 8) buffer BoundKeys { uvec2 bound_keys[]; };
 // [max_batch] per query state, indexed by the query's batch index.
-layout(std430, set = 1, binding = 8) buffer States { ClusterQueryState states[]; };
+layout(std430, set = 1, binding = 9) buffer States { ClusterQueryState states[]; };
 // [work items x K] the best (key, frame) pairs of each work item (round 0's
 // items, then round 1's; at most chunk x blocks).
-layout(std430, set = 1, binding = 9) buffer BlockPairs { uvec2 block_pairs[]; };
+layout(std430, set = 1, binding = 10) buffer BlockPairs { uvec2 block_pairs[]; };
 // Per scan round r: [r] = (workgroups x, 1, 1, work items), the indirect
 // dispatch of cluster_sort's per-item steps, counted while listing; [2 + r]
 // = (workgroups x, 1, 1, tiles), cluster_scan's, written by cluster_sort's
 // prefix step (cluster_layout.hpp: kScanDispatchReset); the host zeroes
 // them before each chunk.
-layout(std430, set = 1, binding = 10) buffer ScanDispatch { uvec4 scan_dispatch[4]; };
+layout(std430, set = 1, binding = 11) buffer ScanDispatch { uvec4 scan_dispatch[4]; };
 // [chunk x blocks] (local query, block): the work items, each query's
 // items of a round consecutive.
-layout(std430, set = 1, binding = 11) buffer WorkItems { uvec2 work_items[]; };
+layout(std430, set = 1, binding = 12) buffer WorkItems { uvec2 work_items[]; };
 // [chunk x blocks] per query: the blocks it lists, before they get their
 // place among the work items.
-layout(std430, set = 1, binding = 12) buffer Listed { uint listed[]; };
+layout(std430, set = 1, binding = 13) buffer Listed { uint listed[]; };
 // The work items of a round sorted by block (cluster_sort.comp), so that a
 // scan invocation evaluates one block for a tile of the queries that visit
 // it (a row loaded once per tile, not once per query). Words, with
@@ -115,7 +120,7 @@ layout(std430, set = 1, binding = 12) buffer Listed { uint listed[]; };
 //   [3B + 1, 4B + 2)    the first tile of each block's items
 //   [4B + 2 + 2i]       item i's rank among its block's items
 //   [4B + 2 + 2j + 1]   the item at sorted position j of the round
-layout(std430, set = 1, binding = 13) buffer BlockSort { uint block_sort[]; };
+layout(std430, set = 1, binding = 14) buffer BlockSort { uint block_sort[]; };
 uint sort_fill(uint round, uint b) { return round * pc.block_count + b; }
 uint sort_item_start(uint b) { return 2u * pc.block_count + b; }
 uint sort_tile_start(uint b) { return 3u * pc.block_count + 1u + b; }

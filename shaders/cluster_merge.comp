@@ -59,7 +59,7 @@ uint list_other_blocks(uint local_query, uvec2 items0, uint upper, vec4 q[DV], f
   const uint row = local_query * pc.block_count;
   uint tail = pc.block_count;
   for (uint c = 0u; c < pc.cluster_count; ++c) {
-    const uint key = bound_keys[key_base + c].x;
+    const uint key = texelFetch(bound_key_texels, int(key_base + c)).x;
     if (key != kSkip && key <= upper) {
       --tail;
       listed[row + tail] = c;

@@ -65,6 +65,10 @@ uint least_blocks(uint local_query, uint seeds[kSeedClusters], uint upper, vec4 
   return count;
 }
 
+// Query `base`'s (bound key, centroid distance key) of cluster c, through
+// the texel view (cluster_layout.glsl).
+uvec2 read_keys(uint base, uint c) { return texelFetch(bound_key_texels, int(base + c)).xy; }
+
 void main() {
   const uint local_query = gl_GlobalInvocationID.x;
   if (local_query >= pc.query_count) return;
@@ -72,10 +76,17 @@ void main() {
   const uint base = local_query * pc.cluster_count;
   const uint clusters = pc.cluster_count;
 
+  // nprobe mode: the probed clusters are those of distance key < threshold,
+  // and the first `at_threshold` (by ascending id) of those at it. Every
+  // eligible cluster is probed while there are at most nprobe.
+  bool probe_all = true;
+  uint threshold = 0u;
+  uint at_threshold = 0u;
   if (pc.nprobe != 0u) {
     uint eligible = 0u;
-    for (uint c = 0u; c < clusters; ++c) eligible += bound_keys[base + c].x != kSkip ? 1u : 0u;
+    for (uint c = 0u; c < clusters; ++c) eligible += read_keys(base, c).x != kSkip ? 1u : 0u;
     if (eligible > pc.nprobe) {
+      probe_all = false;
       // The least T with count(distance key <= T) >= nprobe (ineligible
       // clusters have distance key kSkip, above every T tried).
       uint lo = 0u;
@@ -83,7 +94,7 @@ void main() {
       for (uint step = 0u; step < 32u && lo < hi; ++step) {
         const uint mid = lo + ((hi - lo) >> 1u);
         uint n = 0u;
-        for (uint c = 0u; c < clusters; ++c) n += bound_keys[base + c].y <= mid ? 1u : 0u;
+        for (uint c = 0u; c < clusters; ++c) n += read_keys(base, c).y <= mid ? 1u : 0u;
         if (n >= pc.nprobe) {
           hi = mid;
         } else {
@@ -91,22 +102,17 @@ void main() {
         }
       }
       uint below = 0u;
-      for (uint c = 0u; c < clusters; ++c) below += bound_keys[base + c].y < lo ? 1u : 0u;
-      uint take = pc.nprobe - below;  // clusters at exactly the threshold, by ascending id
-      for (uint c = 0u; c < clusters; ++c) {
-        const uint distance = bound_keys[base + c].y;
-        bool keep = distance < lo;
-        if (distance == lo && take > 0u) {
-          keep = true;
-          --take;
-        }
-        if (!keep) bound_keys[base + c].x = kSkip;
-      }
+      for (uint c = 0u; c < clusters; ++c) below += read_keys(base, c).y < lo ? 1u : 0u;
+      threshold = lo;
+      at_threshold = pc.nprobe - below;
     }
   }
 
-  // The kSeedClusters eligible clusters of least (centroid distance, id),
-  // the first the seed; kNone past the eligible ones.
+  // The kSeedClusters eligible (and probed) clusters of least (centroid
+  // distance, id), the first the seed; kNone past the eligible ones. In
+  // nprobe mode the same loop marks the clusters not probed kSkip for the
+  // merge (this pass reads the keys through the texel view, which need not
+  // see its own writes, so it never reads them back).
   uint seeds[kSeedClusters];
   uint seed_distances[kSeedClusters];
   [[unroll]] for (uint j = 0u; j < kSeedClusters; ++j) {
@@ -114,10 +120,21 @@ void main() {
     seed_distances[j] = kSkip;
   }
   for (uint c = 0u; c < clusters; ++c) {
-    const uvec2 keys = bound_keys[base + c];
+    const uvec2 keys = read_keys(base, c);
     if (keys.x == kSkip) continue;
     uint cluster = c;
     uint distance = keys.y;
+    if (!probe_all) {
+      bool probed = distance < threshold;
+      if (distance == threshold && at_threshold > 0u) {
+        probed = true;
+        --at_threshold;
+      }
+      if (!probed) {
+        bound_keys[base + c].x = kSkip;
+        continue;
+      }
+    }
     // Insertion as in least_blocks; ascending ids keep the lower one first on ties.
     [[unroll]] for (uint j = 0u; j < kSeedClusters; ++j) {
       const bool less = seeds[j] == kNone || distance < seed_distances[j];

@@ -315,6 +315,7 @@ Result<std::uint64_t> ClusterKernel::size_scratch(const Context& context, const 
   // (the kernels loop past it), so the item count does not cap the chunk
   // (it did: 314 queries at 417k frames, too few to share blocks).
   chunk = std::min({chunk, range / (pairs_per_query * 8), range / (clusters * 8),
+                    std::uint64_t{limits.maxTexelBufferElements} / clusters,
                     range / (std::uint64_t{block_count_} * 8), (range - sort_header) / sort_per_query,
                     std::uint64_t{limits.maxComputeWorkGroupCount[1]}});
   if (chunk == 0) return make_error("Vulkan: one query's cluster scratch exceeds maxStorageBufferRange");
@@ -334,7 +335,8 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
     MemoryUse use;
     const char* what;
   } buffers[] = {
-      {&SlotScratch::bound_keys, bound_capacity_ * 8, storage, MemoryUse::DeviceLocal, "the cluster bound keys"},
+      {&SlotScratch::bound_keys, bound_capacity_ * 8, storage | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+       MemoryUse::DeviceLocal, "the cluster bound keys"},
       {&SlotScratch::states, std::uint64_t{options.max_batch} * sizeof(ClusterQueryState), storage,
        MemoryUse::HostMapped, "the cluster query states"},
       {&SlotScratch::block_pairs, pair_capacity_ * 8, storage, MemoryUse::DeviceLocal, "the cluster block pairs"},
@@ -348,9 +350,6 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
        storage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::DeviceLocal, "the cluster block sort"},
   };
   static_assert(std::size(buffers) == kClusterSet.storage);
-  const std::array<VkBufferView, kClusterSet.texel> views = {
-      member_meta_.view.get(),     block_info_.view.get(),  cluster_info_.view.get(), cluster_vectors_.view.get(),
-      block_vectors_.view.get(),   member_rows_.view.get(), member_cost_.view.get()};
   slots_.resize(options.slots);
   for (SlotScratch& slot : slots_) {
     std::array<VkBuffer, kClusterSet.storage> handles{};
@@ -359,6 +358,11 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
                                                                      buffers[b].use, buffers[b].what));
       handles[b] = (slot.*(buffers[b].member)).buffer.get();
     }
+    MMVK_ASSIGN_OR_RETURN(slot.bound_key_view, create_texel_view(context, slot.bound_keys, VK_FORMAT_R32G32_UINT, 8,
+                                                                 slot.bound_keys.size, "the cluster bound keys"));
+    const std::array<VkBufferView, kClusterSet.texel> views = {
+        member_meta_.view.get(),   block_info_.view.get(),  cluster_info_.view.get(), cluster_vectors_.view.get(),
+        block_vectors_.view.get(), member_rows_.view.get(), member_cost_.view.get(),  slot.bound_key_view.get()};
     MMVK_ASSIGN_OR_RETURN(slot.set, allocate_set(context, descriptor_pool_.get(), set_layout_.get(), views, handles));
   }
   return {};

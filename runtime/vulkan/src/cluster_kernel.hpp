@@ -80,6 +80,7 @@ class ClusterKernel {
  private:
   struct SlotScratch {
     Buffer bound_keys;   // [chunk x clusters] uvec2
+    UniqueBufferView bound_key_view;  // after bound_keys: destroyed first
     Buffer states;       // [max_batch] ClusterQueryState, host-mapped
     Buffer block_pairs;  // [chunk x blocks x K] uvec2, by work item
     Buffer scan_dispatch;  // 2 x (groups x, 1, 1, items): indirect args of the scans

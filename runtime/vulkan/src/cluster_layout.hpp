@@ -54,16 +54,17 @@ enum ClusterBinding : std::uint32_t {
   kBindingBlockVectors = 4,    // uniform texel, RGBA32F
   kBindingMemberRows = 5,      // uniform texel, RGBA32F
   kBindingMemberCost = 6,      // uniform texel, RG32F
-  kBindingBoundKeys = 7,       // storage
-  kBindingStates = 8,          // storage
-  kBindingBlockPairs = 9,      // storage
-  kBindingScanDispatch = 10,   // storage + indirect
-  kBindingWorkItems = 11,      // storage
-  kBindingListed = 12,         // storage
-  kBindingBlockSort = 13,      // storage
-  kClusterBindingCount = 14,
+  kBindingBoundKeyTexels = 7,  // uniform texel, RG32UI: a view of the bound keys' buffer
+  kBindingBoundKeys = 8,       // storage
+  kBindingStates = 9,          // storage
+  kBindingBlockPairs = 10,     // storage
+  kBindingScanDispatch = 11,   // storage + indirect
+  kBindingWorkItems = 12,      // storage
+  kBindingListed = 13,         // storage
+  kBindingBlockSort = 14,      // storage
+  kClusterBindingCount = 15,
 };
-inline constexpr SetShape kClusterSet{7, 7};
+inline constexpr SetShape kClusterSet{8, 7};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
 // The workgroup size of cluster_scan (one invocation per work item) and

@@ -11,10 +11,11 @@
 
 namespace mmvk::vulkan::detail {
 
-Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool, VkFormat format,
-                                      std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
-                                      bool force_staging) {
-  const std::uint64_t texels = data.size() / texel_bytes;
+namespace {
+
+// Whether the device can view `texels` texels of `format` as one uniform
+// texel buffer.
+Status check_texel_view(const Context& context, VkFormat format, std::uint64_t texels, const char* what) {
   const VkPhysicalDeviceLimits& limits = context.properties().limits;
   if (texels > limits.maxTexelBufferElements) {
     return make_error(std::string("Vulkan: too large for this device: ") + what + " needs " +
@@ -26,6 +27,30 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
   if ((format_props.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT) == 0) {
     return make_error(std::string("Vulkan: the device cannot read ") + what + " as a uniform texel buffer");
   }
+  return {};
+}
+
+}  // namespace
+
+Result<UniqueBufferView> create_texel_view(const Context& context, const Buffer& buffer, VkFormat format,
+                                           std::uint32_t texel_bytes, std::uint64_t bytes, const char* what) {
+  const std::uint64_t texels = bytes / texel_bytes;
+  MMVK_TRY(check_texel_view(context, format, texels, what));
+  VkBufferViewCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+  info.buffer = buffer.buffer.get();
+  info.format = format;
+  info.offset = 0;
+  info.range = texels * texel_bytes;
+  VkBufferView view = VK_NULL_HANDLE;
+  MMVK_VK_CHECK(vkCreateBufferView(context.device(), &info, nullptr, &view));
+  return UniqueBufferView(context.device(), view);
+}
+
+Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool, VkFormat format,
+                                      std::uint32_t texel_bytes, std::span<const std::byte> data, const char* what,
+                                      bool force_staging) {
+  MMVK_TRY(check_texel_view(context, format, data.size() / texel_bytes, what));
   Result<Buffer> buffer = create_buffer(context, data.size(),
                                         VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                         MemoryUse::DeviceLocal, what);
@@ -35,22 +60,11 @@ Result<TexelBuffer> make_texel_buffer(const Context& context, VkCommandPool pool
     buffer->mapped = nullptr;
   }
   MMVK_TRY(upload(context, pool, *buffer, data));
-
-  VkBufferViewCreateInfo info{};
-  info.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
-  info.buffer = buffer->buffer.get();
-  info.format = format;
-  info.offset = 0;
-  info.range = data.size();
-  VkBufferView view = VK_NULL_HANDLE;
-  MMVK_VK_CHECK(vkCreateBufferView(context.device(), &info, nullptr, &view));
   TexelBuffer result;
+  MMVK_ASSIGN_OR_RETURN(result.view, create_texel_view(context, *buffer, format, texel_bytes, data.size(), what));
   result.buffer = std::move(*buffer);
-  result.view = UniqueBufferView(context.device(), view);
   return result;
 }
-
-
 
 std::uint32_t scan_row_count(const Database& database) {
   std::uint32_t rows = 0;

@@ -63,6 +63,13 @@ std::span<const std::byte> bytes_of(const std::vector<T>& values) {
   return std::as_bytes(std::span<const T>(values));
 }
 
+// A uniform texel view of the first `bytes` of `buffer` (created with
+// VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT), after checking the texel count
+// against maxTexelBufferElements and the format's support; `what` names the
+// data in errors.
+Result<UniqueBufferView> create_texel_view(const Context& context, const Buffer& buffer, VkFormat format,
+                                           std::uint32_t texel_bytes, std::uint64_t bytes, const char* what);
+
 // A device-local texel buffer of `format` holding `data` (uploaded through
 // staging when the memory is not host-visible, or when force_staging), and
 // its view. `what` names the data in errors, e.g. over maxTexelBufferElements.

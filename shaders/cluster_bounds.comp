@@ -54,7 +54,7 @@ void main() {
   vec4 q[DV];
   float w[CHANNELS];
   load_query(query, q, w);
-  const uint stride = gl_NumWorkGroups.x * kItemsPerScanGroup;
+  const uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
   for (uint c = gl_GlobalInvocationID.x; c < pc.cluster_count; c += stride) {
     bound_keys[local_query * pc.cluster_count + c] = cluster_keys(c, p, q, w);
   }

@@ -19,10 +19,10 @@ const uint kNeverCandidate = 7u;
 // Work items (one invocation each) per cluster_scan workgroup
 // (cluster_layout.hpp: kScanWorkgroup); the scan is built with that size.
 const uint kItemsPerScanGroup = 64u;
-// Clusters per cluster_bounds invocation (cluster_layout.hpp:
+// Clusters per cluster_bounds invocation, at most (cluster_layout.hpp:
 // kClustersPerBoundsInvocation): the host dispatches
-// ceil(clusters / (kItemsPerScanGroup x this)) workgroups per query.
-const uint kClustersPerBoundsInvocation = 32u;
+// ceil(clusters / (workgroup size x this)) workgroups per query.
+const uint kClustersPerBoundsInvocation = 128u;
 // Blocks scan round 0 evaluates per query (cluster_select): those of least
 // bound among the blocks of the kSeedClusters nearest clusters. Bandai
 // volume set, transition: 2 blocks of 2 clusters visited 4.38% of the

@@ -221,9 +221,10 @@ Result<ClusterKernel> ClusterKernel::create(const Context& context, VkCommandPoo
   const std::array<SetShape, 2> sets = {kSearchSet, kClusterSet};
   MMVK_TRY(check_binding_limits(context, sets, "cluster kernels"));
   ClusterKernel kernel;
-  // The per-query kernels (select, merge) use the search's workgroup (8 on
-  // CPU drivers: one workgroup runs on one CPU thread, and a chunk may hold
-  // only tens of queries); the grids (bounds, scan) use kScanWorkgroup.
+  // The per-query kernels (bounds, select, merge) use the search's
+  // workgroup (8 on CPU drivers: one workgroup runs on one CPU thread, and a
+  // chunk may hold only tens of queries); the grids (sort, scan) use
+  // kScanWorkgroup.
   kernel.shape_ = shape;
   kernel.max_batch_ = options.max_batch;
   kernel.cluster_count_ = table.cluster_count;
@@ -373,8 +374,7 @@ Status ClusterKernel::create_pipelines(const Context& context, std::uint32_t max
   const VkPipelineLayout layout = pipeline_layout_.get();
   KernelShape grid_shape = shape_;
   grid_shape.workgroup_size = kScanWorkgroup;
-  MMVK_ASSIGN_OR_RETURN(bounds_,
-                        create_compute_pipeline(context, layout, "cluster_bounds", shape_spec(grid_shape, 1)));
+  MMVK_ASSIGN_OR_RETURN(bounds_, create_compute_pipeline(context, layout, "cluster_bounds", shape_spec(shape_, 1)));
   MMVK_ASSIGN_OR_RETURN(select_, create_compute_pipeline(context, layout, "cluster_select", shape_spec(shape_, 1)));
   for (std::uint32_t step = 0; step < std::size(sort_); ++step) {
     std::vector<SpecValue> spec = shape_spec(grid_shape, 1);
@@ -449,7 +449,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
   const VkPipelineLayout layout = pipeline_layout_.get();
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, sets.data(), 0, nullptr);
   const std::uint32_t items_per_group = kItemsPerScanGroup;
-  const std::uint32_t bounds_clusters = kScanWorkgroup * kClustersPerBoundsInvocation;
+  const std::uint32_t bounds_clusters = wg * kClustersPerBoundsInvocation;
   const std::uint32_t bounds_groups = (cluster_count_ + bounds_clusters - 1) / bounds_clusters;
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);

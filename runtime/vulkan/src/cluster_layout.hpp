@@ -68,17 +68,20 @@ inline constexpr SetShape kClusterSet{8, 7};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
 // The workgroup size of cluster_scan (one invocation per work item) and
-// cluster_bounds, on every device (Vulkan guarantees 128); GLSL:
+// cluster_sort, on every device (Vulkan guarantees 128); GLSL:
 // kItemsPerScanGroup.
 inline constexpr std::uint32_t kScanWorkgroup = 64;
 inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup;
-// Clusters per cluster_bounds invocation (GLSL: the same name): the query's
-// loads (storage-buffer loads, scalar loops over the lanes on lavapipe) are
-// shared by them. Bandai volume set, transition, B = 1024, the pass alone:
-// 8 clusters took about 15 ms a batch with lavapipe's AVX2 code and 7 ms
-// with its AVX-512 code, 32 clusters about 10 and 6 ms (128 was slower
-// again; bench/RESULTS.md, 2026-11-27, "lavapipe on an AVX2 host").
-inline constexpr std::uint32_t kClustersPerBoundsInvocation = 32;
+// Clusters per cluster_bounds invocation, at most (GLSL: the same name):
+// the query's loads (storage-buffer loads, scalar loops over the lanes on
+// lavapipe) are shared by them. The pass runs in the search's workgroup (8
+// lanes on CPU drivers), so up to 8 x 128 clusters take one workgroup per
+// query. Bandai volume set (646 clusters), transition, B = 1024, the pass
+// alone, lavapipe's AVX2 / AVX-512 code: 5 clusters an invocation took
+// about 15 / 7 ms a batch, 10 about 11 / 7.8, 81 about 6.4 / 5.7
+// (bench/RESULTS.md, 2026-11-27, "the bounds pass in the search's
+// workgroup").
+inline constexpr std::uint32_t kClustersPerBoundsInvocation = 128;
 
 // GLSL: ScanDispatch, (groups x, 1, 1, count) per scan round for the
 // per-item sort steps, then per round for the tiled scan; reset by the

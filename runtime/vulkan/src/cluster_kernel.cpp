@@ -41,8 +41,15 @@ constexpr std::uint32_t kMaxProbeClusters = 1700;
 
 // Work items per cluster_scan tile (one block, up to this many queries in
 // registers; pad slots repeat a query): K = 1 keeps two registers per
-// query, K > 1 keeps K pairs, as the brute force's tiles.
-std::uint32_t scan_tile(std::uint32_t k_class) { return k_class == 1 ? 8 : 4; }
+// query, K > 1 keeps K pairs, as the brute force's tiles. Round 0 scans
+// few blocks per query, each visited by few queries (2.8 items a block on
+// the Bandai volume set, transition, B = 1,024), so most of a tile of 8
+// would be pad slots, evaluated all the same: its tiles hold kRound0Tile.
+constexpr std::uint32_t kRound0Tile = 2;
+std::uint32_t scan_tile(std::uint32_t k_class, std::uint32_t round) {
+  if (round == 0) return kRound0Tile;
+  return k_class == 1 ? 8 : 4;
+}
 
 std::uint64_t loop_iterations(std::uint64_t clusters, std::uint64_t blocks, std::uint32_t k_class) {
   return clusters + (2 + std::uint64_t{k_class}) * blocks;
@@ -383,12 +390,15 @@ Status ClusterKernel::create_pipelines(const Context& context, std::uint32_t max
   }
   for (const std::uint32_t k : {1u, 4u, 16u}) {
     if (k > k_class(max_k)) break;
-    std::vector<SpecValue> scan_spec = shape_spec(grid_shape, k);
-    scan_spec.push_back({kSpecTile, scan_tile(k)});
-    MMVK_ASSIGN_OR_RETURN(UniquePipeline scan, create_compute_pipeline(context, layout, "cluster_scan", scan_spec));
-    MMVK_ASSIGN_OR_RETURN(UniquePipeline merge,
+    Variant variant{k, {}, {}};
+    for (std::uint32_t round = 0; round < 2; ++round) {
+      std::vector<SpecValue> scan_spec = shape_spec(grid_shape, k);
+      scan_spec.push_back({kSpecTile, scan_tile(k, round)});
+      MMVK_ASSIGN_OR_RETURN(variant.scan[round], create_compute_pipeline(context, layout, "cluster_scan", scan_spec));
+    }
+    MMVK_ASSIGN_OR_RETURN(variant.merge,
                           create_compute_pipeline(context, layout, "cluster_merge", shape_spec(shape_, k)));
-    variants_.push_back(Variant{k, std::move(scan), std::move(merge)});
+    variants_.push_back(std::move(variant));
   }
   return {};
 }
@@ -418,6 +428,7 @@ std::vector<std::string_view> ClusterKernel::kernel_names() const {
   std::vector<std::string_view> names = {"cluster_bounds", "cluster_select", "cluster_sort", "cluster_sort",
                                          "cluster_sort"};
   for (std::size_t v = 0; v < variants_.size(); ++v) {
+    names.push_back("cluster_scan");
     names.push_back("cluster_scan");
     names.push_back("cluster_merge");
   }
@@ -453,7 +464,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
   const std::uint32_t bounds_groups = (cluster_count_ + bounds_clusters - 1) / bounds_clusters;
   for (std::uint32_t base = 0; base < batch; base += chunk) {
     const std::uint32_t count = std::min(chunk, batch - base);
-    ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, scan_tile(kc)};
+    ClusterPush push{base, count, k, 0, cluster_count_, block_count_, nprobe_, 0};
     const std::uint32_t query_groups = (count + wg - 1) / wg;
     // The previous chunk's last merge read the scratch this chunk rewrites.
     if (base != 0) full_barrier(commands);
@@ -470,6 +481,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
         (std::uint64_t{count} * block_count_ + items_per_group - 1) / items_per_group, kMaxIndirectGroups);
     for (std::uint32_t round = 0; round < 2; ++round) {
       push.round = round;
+      push.tile = scan_tile(kc, round);
       // The work items (and so the group counts) were listed on the GPU:
       // sorted by block (rank, prefix sums, scatter), then scanned by tile.
       for (std::uint32_t step = 0; step < std::size(sort_); ++step) {
@@ -482,7 +494,7 @@ Status ClusterKernel::record(const Context& context, VkCommandBuffer commands, s
         }
       }
       full_barrier(commands);
-      MMVK_TRY(dispatch_indirect(context, commands, variant->scan.get(), layout, push, scratch.scan_dispatch,
+      MMVK_TRY(dispatch_indirect(context, commands, variant->scan[round].get(), layout, push, scratch.scan_dispatch,
                                  (kTileDispatchEntry + round) * kScanDispatchStride, max_scan_groups, "cluster_scan"));
       full_barrier(commands);
       MMVK_TRY(dispatch(context, commands, variant->merge.get(), layout, push, query_groups, 1, "cluster_merge"));

@@ -9,8 +9,8 @@
 //                   pair, the 4 blocks of least bound among the blocks
 //                   of the 2 nearest clusters (by centroid)
 //   cluster_sort    per round, 3 steps: the listed work items sorted by
-//                   block (a counting sort), tiles of up to scan_tile(K)
-//                   items of one block
+//                   block (a counting sort), tiles of up to scan_tile(K,
+//                   round) items of one block
 //   cluster_scan    round 0 (one invocation per tile, indirect): those
 //                   blocks (listed by cluster_select)
 //   cluster_merge   round 0 (query): the k-th best so far = upper bound;
@@ -91,7 +91,7 @@ class ClusterKernel {
   };
   struct Variant {
     std::uint32_t k_class = 1;
-    UniquePipeline scan;
+    UniquePipeline scan[2];  // per round: its tile size (scan_tile)
     UniquePipeline merge;
   };
   // The steps of create(), in order.

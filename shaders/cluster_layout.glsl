@@ -27,10 +27,14 @@ const uint kClustersPerBoundsInvocation = 128u;
 // bound among the blocks of the kSeedClusters nearest clusters. Bandai
 // volume set, transition: 2 blocks of 2 clusters visited 4.38% of the
 // rows, 4 blocks 4.14%, 8 blocks 4.14%; 4 blocks of 3 or 4 clusters 3.91%
-// and 3.82% but took as long (cluster_select ranks more blocks).
+// and 3.82%.
 const uint kSeedBlocks = 4u;
-// Nearest clusters (by centroid) whose blocks cluster_select ranks.
-const uint kSeedClusters = 2u;
+// Nearest clusters (by centroid) whose blocks cluster_select ranks. 3 took
+// as long as 2 while cluster_select read the bound keys as storage-buffer
+// loads; since it reads them as texels, 3 and 4 save about 1.5 ms a batch
+// of 1,024 (the round-1 scan and merge gain more than the select costs;
+// bench/RESULTS.md, 2026-11-27, "AVX2 code").
+const uint kSeedClusters = 3u;
 // Most workgroups of an indirect cluster dispatch (Vulkan's minimum of
 // maxComputeWorkGroupCount[0], cluster_layout.hpp: kMaxIndirectGroups);
 // past it, invocations take several items (a grid-stride loop), so a

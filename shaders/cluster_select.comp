@@ -9,7 +9,7 @@
 //  - picks the seed: the eligible cluster of least (centroid distance, id),
 //    ClusterSearch's seed_nearest (the least bound was a worse seed: many
 //    clusters whose box holds the query tie at 0), and the next nearest
-//    (kSeedClusters in all); lists for scan round 0 the kSeedBlocks (4)
+//    ones (kSeedClusters in all); lists for scan round 0 the kSeedBlocks (4)
 //    blocks of least bound among theirs (with k = 1 and a continuing
 //    frame, of those whose bound is <= its cost). Their best gives round
 //    1's upper bound. Scanning every block of the nearest clusters (about

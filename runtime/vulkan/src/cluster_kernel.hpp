@@ -7,7 +7,7 @@
 //                   clusters without candidates; centroid distance (nprobe)
 //   cluster_select  (query): nprobe selection, the continuing frame's
 //                   pair, the 4 blocks of least bound among the blocks
-//                   of the 2 nearest clusters (by centroid)
+//                   of the 3 nearest clusters (by centroid)
 //   cluster_sort    per round, 3 steps: the listed work items sorted by
 //                   block (a counting sort), tiles of up to scan_tile(K,
 //                   round) items of one block

@@ -100,21 +100,33 @@ void scan_tile(uint tile) {
     scale_bias.y = mix(scale_bias.y, uintBitsToFloat(0x7FC00000u), UNIT_COST_TERMS == 0u && never);
     vec4 x[DV];
     [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(member_rows, int(m * DV + v));
-    [[unroll]] for (uint t = 0; t < T; ++t) {
-      const float cost = UNIT_COST_TERMS != 0u ? row_total(x, q[t], w[t]) : row_cost(x, q[t], w[t], scale_bias);
-      const bool tag_rejected_lo = TAG_WORDS >= 1u && (meta.z & tags[t].x) != tags[t].z;
-      const bool tag_rejected_hi = TAG_WORDS >= 2u && (meta.w & tags[t].y) != tags[t].w;
-      const bool skipped_a = r - skipped[t].x <= skipped[t].y;
-      const bool skipped_b = r - skipped[t].z <= skipped[t].w;
-      const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b || never_unit;
-      if (K == 1u) {
-        const bool cheaper = cost <= best_cost[t];
-        const bool better = !rejected && cheaper;
-        // mix() with a bool is OpSelect; `?:` on an array element is a branch.
-        best_cost[t] = mix(best_cost[t], cost, better);
-        best_frame[t] = mix(best_frame[t], r, better);
-      } else if (!rejected && !(cost > worst[t])) {
-        insert_row(best[t], worst[t], cost, r);
+    // Two queries at a time (row_totals2()), the last alone when T is odd.
+    [[unroll]] for (uint pair = 0; pair < T; pair += 2u) {
+      float totals[2];
+      if (pair + 1u < T) {
+        row_totals2(x, q[pair], w[pair], q[pair + 1u], w[pair + 1u], totals[0], totals[1]);
+      } else {
+        totals[0] = row_total(x, q[pair], w[pair]);
+      }
+      // Constant bounds, so the loop unrolls (llvmpipe's loop limit).
+      [[unroll]] for (uint i = 0u; i < 2u; ++i) {
+        const uint t = pair + i;
+        if (t >= T) break;
+        const float cost = UNIT_COST_TERMS != 0u ? totals[i] : scaled_cost(totals[i], scale_bias);
+        const bool tag_rejected_lo = TAG_WORDS >= 1u && (meta.z & tags[t].x) != tags[t].z;
+        const bool tag_rejected_hi = TAG_WORDS >= 2u && (meta.w & tags[t].y) != tags[t].w;
+        const bool skipped_a = r - skipped[t].x <= skipped[t].y;
+        const bool skipped_b = r - skipped[t].z <= skipped[t].w;
+        const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b || never_unit;
+        if (K == 1u) {
+          const bool cheaper = cost <= best_cost[t];
+          const bool better = !rejected && cheaper;
+          // mix() with a bool is OpSelect; `?:` on an array element is a branch.
+          best_cost[t] = mix(best_cost[t], cost, better);
+          best_frame[t] = mix(best_frame[t], r, better);
+        } else if (!rejected && !(cost > worst[t])) {
+          insert_row(best[t], worst[t], cost, r);
+        }
       }
     }
   }

@@ -63,9 +63,48 @@ float row_total(vec4 x[DV], vec4 q[DV], float w[CHANNELS]) {
   return total;
 }
 
-float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
-  precise float cost = scale_bias.x * row_total(x, q, w) + scale_bias.y;
+// row_total() of two queries, a and b, dim by dim: each of the row's
+// values serves both queries before the next, where query by query the
+// row's DV vec4s had to stay live across a whole query. Lavapipe's code
+// for an AVX2 host has 16 vector registers and reloaded them for every
+// query (its brute force ran 6-9% faster paired, bench/RESULTS.md). Each
+// query's operations are row_total()'s, in its order.
+void row_totals2(vec4 x[DV], vec4 qa[DV], float wa[CHANNELS], vec4 qb[DV], float wb[CHANNELS], out float total_a,
+                 out float total_b) {
+  precise float ta = 0.0;
+  precise float tb = 0.0;
+  precise float sa = 0.0;
+  precise float sb = 0.0;
+  uint c = 0u;
+  [[unroll]] for (uint d = 0; d < DIMS; ++d) {
+    const float xd = x[d >> 2u][d & 3u];
+    precise float da = xd - qa[d >> 2u][d & 3u];
+    precise float db = xd - qb[d >> 2u][d & 3u];
+    if (starts_channel(d)) {
+      sa = da * da;
+      sb = db * db;
+    } else {
+      sa = sa + da * da;
+      sb = sb + db * db;
+    }
+    if (ends_channel(d)) {
+      ta = ta + wa[c] * sa;
+      tb = tb + wb[c] * sb;
+      ++c;
+    }
+  }
+  total_a = ta;
+  total_b = tb;
+}
+
+// multiplier x total + bias, rounded in that order (row_cost()).
+float scaled_cost(float total, vec2 scale_bias) {
+  precise float cost = scale_bias.x * total + scale_bias.y;
   return cost;
+}
+
+float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
+  return scaled_cost(row_total(x, q, w), scale_bias);
 }
 
 // Query p's tag rules as one test per tag word w < TAG_WORDS: a row passes

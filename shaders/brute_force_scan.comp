@@ -87,7 +87,7 @@ void main() {
   [[unroll]] for (uint t = 0; t < T; ++t) {
     const uint query = query_index(tile_first + t);
     load_query(query, q[t], w[t]);
-    const QueryGpu p = query_params[query];
+    const QueryGpu p = query_params_of(query);
     bool rejects_all;
     tags[t] = tag_rule(p, rejects_all);
     // Row r is skipped when r - 0 <= kNone: every row.

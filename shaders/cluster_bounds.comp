@@ -50,7 +50,7 @@ void main() {
   if (gl_GlobalInvocationID.x >= pc.cluster_count) return;
   const uint local_query = gl_WorkGroupID.y;
   const uint query = pc.query_base + local_query;
-  const QueryGpu p = query_params[query];
+  const QueryGpu p = query_params_of(query);
   vec4 q[DV];
   float w[CHANNELS];
   load_query(query, q, w);

@@ -8,6 +8,7 @@
 #define MMVK_CLUSTER_LAYOUT_GLSL
 
 #define MMVK_SEARCH_LAYOUT_OWN_PUSH
+#define MMVK_QUERY_TEXELS
 #include "search_layout.glsl"
 
 // A bound key that is never visited (ineligible or not probed cluster).
@@ -96,24 +97,49 @@ layout(set = 1, binding = 6) uniform samplerBuffer member_cost;
 // the texel view, a vectorized gather on lavapipe where a storage-buffer
 // load is a scalar loop over the lanes (shared/LAVAPIPE.md).
 layout(set = 1, binding = 7) uniform usamplerBuffer bound_key_texels;
-layout(std430, set = 1, binding = 8) buffer BoundKeys { uvec2 bound_keys[]; };
+// Texel views of the slot's query buffers (set 0's query_features,
+// query_params as 32-bit words, query_weights): the per-query kernels and
+// the scan tiles load their queries through them, a gather per value
+// where a storage-buffer load is a scalar loop over the lanes (the loads of
+// a scan tile's 8 queries were about a third of the round-1 scan with
+// lavapipe's code for an AVX2 host).
+layout(set = 1, binding = 8) uniform samplerBuffer query_feature_texels;
+layout(set = 1, binding = 9) uniform usamplerBuffer query_param_texels;
+layout(set = 1, binding = 10) uniform samplerBuffer query_weight_texels;
+// Words of a QueryGpu (search_layout.hpp: kQueryGpuWords).
+const uint kQueryGpuWords = 17u;
+vec4 query_feature(uint query, uint v) { return texelFetch(query_feature_texels, int(query * DV + v)); }
+float query_weight(uint query, uint c) { return texelFetch(query_weight_texels, int(query * CHANNELS + c)).x; }
+uint query_param_word(uint query, uint word) {
+  return texelFetch(query_param_texels, int(query * kQueryGpuWords + word)).x;
+}
+// The words the kernel does not use are not fetched (dead after inlining).
+QueryGpu query_params_of(uint query) {
+  const uint q = query;
+  return QueryGpu(query_param_word(q, 0u), query_param_word(q, 1u), query_param_word(q, 2u), query_param_word(q, 3u),
+                  query_param_word(q, 4u), query_param_word(q, 5u), query_param_word(q, 6u), query_param_word(q, 7u),
+                  query_param_word(q, 8u), query_param_word(q, 9u), uintBitsToFloat(query_param_word(q, 10u)),
+                  uintBitsToFloat(query_param_word(q, 11u)), query_param_word(q, 12u), query_param_word(q, 13u),
+                  query_param_word(q, 14u), query_param_word(q, 15u), query_param_word(q, 16u));
+}
+layout(std430, set = 1, binding = 11) buffer BoundKeys { uvec2 bound_keys[]; };
 // [max_batch] per query state, indexed by the query's batch index.
-layout(std430, set = 1, binding = 9) buffer States { ClusterQueryState states[]; };
+layout(std430, set = 1, binding = 12) buffer States { ClusterQueryState states[]; };
 // [work items x K] the best (key, frame) pairs of each work item (round 0's
 // items, then round 1's; at most chunk x blocks).
-layout(std430, set = 1, binding = 10) buffer BlockPairs { uvec2 block_pairs[]; };
+layout(std430, set = 1, binding = 13) buffer BlockPairs { uvec2 block_pairs[]; };
 // Per scan round r: [r] = (workgroups x, 1, 1, work items), the indirect
 // dispatch of cluster_sort's per-item steps, counted while listing; [2 + r]
 // = (workgroups x, 1, 1, tiles), cluster_scan's, written by cluster_sort's
 // prefix step (cluster_layout.hpp: kScanDispatchReset); the host zeroes
 // them before each chunk.
-layout(std430, set = 1, binding = 11) buffer ScanDispatch { uvec4 scan_dispatch[4]; };
+layout(std430, set = 1, binding = 14) buffer ScanDispatch { uvec4 scan_dispatch[4]; };
 // [chunk x blocks] (local query, block): the work items, each query's
 // items of a round consecutive.
-layout(std430, set = 1, binding = 12) buffer WorkItems { uvec2 work_items[]; };
+layout(std430, set = 1, binding = 15) buffer WorkItems { uvec2 work_items[]; };
 // [chunk x blocks] per query: the blocks it lists, before they get their
 // place among the work items.
-layout(std430, set = 1, binding = 13) buffer Listed { uint listed[]; };
+layout(std430, set = 1, binding = 16) buffer Listed { uint listed[]; };
 // The work items of a round sorted by block (cluster_sort.comp), so that a
 // scan invocation evaluates one block for a tile of the queries that visit
 // it (a row loaded once per tile, not once per query). Words, with
@@ -124,7 +150,7 @@ layout(std430, set = 1, binding = 13) buffer Listed { uint listed[]; };
 //   [3B + 1, 4B + 2)    the first tile of each block's items
 //   [4B + 2 + 2i]       item i's rank among its block's items
 //   [4B + 2 + 2j + 1]   the item at sorted position j of the round
-layout(std430, set = 1, binding = 14) buffer BlockSort { uint block_sort[]; };
+layout(std430, set = 1, binding = 17) buffer BlockSort { uint block_sort[]; };
 uint sort_fill(uint round, uint b) { return round * pc.block_count + b; }
 uint sort_item_start(uint b) { return 2u * pc.block_count + b; }
 uint sort_tile_start(uint b) { return 3u * pc.block_count + 1u + b; }

@@ -73,7 +73,7 @@ void scan_tile(uint tile) {
     item[t] = block_sort[sort_sorted(round_base + first + min(t, count - 1u))];
     const uint query = pc.query_base + work_items[item[t]].x;
     load_query(query, q[t], w[t]);
-    const QueryGpu p = query_params[query];
+    const QueryGpu p = query_params_of(query);
     bool rejects_all;
     tags[t] = tag_rule(p, rejects_all);
     // Frame r is skipped when r - 0 <= kNone: every frame.

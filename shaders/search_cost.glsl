@@ -119,8 +119,8 @@ uvec4 tag_rule(QueryGpu p, out bool rejects_all) {
 
 // The features (padded like the rows) and channel weights of query `query`.
 void load_query(uint query, out vec4 q[DV], out float w[CHANNELS]) {
-  [[unroll]] for (uint v = 0; v < DV; ++v) q[v] = query_features[query * DV + v];
-  [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[c] = query_weights[query * CHANNELS + c];
+  [[unroll]] for (uint v = 0; v < DV; ++v) q[v] = query_feature(query, v);
+  [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[c] = query_weight(query, c);
 }
 
 // The (cost, frame) pair of query `query`'s continuing frame, continuing_multiplier
@@ -129,7 +129,7 @@ void load_query(uint query, out vec4 q[DV], out float w[CHANNELS]) {
 // NaN. The scans skip this frame: it is the only row with an extra cost term
 // and exemptions from the rules, so it is evaluated once per query.
 uvec2 continuing_pair(uint query) {
-  const QueryGpu p = query_params[query];
+  const QueryGpu p = query_params_of(query);
   const uint frame = p.continuing_frame;
   if (frame == kNone) return uvec2(kNone, kNone);
   if (!frame_is_candidate(frame, texelFetch(frame_meta, int(frame)), true, p)) return uvec2(kNone, kNone);

@@ -82,6 +82,15 @@ layout(std430, set = 0, binding = 5) readonly buffer Queries { vec4 query_featur
 layout(std430, set = 0, binding = 6) readonly buffer Params { QueryGpu query_params[]; };
 // [max_batch x channels] channel weights (non-empty channels only).
 layout(std430, set = 0, binding = 7) readonly buffer Weights { float query_weights[]; };
+// The query accessors every kernel reads its queries through: here over
+// the storage buffers; a layout that defines MMVK_QUERY_TEXELS before
+// including this file (cluster_layout.glsl) defines them over texel views
+// of the same buffers. Need DV and CHANNELS (kernel_shape.glsl).
+#ifndef MMVK_QUERY_TEXELS
+vec4 query_feature(uint query, uint v) { return query_features[query * DV + v]; }
+float query_weight(uint query, uint c) { return query_weights[query * CHANNELS + c]; }
+QueryGpu query_params_of(uint query) { return query_params[query]; }
+#endif
 // [chunk queries x blocks x K] per-block best (key, frame) pairs.
 layout(std430, set = 0, binding = 8) buffer Scratch { uvec2 scratch[]; };
 // [max_batch x max_k] final best (key, frame) pairs, sorted.

@@ -335,6 +335,10 @@ Result<std::uint64_t> ClusterKernel::size_scratch(const Context& context, const 
 
 // Per slot: the scratch buffers and their set 1, written once.
 Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOptions& options, std::uint64_t chunk) {
+  if (options.slot_queries.size() != options.slots) {
+    return make_error("Vulkan: the cluster kernels need the query buffers of each of the " +
+                      std::to_string(options.slots) + " slots");
+  }
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   const struct {
     Buffer SlotScratch::*member;
@@ -368,9 +372,19 @@ Status ClusterKernel::create_slots(const Context& context, const ClusterKernelOp
     }
     MMVK_ASSIGN_OR_RETURN(slot.bound_key_view, create_texel_view(context, slot.bound_keys, VK_FORMAT_R32G32_UINT, 8,
                                                                  slot.bound_keys.size, "the cluster bound keys"));
+    const SlotQueryBuffers& queries = options.slot_queries[static_cast<std::size_t>(&slot - slots_.data())];
+    MMVK_ASSIGN_OR_RETURN(slot.query_feature_view,
+                          create_texel_view(context, *queries.features, VK_FORMAT_R32G32B32A32_SFLOAT, 16,
+                                            queries.features->size, "the query features"));
+    MMVK_ASSIGN_OR_RETURN(slot.query_param_view, create_texel_view(context, *queries.params, VK_FORMAT_R32_UINT, 4,
+                                                                   queries.params->size, "the query parameters"));
+    MMVK_ASSIGN_OR_RETURN(slot.query_weight_view, create_texel_view(context, *queries.weights, VK_FORMAT_R32_SFLOAT, 4,
+                                                                    queries.weights->size, "the query weights"));
     const std::array<VkBufferView, kClusterSet.texel> views = {
-        member_meta_.view.get(),   block_info_.view.get(),  cluster_info_.view.get(), cluster_vectors_.view.get(),
-        block_vectors_.view.get(), member_rows_.view.get(), member_cost_.view.get(),  slot.bound_key_view.get()};
+        member_meta_.view.get(),      block_info_.view.get(),       cluster_info_.view.get(),
+        cluster_vectors_.view.get(),  block_vectors_.view.get(),    member_rows_.view.get(),
+        member_cost_.view.get(),      slot.bound_key_view.get(),    slot.query_feature_view.get(),
+        slot.query_param_view.get(),  slot.query_weight_view.get()};
     MMVK_ASSIGN_OR_RETURN(slot.set, allocate_set(context, descriptor_pool_.get(), set_layout_.get(), views, handles));
   }
   return {};

@@ -38,6 +38,16 @@
 
 namespace mmvk::vulkan::detail {
 
+// One submission slot's query buffers (VulkanSearch's, set 0), which the
+// cluster kernels read through texel views of their own (set 1); the
+// buffers need VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT and must outlive the
+// kernel.
+struct SlotQueryBuffers {
+  const Buffer* features = nullptr;  // [max_batch x dim_vec4s] vec4
+  const Buffer* params = nullptr;    // [max_batch] QueryGpu
+  const Buffer* weights = nullptr;   // [max_batch x channels] float
+};
+
 struct ClusterKernelOptions {
   std::uint32_t max_batch = 1;
   std::uint32_t max_k = 1;
@@ -45,6 +55,7 @@ struct ClusterKernelOptions {
   std::uint32_t nprobe = 0;               // 0 = exact; >= cluster_count is exact too
   std::uint64_t scratch_bytes = std::uint64_t{512} << 20;  // per slot: VulkanSearchOptions::cluster_scratch_bytes
   bool force_staging = false;
+  std::vector<SlotQueryBuffers> slot_queries;  // one per slot
 };
 
 class ClusterKernel {
@@ -81,6 +92,10 @@ class ClusterKernel {
   struct SlotScratch {
     Buffer bound_keys;   // [chunk x clusters] uvec2
     UniqueBufferView bound_key_view;  // after bound_keys: destroyed first
+    // Views of the slot's query buffers (SlotQueryBuffers).
+    UniqueBufferView query_feature_view;
+    UniqueBufferView query_param_view;
+    UniqueBufferView query_weight_view;
     Buffer states;       // [max_batch] ClusterQueryState, host-mapped
     Buffer block_pairs;  // [chunk x blocks x K] uvec2, by work item
     Buffer scan_dispatch;  // 2 x (groups x, 1, 1, items): indirect args of the scans

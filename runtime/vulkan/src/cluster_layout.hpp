@@ -54,17 +54,20 @@ enum ClusterBinding : std::uint32_t {
   kBindingBlockVectors = 4,    // uniform texel, RGBA32F
   kBindingMemberRows = 5,      // uniform texel, RGBA32F
   kBindingMemberCost = 6,      // uniform texel, RG32F
-  kBindingBoundKeyTexels = 7,  // uniform texel, RG32UI: a view of the bound keys' buffer
-  kBindingBoundKeys = 8,       // storage
-  kBindingStates = 9,          // storage
-  kBindingBlockPairs = 10,     // storage
-  kBindingScanDispatch = 11,   // storage + indirect
-  kBindingWorkItems = 12,      // storage
-  kBindingListed = 13,         // storage
-  kBindingBlockSort = 14,      // storage
-  kClusterBindingCount = 15,
+  kBindingBoundKeyTexels = 7,     // uniform texel, RG32UI: a view of the bound keys' buffer
+  kBindingQueryFeatureTexels = 8,  // uniform texel, RGBA32F: a view of the slot's query features (set 0)
+  kBindingQueryParamTexels = 9,    // uniform texel, R32UI: the slot's QueryGpu array as words
+  kBindingQueryWeightTexels = 10,  // uniform texel, R32F: the slot's query weights
+  kBindingBoundKeys = 11,          // storage
+  kBindingStates = 12,             // storage
+  kBindingBlockPairs = 13,         // storage
+  kBindingScanDispatch = 14,       // storage + indirect
+  kBindingWorkItems = 15,          // storage
+  kBindingListed = 16,             // storage
+  kBindingBlockSort = 17,          // storage
+  kClusterBindingCount = 18,
 };
-inline constexpr SetShape kClusterSet{8, 7};
+inline constexpr SetShape kClusterSet{11, 7};
 static_assert(kClusterSet.texel == kBindingBoundKeys && kClusterSet.bindings() == kClusterBindingCount);
 
 // The workgroup size of cluster_scan (one invocation per work item) and

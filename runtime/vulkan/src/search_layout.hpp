@@ -34,6 +34,10 @@ struct QueryGpu {
   std::uint32_t skip_span_b;
 };
 static_assert(sizeof(QueryGpu) == 68);
+// 32-bit words of a QueryGpu (the cluster kernels read them as R32UI texels;
+// GLSL: kQueryGpuWords in cluster_layout.glsl).
+inline constexpr std::uint32_t kQueryGpuWords = sizeof(QueryGpu) / 4;
+static_assert(kQueryGpuWords == 17);
 static_assert(offsetof(QueryGpu, window_clip) == 24);
 static_assert(offsetof(QueryGpu, continuing_bias) == 40);
 static_assert(offsetof(QueryGpu, continuing_multiplier) == 44);

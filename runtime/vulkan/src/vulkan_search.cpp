@@ -220,16 +220,20 @@ Status VulkanSearch::Impl::create_slots() {
   scratch_pairs = scratch_bytes / 8;
 
   const SlotBufferBytes sizes = slot_buffer_bytes(shape, options);
+  // The cluster kernels read the query buffers through texel views too.
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  const VkBufferUsageFlags query_usage = storage | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   const struct {
     Buffer Slot::*member;
     std::uint64_t bytes;
+    VkBufferUsageFlags usage;
     const char* what;
   } buffers[] = {
-      {&Slot::queries, sizes.queries, "the query buffer"},
-      {&Slot::params, sizes.params, "the query parameter buffer"},
-      {&Slot::weights, sizes.weights, "the weight buffer"},
-      {&Slot::scratch, scratch_bytes, "the scratch buffer"},
-      {&Slot::results, sizes.results, "the result buffer"},
+      {&Slot::queries, sizes.queries, query_usage, "the query buffer"},
+      {&Slot::params, sizes.params, query_usage, "the query parameter buffer"},
+      {&Slot::weights, sizes.weights, query_usage, "the weight buffer"},
+      {&Slot::scratch, scratch_bytes, storage, "the scratch buffer"},
+      {&Slot::results, sizes.results, storage, "the result buffer"},
   };
   static_assert(std::size(buffers) == kSearchSet.storage);
   const std::array<VkBufferView, kSearchSet.texel> views = {
@@ -251,8 +255,8 @@ Status VulkanSearch::Impl::create_slots() {
     std::array<VkBuffer, kSearchSet.storage> handles{};
     for (std::size_t b = 0; b < std::size(buffers); ++b) {
       MMVK_ASSIGN_OR_RETURN(slot.*(buffers[b].member),
-                            create_buffer(*context, buffers[b].bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                          MemoryUse::HostMapped, buffers[b].what));
+                            create_buffer(*context, buffers[b].bytes, buffers[b].usage, MemoryUse::HostMapped,
+                                          buffers[b].what));
       handles[b] = (slot.*(buffers[b].member)).buffer.get();
     }
     // Padding lanes of the query vectors stay zero from here on.
@@ -280,6 +284,7 @@ Status VulkanSearch::Impl::create_cluster_kernel(const ClusterTable& table) {
   cluster_options.nprobe = options.mode == SearchMode::NProbe ? options.nprobe : 0;
   cluster_options.scratch_bytes = options.cluster_scratch_bytes;
   cluster_options.force_staging = options.force_staging_upload;
+  for (const Slot& slot : slots) cluster_options.slot_queries.push_back({&slot.queries, &slot.params, &slot.weights});
   MMVK_ASSIGN_OR_RETURN(ClusterKernel created, ClusterKernel::create(*context, command_pool.get(), set_layout.get(),
                                                                      shape, *database, table, cluster_options));
   clusters.emplace(std::move(created));

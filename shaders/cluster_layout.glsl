@@ -34,7 +34,8 @@ const uint kSeedBlocks = 4u;
 // as long as 2 while cluster_select read the bound keys as storage-buffer
 // loads; since it reads them as texels, 3 and 4 save about 1.5 ms a batch
 // of 1,024 (the round-1 scan and merge gain more than the select costs;
-// bench/RESULTS.md, 2026-11-27, "AVX2 code").
+// bench/RESULTS.md, 2026-11-27, "Both Vulkan targets on lavapipe's code
+// for an AVX2 host").
 const uint kSeedClusters = 3u;
 // Most workgroups of an indirect cluster dispatch (Vulkan's minimum of
 // maxComputeWorkGroupCount[0], cluster_layout.hpp: kMaxIndirectGroups);
@@ -97,6 +98,7 @@ layout(set = 1, binding = 6) uniform samplerBuffer member_cost;
 // the texel view, a vectorized gather on lavapipe where a storage-buffer
 // load is a scalar loop over the lanes (shared/LAVAPIPE.md).
 layout(set = 1, binding = 7) uniform usamplerBuffer bound_key_texels;
+layout(std430, set = 1, binding = 11) buffer BoundKeys { uvec2 bound_keys[]; };
 // Texel views of the slot's query buffers (set 0's query_features,
 // query_params as 32-bit words, query_weights): the per-query kernels and
 // the scan tiles load their queries through them, a gather per value
@@ -122,7 +124,6 @@ QueryGpu query_params_of(uint query) {
                   uintBitsToFloat(query_param_word(q, 11u)), query_param_word(q, 12u), query_param_word(q, 13u),
                   query_param_word(q, 14u), query_param_word(q, 15u), query_param_word(q, 16u));
 }
-layout(std430, set = 1, binding = 11) buffer BoundKeys { uvec2 bound_keys[]; };
 // [max_batch] per query state, indexed by the query's batch index.
 layout(std430, set = 1, binding = 12) buffer States { ClusterQueryState states[]; };
 // [work items x K] the best (key, frame) pairs of each work item (round 0's

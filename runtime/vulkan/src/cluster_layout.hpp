@@ -47,14 +47,14 @@ static_assert(offsetof(ClusterQueryState, items1) == 32);
 // Descriptor bindings of set 1 (cluster_layout.glsl); set 0 is the search
 // layout (search_layout.hpp).
 enum ClusterBinding : std::uint32_t {
-  kBindingMemberMeta = 0,      // uniform texel, RGBA32UI
-  kBindingBlockInfo = 1,       // uniform texel, RGBA32UI, 2 per block
-  kBindingClusterInfo = 2,     // uniform texel, RGBA32UI
-  kBindingClusterVectors = 3,  // uniform texel, RGBA32F
-  kBindingBlockVectors = 4,    // uniform texel, RGBA32F
-  kBindingMemberRows = 5,      // uniform texel, RGBA32F
-  kBindingMemberCost = 6,      // uniform texel, RG32F
-  kBindingBoundKeyTexels = 7,     // uniform texel, RG32UI: a view of the bound keys' buffer
+  kBindingMemberMeta = 0,          // uniform texel, RGBA32UI
+  kBindingBlockInfo = 1,           // uniform texel, RGBA32UI, 2 per block
+  kBindingClusterInfo = 2,         // uniform texel, RGBA32UI
+  kBindingClusterVectors = 3,      // uniform texel, RGBA32F
+  kBindingBlockVectors = 4,        // uniform texel, RGBA32F
+  kBindingMemberRows = 5,          // uniform texel, RGBA32F
+  kBindingMemberCost = 6,          // uniform texel, RG32F
+  kBindingBoundKeyTexels = 7,      // uniform texel, RG32UI: a view of the bound keys' buffer
   kBindingQueryFeatureTexels = 8,  // uniform texel, RGBA32F: a view of the slot's query features (set 0)
   kBindingQueryParamTexels = 9,    // uniform texel, R32UI: the slot's QueryGpu array as words
   kBindingQueryWeightTexels = 10,  // uniform texel, R32F: the slot's query weights
@@ -82,8 +82,8 @@ inline constexpr std::uint32_t kItemsPerScanGroup = kScanWorkgroup;
 // query. Bandai volume set (646 clusters), transition, B = 1024, the pass
 // alone, lavapipe's AVX2 / AVX-512 code: 5 clusters an invocation took
 // about 15 / 7 ms a batch, 10 about 11 / 7.8, 81 about 6.4 / 5.7
-// (bench/RESULTS.md, 2026-11-27, "the bounds pass in the search's
-// workgroup").
+// (bench/RESULTS.md, 2026-11-27, "Both Vulkan targets on lavapipe's code
+// for an AVX2 host").
 inline constexpr std::uint32_t kClustersPerBoundsInvocation = 128;
 
 // GLSL: ScanDispatch, (groups x, 1, 1, count) per scan round for the

@@ -48,8 +48,9 @@
 //   tests nothing (Bandai volume set, B = 1,024: 5% faster with lavapipe's
 //   code for an AVX2 host, 4% with its AVX-512 code).
 // - Rows are scanned in descending order (their frames ascend with them),
-//   so `cost <= best` keeps the lowest frame among equal costs (the reference's order), accepts an
-//   infinite cost into an empty slot and rejects NaN, in one comparison.
+//   so `cost <= best` keeps the lowest frame among equal costs (the
+//   reference's order), accepts an infinite cost into an empty slot and
+//   rejects NaN, in one comparison (keep_row(), top_k.glsl).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -77,6 +78,15 @@ void widen_band(uint a, uint span, uint first, uint step, uint steps, inout uint
   if (j_first >= j_end) return;
   lo = min(lo, j_first);
   hi = max(hi, j_end);
+}
+
+// Scan row `row`'s terms (tags lo, tags hi, multiplier bits, bias bits;
+// not read, zeros, when no tag and no cost term can matter: a database
+// without tags, multipliers or biases) and features.
+void load_row(uint row, out uvec4 terms, out vec4 x[DV]) {
+  terms = uvec4(0u);
+  if (TAG_WORDS != 0u || UNIT_COST_TERMS == 0u) terms = texelFetch(scan_terms, int(row));
+  [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(row, v));
 }
 
 // The frame of scan row `row`.
@@ -141,13 +151,10 @@ void main() {
   for (uint n = steps - band; n > 0u;) {
     --n;
     const uint row = first + (n < band_lo ? n : n + band) * step;
-    // (tags lo, tags hi, multiplier, bias), not read when no tag and no
-    // cost term can matter (a database without tags, multipliers or biases).
-    uvec4 terms = uvec4(0u);
-    if (TAG_WORDS != 0u || UNIT_COST_TERMS == 0u) terms = texelFetch(scan_terms, int(row));
-    const vec2 scale_bias = uintBitsToFloat(terms.zw);
+    uvec4 terms;
     vec4 x[DV];
-    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(row, v));
+    load_row(row, terms, x);
+    const vec2 scale_bias = uintBitsToFloat(terms.zw);
 
     // Two queries at a time (row_totals2()), the last alone when T is odd.
     [[unroll]] for (uint pair = 0; pair < T; pair += 2u) {
@@ -168,31 +175,20 @@ void main() {
         const bool tag_rejected_lo = TAG_WORDS >= 1u && (terms.x & tags[t].x) != tags[t].z;
         const bool tag_rejected_hi = TAG_WORDS >= 2u && (terms.y & tags[t].y) != tags[t].w;
         const bool rejected = tag_rejected_lo || tag_rejected_hi;
-        if (K == 1u) {
-          const bool cheaper = cost <= best_cost[t];
-          const bool better = !rejected && cheaper;
-          // mix() with a bool is OpSelect; `?:` on an array element is a branch.
-          best_cost[t] = mix(best_cost[t], cost, better);
-          best_row[t] = mix(best_row[t], row, better);
-        } else if (!rejected && !(cost > worst[t])) {
-          // Rare once good rows were seen (but lavapipe masks, not skips, it).
-          insert_row(best[t], worst[t], cost, row);
-        }
+        keep_row(best_cost[t], best_row[t], best[t], worst[t], cost, row, rejected, true);
       }
     }
   }
-
 
   // The band, with the skip tests (its loop over the tile is unrolled too:
   // indexing the tile's arrays by a loop variable moved them to memory for
   // the whole kernel, 20% slower).
   for (uint j = band_lo; j < band_hi; ++j) {
     const uint row = first + j * step;
-    uvec4 terms = uvec4(0u);
-    if (TAG_WORDS != 0u || UNIT_COST_TERMS == 0u) terms = texelFetch(scan_terms, int(row));
-    const vec2 scale_bias = uintBitsToFloat(terms.zw);
+    uvec4 terms;
     vec4 x[DV];
-    [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(row, v));
+    load_row(row, terms, x);
+    const vec2 scale_bias = uintBitsToFloat(terms.zw);
     [[unroll]] for (uint t = 0; t < T; ++t) {
       const float total = row_total(x, q[t], w[t]);
       const float cost = UNIT_COST_TERMS != 0u ? total : scaled_cost(total, scale_bias);
@@ -201,15 +197,7 @@ void main() {
       const bool skipped_a = row - skipped[t].x <= skipped[t].y;
       const bool skipped_b = row - skipped[t].z <= skipped[t].w;
       const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b;
-      if (K == 1u) {
-        const bool cheaper = cost < best_cost[t];
-        const bool tie_lower = cost == best_cost[t] && row < best_row[t];
-        const bool better = !rejected && (cheaper || tie_lower);
-        best_cost[t] = mix(best_cost[t], cost, better);
-        best_row[t] = mix(best_row[t], row, better);
-      } else if (!rejected && !(cost > worst[t])) {
-        insert_row(best[t], worst[t], cost, row);
-      }
+      keep_row(best_cost[t], best_row[t], best[t], worst[t], cost, row, rejected, false);
     }
   }
 
@@ -220,7 +208,8 @@ void main() {
     if (rejects_all[t]) {
       [[unroll]] for (uint j = 0; j < K; ++j) scratch[base + j] = uvec2(kNone, kNone);
     } else if (K == 1u) {
-      scratch[base] = best_row[t] == kNone ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost[t]), frame_of_row(best_row[t]));
+      const bool empty = best_row[t] == kNone;
+      scratch[base] = empty ? uvec2(kNone, kNone) : uvec2(orderable_bits(best_cost[t]), frame_of_row(best_row[t]));
     } else {
       [[unroll]] for (uint j = 0; j < K; ++j) {
         scratch[base + j] = best[t][j].y == kNone ? best[t][j] : uvec2(best[t][j].x, frame_of_row(best[t][j].y));

@@ -4,8 +4,9 @@
 //  round 0: cluster_select's items; the k-th best key is the upper bound
 //           of round 1 (kSkip while fewer than k were found); lists, of the
 //           clusters whose bound key is <= it, the blocks not scanned in
-//           round 0 whose own bound key is <= it (block-level culling: a block's box is much
-//           tighter than its cluster's) for scan round 1.
+//           round 0 whose own bound key is <= it (block-level culling: a
+//           block's box is much tighter than its cluster's) for scan
+//           round 1.
 //  round 1: the items of both rounds; writes the results and the number of
 //           rows evaluated.
 // The loops run at most cluster_count + 2 x block_count iterations per
@@ -45,10 +46,11 @@ uint merge_items(inout uvec2 best[K], uvec2 items) {
 // over their blocks ran the union of the lanes' blocks (the largest cost of
 // small blocks on lavapipe). Blocks are listed at the row's front: before
 // the m-th cluster taken is tested, at most (its blocks and the earlier
-// ones') <= block_count - (clusters left) entries are written, so the front never reaches a tail entry still to be read. The
-// order of the items does not change the results (the merges insert pairs
-// in a strict total order). At most cluster_count, then cluster_count +
-// block_count iterations.
+// ones') <= block_count - (clusters left) entries are written, so the
+// front never reaches a tail entry still to be read. The order of the
+// items does not change the results (the merges insert pairs in a strict
+// total order). At most cluster_count, then cluster_count + block_count
+// iterations.
 uint list_other_blocks(uint local_query, uvec2 items0, uint upper, vec4 q[DV], float w[CHANNELS]) {
   // Round 0's blocks (at most kSeedBlocks), kNone where fewer.
   uint seed_blocks[kSeedBlocks];

@@ -77,7 +77,8 @@ void scan_tile(uint tile) {
     bool rejects_all;
     tags[t] = tag_rule(p, rejects_all);
     // Frame r is skipped when r - 0 <= kNone: every frame.
-    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : uvec4(p.skip_first_a, p.skip_span_a, p.skip_first_b, p.skip_span_b);
+    const uvec4 ranges = uvec4(p.skip_first_a, p.skip_span_a, p.skip_first_b, p.skip_span_b);
+    skipped[t] = rejects_all ? uvec4(0u, kNone, 0u, kNone) : ranges;
     best_cost[t] = kInfinity;
     best_frame[t] = kNone;
     clear_pairs(best[t]);
@@ -118,15 +119,7 @@ void scan_tile(uint tile) {
         const bool skipped_a = r - skipped[t].x <= skipped[t].y;
         const bool skipped_b = r - skipped[t].z <= skipped[t].w;
         const bool rejected = tag_rejected_lo || tag_rejected_hi || skipped_a || skipped_b || never_unit;
-        if (K == 1u) {
-          const bool cheaper = cost <= best_cost[t];
-          const bool better = !rejected && cheaper;
-          // mix() with a bool is OpSelect; `?:` on an array element is a branch.
-          best_cost[t] = mix(best_cost[t], cost, better);
-          best_frame[t] = mix(best_frame[t], r, better);
-        } else if (!rejected && !(cost > worst[t])) {
-          insert_row(best[t], worst[t], cost, r);
-        }
+        keep_row(best_cost[t], best_frame[t], best[t], worst[t], cost, r, rejected, true);
       }
     }
   }

@@ -147,12 +147,12 @@ void main() {
     }
   }
 
-  const uvec2 continuing = continuing_pair(query);
+  vec4 q[DV];
+  float w[CHANNELS];
+  load_query(query, q, w);
+  const uvec2 continuing = continuing_pair(query, q, w);
   uvec2 items = uvec2(0u, 0u);
   if (seeds[0] != kNone) {
-    vec4 q[DV];
-    float w[CHANNELS];
-    load_query(query, q, w);
     const uint upper = pc.k == 1u && continuing.y != kNone ? continuing.x : kSkip;
     items = move_listed(0u, local_query, least_blocks(local_query, seeds, upper, q, w));
   }

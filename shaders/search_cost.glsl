@@ -109,8 +109,9 @@ float row_cost(vec4 x[DV], vec4 q[DV], float w[CHANNELS], vec2 scale_bias) {
 
 // Query p's tag rules as one test per tag word w < TAG_WORDS: a row passes
 // when (row tags & mask) == wanted, with mask = require | exclude and
-// wanted = require (the scans' one test per word and row). rejects_all: no row can pass (a tag both required and
-// excluded, or required in a word no frame uses).
+// wanted = require (the scans' one test per word and row). rejects_all:
+// no row can pass (a tag both required and excluded, or required in a word
+// no frame uses).
 uvec4 tag_rule(QueryGpu p, out bool rejects_all) {
   rejects_all = (p.require_lo & p.exclude_lo) != 0u || (p.require_hi & p.exclude_hi) != 0u ||
                 (TAG_WORDS < 1u && p.require_lo != 0u) || (TAG_WORDS < 2u && p.require_hi != 0u);
@@ -123,21 +124,19 @@ void load_query(uint query, out vec4 q[DV], out float w[CHANNELS]) {
   [[unroll]] for (uint c = 0; c < CHANNELS; ++c) w[c] = query_weight(query, c);
 }
 
-// The (cost, frame) pair of query `query`'s continuing frame, continuing_multiplier
-// and continuing_bias included, or (kNone, kNone) when it has none (validate_search keeps it
-// below the frame count otherwise), it is not a candidate or its cost is
-// NaN. The scans skip this frame: it is the only row with an extra cost term
+// The (cost, frame) pair of query `query`'s continuing frame (q, w: the
+// query's features and weights, load_query()), continuing_multiplier and
+// continuing_bias included, or (kNone, kNone) when it has none
+// (validate_search keeps it below the frame count otherwise), it is not a
+// candidate or its cost is NaN. The scans skip this frame: it is the only row with an extra cost term
 // and exemptions from the rules, so it is evaluated once per query.
-uvec2 continuing_pair(uint query) {
+uvec2 continuing_pair(uint query, vec4 q[DV], float w[CHANNELS]) {
   const QueryGpu p = query_params_of(query);
   const uint frame = p.continuing_frame;
   if (frame == kNone) return uvec2(kNone, kNone);
   if (!frame_is_candidate(frame, texelFetch(frame_meta, int(frame)), true, p)) return uvec2(kNone, kNone);
   vec4 x[DV];
-  vec4 q[DV];
-  float w[CHANNELS];
   [[unroll]] for (uint v = 0; v < DV; ++v) x[v] = texelFetch(features, feature_texel(p.continuing_row, v));
-  load_query(query, q, w);
   // mmvk::frame_cost's order: (multiplier * total + bias) * continuing_multiplier
   // + continuing_bias, each step rounded (precise: no fused multiply-add).
   precise float cost = row_cost(x, q, w, texelFetch(frame_cost, int(frame)).xy) * p.continuing_multiplier;

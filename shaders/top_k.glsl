@@ -36,4 +36,28 @@ void insert_row(inout uvec2 best[K], inout float worst, float cost, uint frame) 
   }
 }
 
+// Keeps the row of frame (or scan row) `row` and cost `cost` among a
+// query's best unless `rejected`. K = 1: (best_cost, best_row), a row of
+// kNone an empty slot; when rows arrive in descending order
+// (`descending`), `cost <= best_cost` keeps the lower row among equal
+// costs, accepts an infinite cost into an empty slot and rejects NaN in
+// one comparison, else the tie is decided by the row. K > 1: insert_row()
+// behind its one-compare prefilter (a strict pair order, any arrival
+// order). Branch-free for K = 1: mix() with a bool is OpSelect, and every
+// operand of || and && is a named bool (glslang compiles a short-circuit
+// operator whose right side is an expression into a branch).
+void keep_row(inout float best_cost, inout uint best_row, inout uvec2 best[K], inout float worst, float cost, uint row,
+              bool rejected, bool descending) {
+  if (K == 1u) {
+    const bool cheaper = descending ? cost <= best_cost : cost < best_cost;
+    const bool tie_lower = !descending && cost == best_cost && row < best_row;
+    const bool better = !rejected && (cheaper || tie_lower);
+    best_cost = mix(best_cost, cost, better);
+    best_row = mix(best_row, row, better);
+  } else if (!rejected && !(cost > worst)) {
+    // Rare once good rows were seen (but lavapipe masks, not skips, it).
+    insert_row(best, worst, cost, row);
+  }
+}
+
 #endif

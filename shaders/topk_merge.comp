@@ -26,7 +26,13 @@ void main() {
   for (uint block = 0; block < pc.block_count; ++block) {
     [[unroll]] for (uint i = 0; i < K; ++i) insert_pair(best, scratch[base + block * K + i]);
   }
-  if (ADD_CONTINUING) insert_pair(best, continuing_pair(pc.query_base + local_query));
+  if (ADD_CONTINUING) {
+    const uint query = pc.query_base + local_query;
+    vec4 q[DV];
+    float w[CHANNELS];
+    load_query(query, q, w);
+    insert_pair(best, continuing_pair(query, q, w));
+  }
 
   const uint out_base = (pc.query_base + local_query) * K;
   [[unroll]] for (uint j = 0; j < K; ++j) results[out_base + j] = best[j];

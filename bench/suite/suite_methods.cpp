@@ -161,8 +161,11 @@ struct SuiteMethodFactory::Shared {
     } else if (backend != "reference") {
       method.index_bytes += tiled_copy_bytes(db);
       // ClusterSearch keeps its rows at half precision (half_filter, on by
-      // default): 2 bytes a value instead of 4.
-      if (entry->uses_cluster_table) method.index_bytes -= double(db.frame_count()) * db.dims() * 2.0;
+      // default) and its tile boxes too: 2 bytes a value instead of 4.
+      if (entry->uses_cluster_table) {
+        const double tiles = double((db.frame_count() + kFastTileRows - 1) / kFastTileRows);
+        method.index_bytes -= (double(db.frame_count()) + 2.0 * tiles) * db.dims() * 2.0;
+      }
     }
     return method;
   }

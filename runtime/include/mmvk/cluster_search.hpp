@@ -19,7 +19,9 @@
 // cluster bounds never need to account for continuing_bias.
 // Within a visited cluster, the members (in frame order, so mostly runs of
 // neighbouring frames) are evaluated in tiles of 16 rows, and a tile whose
-// own box bound is above the k-th best is skipped (same box-bound argument).
+// own box bound is above the k-th best is skipped (same box-bound argument;
+// the tile boxes, and the boxes of spans of 16 tiles, are held as halves
+// rounded outward, so each still holds its rows).
 // Clusters are skipped without evaluation when their tag union misses the
 // query's require_all mask, their tag intersection hits exclude_any, or all
 // their members are do-not-use, edge-excluded or block-transition.

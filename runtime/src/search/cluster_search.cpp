@@ -45,10 +45,10 @@ void place_clusters(ClusterSearch::Layout& l, std::uint32_t& tile_packs) {
   }
 }
 
-// A box per tile, and the rows each tile holds.
+// A box per tile (halves, rounded outward), and the rows each tile holds.
 void build_tile_boxes(ClusterSearch::Layout& l, const Database& database, std::uint32_t tile_packs) {
   const std::uint32_t k = l.table.cluster_count;
-  l.tile_boxes = detail::BoxPacks(tile_packs, l.dims);
+  detail::BoxPacks tile_boxes(tile_packs, l.dims);
   l.tile_rows.assign(l.tile_offsets[k], 0);
   for (std::uint32_t c = 0; c < k; ++c) {
     for (std::uint32_t tile = l.tile_offsets[c]; tile < l.tile_offsets[c + 1]; ++tile) {
@@ -59,12 +59,14 @@ void build_tile_boxes(ClusterSearch::Layout& l, const Database& database, std::u
         box.add_row(database.row(f), database.frame_multiplier()[f], database.frame_bias()[f]);
         ++l.tile_rows[tile];
       }
-      l.tile_boxes.set(std::size_t{l.tile_box_pack[c]} * kLanes + (tile - l.tile_offsets[c]), box);
+      tile_boxes.set(std::size_t{l.tile_box_pack[c]} * kLanes + (tile - l.tile_offsets[c]), box);
     }
   }
+  l.tile_boxes = detail::HalfBoxPacks(std::move(tile_boxes));
 }
 
-// A box per span of 16 tiles, for clusters of more than one span.
+// A box per span of 16 tiles (halves, rounded outward), for clusters of
+// more than one span.
 void build_span_boxes(ClusterSearch::Layout& l, const Database& database) {
   const std::uint32_t k = l.table.cluster_count;
   l.span_box_pack.assign(k, kNoCluster);
@@ -75,7 +77,7 @@ void build_span_boxes(ClusterSearch::Layout& l, const Database& database) {
     l.span_box_pack[c] = span_packs;
     span_packs += static_cast<std::uint32_t>(packs_of(spans));
   }
-  l.span_boxes = detail::BoxPacks(span_packs, l.dims);
+  detail::BoxPacks span_boxes(span_packs, l.dims);
   for (std::uint32_t c = 0; c < k; ++c) {
     if (l.span_box_pack[c] == kNoCluster) continue;
     const std::size_t first_slot = std::size_t{l.tile_offsets[c]} * kLanes;
@@ -87,9 +89,10 @@ void build_span_boxes(ClusterSearch::Layout& l, const Database& database) {
         const std::uint32_t f = l.frame[slot];
         if (f != kNoFrame) box.add_row(database.row(f), database.frame_multiplier()[f], database.frame_bias()[f]);
       }
-      l.span_boxes.set(std::size_t{l.span_box_pack[c]} * kLanes + span, box);
+      span_boxes.set(std::size_t{l.span_box_pack[c]} * kLanes + span, box);
     }
   }
+  l.span_boxes = detail::HalfBoxPacks(std::move(span_boxes));
 }
 
 // The clusters' boxes and centroids, from the (reordered) table.
@@ -216,13 +219,13 @@ void bound_tiles(const WalkContext& x, Scratch& s, const QueryView& v, std::uint
   if (x.options.tile_bound && (!x.options.span_bound || l.span_box_pack[c] == kNoCluster)) {
     // Members are in frame order, so a tile mostly holds neighbouring
     // frames of a clip and its box is tight.
-    l.kernels.box_bounds(x.tile_boxes, l.tile_box_pack[c], packs_of(tiles), v.q, v.w, s.tile_bound.data());
+    l.kernels.half_box_bounds(x.tile_boxes, l.tile_box_pack[c], packs_of(tiles), v.q, v.w, s.tile_bound.data());
     s.counters.tiles_checked += tiles;
   } else if (x.options.tile_bound) {
     // Spans of 16 tiles first: the tile bounds of a span whose own bound is
     // above the k-th best are never computed (+inf: skipped below).
     const std::size_t spans = packs_of(tiles);
-    l.kernels.box_bounds(x.span_boxes, l.span_box_pack[c], packs_of(spans), v.q, v.w, s.span_bound.data());
+    l.kernels.half_box_bounds(x.span_boxes, l.span_box_pack[c], packs_of(spans), v.q, v.w, s.span_bound.data());
     const float threshold = v.best.back().cost;
     for (std::size_t span = 0; span < spans;) {
       if (s.span_bound[span] > threshold) {
@@ -232,8 +235,8 @@ void bound_tiles(const WalkContext& x, Scratch& s, const QueryView& v, std::uint
       }
       std::size_t run_end = span + 1;
       while (run_end < spans && !(s.span_bound[run_end] > threshold)) ++run_end;
-      l.kernels.box_bounds(x.tile_boxes, l.tile_box_pack[c] + span, run_end - span, v.q, v.w,
-                           s.tile_bound.data() + span * kLanes);
+      l.kernels.half_box_bounds(x.tile_boxes, l.tile_box_pack[c] + span, run_end - span, v.q, v.w,
+                                s.tile_bound.data() + span * kLanes);
       s.counters.tiles_checked += (run_end - span) * kLanes;
       span = run_end;
     }

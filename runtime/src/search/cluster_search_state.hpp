@@ -138,7 +138,10 @@ struct ClusterSearch::Layout {
   // The box of each tile's member rows, with their minimum multiplier and
   // bias. A cluster's tile boxes start a pack of their own, so its bounds
   // are whole packs: tile i of cluster c is box tile_box_pack[c] * 16 + i.
-  detail::BoxPacks tile_boxes;
+  // Held as halves, rounded outward: the bounds read half the bytes (a lone
+  // query waits on them), and a box widened to halves prunes almost the
+  // same tiles (0.2% more pass on the Bandai volume set).
+  detail::HalfBoxPacks tile_boxes;
   std::vector<std::uint32_t> tile_box_pack;  // [clusters]
   std::vector<std::uint8_t> tile_rows;       // [tiles]: member rows (the rest is padding)
   std::uint32_t max_cluster_tiles = 0;
@@ -146,7 +149,8 @@ struct ClusterSearch::Layout {
   // 16 tiles (one tile-box pack) of a cluster with more than one span,
   // packed like the tile boxes: span j of cluster c is box span_box_pack[c]
   // * 16 + j; kNoCluster for a cluster of one span (its cluster box is it).
-  detail::BoxPacks span_boxes;
+  // Halves, as the tile boxes.
+  detail::HalfBoxPacks span_boxes;
   std::vector<std::uint32_t> span_box_pack;  // [clusters]
   detail::BoxPacks cluster_boxes;            // box c: the table's box, min_multiplier and min_bias
   // Box c: [centroid, centroid], multiplier 1, bias 0, so its bound is the
@@ -180,8 +184,8 @@ struct WalkContext {
   const ClusterSearch::Layout& l;
   const ClusterSearchOptions& options;
   detail::TileArrays tiles;
-  detail::BoxArrays tile_boxes;
-  detail::BoxArrays span_boxes;
+  detail::HalfBoxArrays tile_boxes;
+  detail::HalfBoxArrays span_boxes;
   detail::HalfTileArrays half_tiles;
 };
 

@@ -1,5 +1,6 @@
 // IEEE binary16 ("half") conversions in portable code: the half-precision
-// tiles are built with float_to_half, and the baseline kernels read them
+// tiles are built with float_to_half (the half boxes with its directed
+// forms), and the baseline kernels read them
 // with half_to_float (the x86 kernels use F16C / AVX-512's vcvtph2ps, which
 // converts exactly as half_to_float does: every half is a float).
 #pragma once
@@ -44,6 +45,25 @@ inline std::uint16_t float_to_half(float f) {
   const std::uint32_t rest = magnitude & 0x1fffu;
   if (rest > 0x1000u || (rest == 0x1000u && (h & 1u) != 0)) ++h;  // a carry moves to the next binade, as it should
   return static_cast<std::uint16_t>(sign | h);
+}
+
+// Directed rounding, for boxes that must hold their float box (a box's low
+// ends rounded down, its high ends up): the largest half <= f, for any f
+// but NaN (below -kHalfMax: -inf; above it: kHalfMax).
+inline std::uint16_t float_to_half_down(float f) {
+  if (f < -kHalfMax) return 0xfc00u;
+  if (f > kHalfMax) return 0x7bffu;
+  const std::uint16_t h = float_to_half(f);
+  if (!(half_to_float(h) > f)) return h;
+  // One half toward -inf: +0 goes to the negative subnormal nearest 0, a
+  // positive half down in magnitude, a negative one up.
+  if (h == 0) return 0x8001u;
+  return static_cast<std::uint16_t>((h & 0x8000u) != 0 ? h + 1u : h - 1u);
+}
+
+// The smallest half >= f, for any f but NaN: -round_down(-f).
+inline std::uint16_t float_to_half_up(float f) {
+  return static_cast<std::uint16_t>(float_to_half_down(-f) ^ 0x8000u);
 }
 
 }  // namespace mmvk::detail

@@ -305,7 +305,7 @@ struct PassBits {
     return bits;
   }
 };
-#include "search/half_filter_kernel.inc"
+#include "search/half_kernels.inc"
 }  // namespace half_generic
 #if defined(__x86_64__) && defined(__clang__)
 // Clang ignores GCC's target pragmas (the kernels would be built for SSE2
@@ -317,11 +317,11 @@ struct PassBits {
 MMVK_DEFINE_KERNELS(avx2, V8)
 #pragma clang attribute pop
 #pragma clang attribute push(__attribute__((target("avx2,f16c"))), apply_to = function)
-#include "search/half_filter_avx2.inc"
+#include "search/half_kernels_avx2.inc"
 #pragma clang attribute pop
 #pragma clang attribute push(__attribute__((target("avx512f"))), apply_to = function)
 MMVK_DEFINE_KERNELS(avx512, V16)
-#include "search/half_filter_avx512.inc"
+#include "search/half_kernels_avx512.inc"
 #pragma clang attribute pop
 #elif defined(__x86_64__) && defined(__GNUC__)
 #define MMVK_HAS_X86_KERNELS 1
@@ -331,16 +331,19 @@ MMVK_DEFINE_KERNELS(avx2, V8)
 #pragma GCC pop_options
 #pragma GCC push_options
 #pragma GCC target("avx2,f16c")
-#include "search/half_filter_avx2.inc"
+#include "search/half_kernels_avx2.inc"
 #pragma GCC pop_options
 #pragma GCC push_options
 #pragma GCC target("avx512f")
 MMVK_DEFINE_KERNELS(avx512, V16)
-#include "search/half_filter_avx512.inc"
+#include "search/half_kernels_avx512.inc"
 #pragma GCC pop_options
 #endif
 
-Kernels generic_kernels() { return {evaluate_tiles_generic, box_bounds_generic, half_generic::half_filter, "generic", 2}; }
+Kernels generic_kernels() {
+  return {evaluate_tiles_generic, box_bounds_generic, half_generic::half_box_bounds, half_generic::half_filter,
+          "generic", 2};
+}
 
 #if defined(MMVK_HAS_X86_KERNELS)
 // F16C from CPUID leaf 1 (Clang's __builtin_cpu_supports has no "f16c").
@@ -349,13 +352,18 @@ bool has_f16c() {
   return __get_cpuid(1, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_F16C) != 0;
 }
 
-// AVX2 machines without F16C (none are known) filter with the baseline
-// conversion.
+// AVX2 machines without F16C (none are known) read halves with the
+// baseline conversion.
 Kernels avx2_kernels() {
-  return {evaluate_tiles_avx2, box_bounds_avx2, has_f16c() ? half_avx2::half_filter : half_generic::half_filter,
-          "avx2", 4};
+  if (!has_f16c()) {
+    return {evaluate_tiles_avx2, box_bounds_avx2, half_generic::half_box_bounds, half_generic::half_filter, "avx2", 4};
+  }
+  return {evaluate_tiles_avx2, box_bounds_avx2, half_avx2::half_box_bounds, half_avx2::half_filter, "avx2", 4};
 }
-Kernels avx512_kernels() { return {evaluate_tiles_avx512, box_bounds_avx512, half_avx512::half_filter, "avx512f", 4}; }
+Kernels avx512_kernels() {
+  return {evaluate_tiles_avx512, box_bounds_avx512, half_avx512::half_box_bounds, half_avx512::half_filter, "avx512f",
+          4};
+}
 #endif
 
 }  // namespace

@@ -52,6 +52,18 @@ struct BoxArrays {
   std::uint32_t dims;
 };
 
+// BoxArrays at half precision (HalfBoxPacks): lo rounded down and hi
+// rounded up, so each box holds the float box it came from.
+struct HalfBoxArrays {
+  const std::uint16_t* lo;
+  const std::uint16_t* hi;
+  const float* min_multiplier;
+  const float* min_bias;
+  const std::uint32_t* channel_end;
+  std::uint32_t channels;
+  std::uint32_t dims;
+};
+
 // Tiles at half precision (half_tile_store.hpp): [tile][dims][16] IEEE
 // binary16 features, and [tile] masks of the lanes that may be candidates
 // (bit l: lane l).
@@ -79,6 +91,12 @@ struct Kernels {
   // skipped.
   void (*box_bounds)(const BoxArrays& boxes, std::size_t first_pack, std::size_t pack_count, const float* query,
                      const float* weights, float* out);
+  // box_bounds over boxes held as halves (ClusterSearch's tile and span
+  // boxes): the same operations on each half widened to float. A half box
+  // holds its float box, so its bound is at most the float box's and never
+  // exceeds the cost of a row inside.
+  void (*half_box_bounds)(const HalfBoxArrays& boxes, std::size_t first_pack, std::size_t pack_count,
+                          const float* query, const float* weights, float* out);
   // ClusterSearch's first filter, for one query: distances[i * 16 + l] gets
   // lane l's distance over the half rows of tile tile_ids[i], sum_ch w_ch
   // sum_d (q_d - xh_d)^2 summed in the cost's order, and masks[i] the valid

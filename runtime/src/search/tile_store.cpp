@@ -1,7 +1,9 @@
 #include "search/tile_store.hpp"
 
 #include <algorithm>
+#include <utility>
 
+#include "search/half_float.hpp"
 #include "search/top_k.hpp"
 
 namespace mmvk::detail {
@@ -73,6 +75,18 @@ void BoxPacks::set(std::size_t box, const float* lo_values, const float* hi_valu
   }
   min_multiplier[box] = multiplier;
   min_bias[box] = bias;
+}
+
+HalfBoxPacks::HalfBoxPacks(BoxPacks&& boxes)
+    : lo(boxes.lo.size()),
+      hi(boxes.hi.size()),
+      min_multiplier(std::move(boxes.min_multiplier)),
+      min_bias(std::move(boxes.min_bias)),
+      dims(boxes.dims) {
+  for (std::size_t i = 0; i < boxes.lo.size(); ++i) {
+    lo[i] = float_to_half_down(boxes.lo[i]);
+    hi[i] = float_to_half_up(boxes.hi[i]);
+  }
 }
 
 }  // namespace mmvk::detail

@@ -101,4 +101,22 @@ struct BoxPacks {
   }
 };
 
+// BoxPacks at half precision, in half the bytes: each lo rounded down and
+// each hi rounded up (float_to_half_down / _up), so a half box holds the
+// float box it came from and its bound (Kernels::half_box_bounds) stays a
+// lower bound of its rows' costs. The minimum multipliers and biases stay
+// floats.
+struct HalfBoxPacks {
+  AlignedArray<std::uint16_t> lo, hi;        // [packs][dims][16]
+  AlignedFloats min_multiplier, min_bias;    // [packs][16]
+  std::uint32_t dims = 0;
+
+  HalfBoxPacks() = default;
+  explicit HalfBoxPacks(BoxPacks&& boxes);
+  HalfBoxArrays arrays(const std::vector<std::uint32_t>& channel_end) const {
+    return {lo.data(), hi.data(), min_multiplier.data(), min_bias.data(), channel_end.data(),
+            static_cast<std::uint32_t>(channel_end.size()), dims};
+  }
+};
+
 }  // namespace mmvk::detail

@@ -116,8 +116,7 @@ uint query_param_word(uint query, uint word) {
   return texelFetch(query_param_texels, int(query * kQueryGpuWords + word)).x;
 }
 // The words the kernel does not use are not fetched (dead after inlining).
-QueryGpu query_params_of(uint query) {
-  const uint q = query;
+QueryGpu query_params_of(uint q) {
   return QueryGpu(query_param_word(q, 0u), query_param_word(q, 1u), query_param_word(q, 2u), query_param_word(q, 3u),
                   query_param_word(q, 4u), query_param_word(q, 5u), query_param_word(q, 6u), query_param_word(q, 7u),
                   query_param_word(q, 8u), query_param_word(q, 9u), uintBitsToFloat(query_param_word(q, 10u)),

@@ -60,11 +60,14 @@ double cluster_table_bytes(const ClusterTable& t) {
          vector_bytes(t.channel_radius);
 }
 
+// Tiles of 16 rows (kFastTileRows) that hold every frame.
+double tile_count(const Database& db) { return double((db.frame_count() + kFastTileRows - 1) / kFastTileRows); }
+
 // FastSearch's and ClusterSearch's tiled copy (mmvk/fast_search.hpp): rows
 // in tiles of 16, each tile with a min/max box, plus fast-box's group boxes
 // of 256 rows. Computed from the documented layout, not measured.
 double tiled_copy_bytes(const Database& db) {
-  const double tiles = double((db.frame_count() + kFastTileRows - 1) / kFastTileRows);
+  const double tiles = tile_count(db);
   const double groups = double((db.frame_count() + 255) / 256);
   return (tiles * kFastTileRows + 2.0 * tiles + 2.0 * groups) * db.dims() * sizeof(float);
 }
@@ -163,8 +166,7 @@ struct SuiteMethodFactory::Shared {
       // ClusterSearch keeps its rows at half precision (half_filter, on by
       // default) and its tile boxes too: 2 bytes a value instead of 4.
       if (entry->uses_cluster_table) {
-        const double tiles = double((db.frame_count() + kFastTileRows - 1) / kFastTileRows);
-        method.index_bytes -= (double(db.frame_count()) + 2.0 * tiles) * db.dims() * 2.0;
+        method.index_bytes -= (double(db.frame_count()) + 2.0 * tile_count(db)) * db.dims() * 2.0;
       }
     }
     return method;

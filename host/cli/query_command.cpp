@@ -48,8 +48,10 @@ constexpr const char* kQueryOutput =
     "  <query index>\\t<frame>:<cost>\\t<frame>:<cost> ...   best first, k entries;\n"
     "  'none' where fewer than k frames are candidates. Costs are printed with\n"
     "  %.9g, which round-trips float32 exactly.\n"
-    "--explain prints the first query's explanation to stderr: the winner's and\n"
-    "the --frames' per-channel costs, and why frames are not candidates.\n"
+    "--explain prints every query's explanation to stderr (--explain-queries: the\n"
+    "named ones only): the winner's and the --frames' per-channel costs, the clip\n"
+    "and its time, the bias and multiplier applied, and why frames are not\n"
+    "candidates.\n"
     "\n"
     "The vulkan-* backends keep their pipeline cache between runs in\n"
     "$XDG_CACHE_HOME/mmvk (else ~/.cache/mmvk), one file per device.\n";
@@ -68,6 +70,7 @@ struct QueryArgs {
   std::uint32_t threads = 0;
   std::optional<std::string> out;
   bool explain = false;
+  std::optional<std::string> explain_queries;  // query indices; implies explain
   std::optional<std::string> frames;
   // Query options, applied to every query.
   std::optional<std::string> continuing;
@@ -148,7 +151,8 @@ void declare_search(CommandLine& cli, QueryArgs& out) {
   cli.integer("--k", out.k, "K", "results per query, 1..16 (default 1)", 1, kMaxK);
   cli.integer("--threads", out.threads, "N", "0 = all cores (default), at most 1024", 0, ThreadPool::kMaxThreads);
   cli.text("--out", out.out, "FILE", "the results (default: stdout)");
-  cli.flag("--explain", out.explain, "explain the first query on stderr");
+  cli.flag("--explain", out.explain, "explain every query on stderr");
+  cli.text("--explain-queries", out.explain_queries, "Q,Q,...", "explain only these queries (0-based; implies --explain)");
   cli.text("--frames,--frame", out.frames, "F,F,...", "frames whose costs --explain shows beside the winner's");
 }
 
@@ -335,7 +339,7 @@ Result<std::vector<QueryParams>> all_query_params(const Database& db, const Quer
 // after the results are printed.
 Result<std::vector<std::uint32_t>> explain_frames(const Database& db, const QueryArgs& args) {
   std::vector<std::uint32_t> frames;
-  if (!args.explain || !args.frames) return frames;
+  if (!(args.explain || args.explain_queries) || !args.frames) return frames;
   for (const std::string& item : split_list(*args.frames)) {
     const Result<std::uint32_t> frame = parse_u32("--frames", item, 0, db.frame_count() - 1);
     if (!frame) {
@@ -344,6 +348,43 @@ Result<std::vector<std::uint32_t>> explain_frames(const Database& db, const Quer
     frames.push_back(*frame);
   }
   return frames;
+}
+
+// The queries --explain explains: every query, or --explain-queries' list,
+// checked against the batch before any work.
+Result<std::vector<std::size_t>> explained_queries(const QueryArgs& args, std::size_t count) {
+  std::vector<std::size_t> chosen;
+  if (!args.explain_queries) {
+    if (args.explain) for (std::size_t q = 0; q < count; ++q) chosen.push_back(q);
+    return chosen;
+  }
+  const std::uint32_t last = std::uint32_t(std::min<std::size_t>(count - 1, UINT32_MAX));
+  for (const std::string& item : split_list(*args.explain_queries)) {
+    const Result<std::uint32_t> query = parse_u32("--explain-queries", item, 0, last);
+    if (!query) return make_error(query.message() + " (the batch has " + std::to_string(count) + " queries)");
+    chosen.push_back(*query);
+  }
+  return chosen;
+}
+
+// Each chosen query's explanation on stderr, in the order asked. A query's
+// continuing frame is explained beside the winner (the frame it would keep
+// playing), unless --frames names it already.
+Status print_explanations(const Database& db, const Queries& queries, std::span<const QueryParams> params,
+                          std::span<const std::size_t> chosen, std::span<const std::uint32_t> frames,
+                          std::uint32_t k) {
+  std::vector<std::uint32_t> shown;
+  for (const std::size_t q : chosen) {
+    const std::span<const float> query = std::span<const float>(queries.features).subspan(q * db.dims(), db.dims());
+    const std::uint32_t continuing = params[q].continuing_frame;
+    shown.assign(frames.begin(), frames.end());
+    if (continuing != kNoFrame && std::find(shown.begin(), shown.end(), continuing) == shown.end()) {
+      shown.push_back(continuing);
+    }
+    MMVK_ASSIGN_OR_RETURN(const Explanation explanation, explain_query(db, query, params[q], shown, k));
+    std::fputs(("explain, query " + std::to_string(q) + ":\n" + format_explanation(db, explanation)).c_str(), stderr);
+  }
+  return {};
 }
 
 // Makes the backend, runs the one search and reports its speed on stderr.
@@ -411,6 +452,8 @@ int run_query(Args args, const char*) {
   if (!params) return fail(params.message());
   Result<std::vector<std::uint32_t>> frames = explain_frames(*db, parsed);
   if (!frames) return report_error("query", frames.message(), kUsageExit);
+  Result<std::vector<std::size_t>> explained = explained_queries(parsed, queries->count);
+  if (!explained) return report_error("query", explained.message(), kUsageExit);
 
   BackendHolder holder;
   Result<std::vector<Match>> results = search(holder, *db, parsed, *queries, *params);
@@ -419,11 +462,8 @@ int run_query(Args args, const char*) {
     return fail(written.message());
   }
   if (queries->pose && (*results)[0].frame != kNoFrame) print_pose_errors(*db, *queries, (*results)[0].frame);
-  if (parsed.explain) {
-    Result<Explanation> explanation = explain_query(*db, std::span<const float>(queries->features).first(db->dims()),
-                                                    (*params)[0], *frames, parsed.k);
-    if (!explanation) return fail(explanation.message());
-    std::fputs(("explain, query 0:\n" + format_explanation(*db, *explanation)).c_str(), stderr);
+  if (Status printed = print_explanations(*db, *queries, *params, *explained, *frames, parsed.k); !printed) {
+    return fail(printed.message());
   }
   return 0;
 }

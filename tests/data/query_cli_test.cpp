@@ -121,6 +121,34 @@ TEST_F(QueryCli, BadQueryFilesAreNamed) {
   EXPECT_NE(before_load.output.find("unknown backend 'nonsense'"), std::string::npos) << before_load.output;
 }
 
+// --explain explains every query of the batch, --explain-queries only the
+// named ones; a query's continuing frame is explained beside its winner.
+TEST_F(QueryCli, ExplainCoversEveryQueryOrTheNamedOnes) {
+  const std::string query = mmvk_ + " query " + db_ + " --queries " + write_queries(3, 27).string() + " --normalized";
+  const CommandResult all = run(query + " --explain --continuing 40");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  for (const char* header : {"explain, query 0:\n", "explain, query 1:\n", "explain, query 2:\n"}) {
+    EXPECT_NE(all.output.find(header), std::string::npos) << header << all.output;
+  }
+  const std::size_t first = all.output.find("explain, query 0:");
+  EXPECT_NE(all.output.find("frame 40 (clip ", first), std::string::npos) << "the continuing frame\n" << all.output;
+
+  const CommandResult named = run(query + " --explain-queries 2,0");
+  ASSERT_EQ(named.exit_code, 0) << named.output;
+  EXPECT_EQ(named.output.find("explain, query 1:"), std::string::npos) << named.output;
+  const std::size_t two = named.output.find("explain, query 2:");
+  const std::size_t zero = named.output.find("explain, query 0:");
+  ASSERT_NE(two, std::string::npos) << named.output;
+  ASSERT_NE(zero, std::string::npos) << named.output;
+  EXPECT_LT(two, zero) << "explained in the order asked";
+
+  const CommandResult beyond = run(query + " --explain-queries 3");
+  EXPECT_NE(beyond.exit_code, 0);
+  EXPECT_NE(beyond.output.find("--explain-queries"), std::string::npos) << beyond.output;
+  EXPECT_NE(beyond.output.find("the batch has 3 queries"), std::string::npos) << beyond.output;
+  EXPECT_EQ(beyond.output.find("\n0\t"), std::string::npos) << "results printed before the error:\n" << beyond.output;
+}
+
 // --help lists the backend registry itself: every name a --backend accepts.
 TEST_F(QueryCli, HelpListsTheRegistry) {
   const CommandResult help = run(mmvk_ + " query --help");

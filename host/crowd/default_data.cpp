@@ -15,7 +15,7 @@ namespace mmvk::crowd {
 namespace {
 
 // Bumped when the way the host builds databases changes (not the data).
-constexpr std::uint32_t kRecipeVersion = 1;
+constexpr std::uint32_t kRecipeVersion = 2;  // 2: mirrored spines keep their parent's reflection axis
 
 // The digest of everything a build reads: the manifest (or folder listing)
 // and the bytes of every clip.

@@ -11,7 +11,8 @@
 // CMU rest frames are world aligned (K = reflect X everywhere); Bandai's are
 // not (the hips reflect local Y, the chest local Z, the limbs local X), so K
 // is chosen per joint from the rest offsets, among the three axis
-// reflections. A reflection of axis a is -(180 degree turn about a), so
+// reflections, keeping the parent's where it fits nearly as well (so that a
+// posture and its mirror have nearly the same local rotations). A reflection of axis a is -(180 degree turn about a), so
 // K_a L K_b is the quaternion -(e_a q e_b) with e_a the unit pure quaternion
 // of axis a; the minus sign makes mirror(mirror(m)) == m exactly (only
 // component swaps and sign flips are involved, no rounding).
@@ -86,6 +87,10 @@ glm::vec3 reflect(int axis, glm::vec3 v) {
 
 constexpr int kWorldAxis = 0;  // mirror across the YZ plane: x -> -x
 
+// How far (a fraction of the children's offsets) the parent's reflection
+// axis may misplace a joint's children before the joint takes its own.
+constexpr double kKeepParentAxisMisfit = 0.1;
+
 // K_j per joint (0, 1, 2 = reflect local X, Y, Z); see the file comment.
 std::vector<int> local_reflection_axes(const Skeleton& skeleton, const std::vector<int>& pairs) {
   const std::size_t n = skeleton.size();
@@ -105,19 +110,28 @@ std::vector<int> local_reflection_axes(const Skeleton& skeleton, const std::vect
     // Summing over both partners' children, in this fixed order, gives both
     // the same axis, which mirror(mirror(m)) == m relies on.
     std::array<double, 3> cost{0.0, 0.0, 0.0};
+    double length = 0.0;  // of the children's offsets
     for (const std::size_t owner : {j, partner}) {
       for (const std::size_t c : children[owner]) {
         const glm::vec3 target = skeleton.rest_offsets[static_cast<std::size_t>(pairs[c])];
         for (int a = 0; a < 3; ++a) cost[a] += glm::length(reflect(a, skeleton.rest_offsets[c]) - target);
+        length += glm::length(skeleton.rest_offsets[c]);
       }
       if (owner == partner) break;
     }
     int best = inherited;
     for (int a = 0; a < 3; ++a) {
-      // Keep the parent's axis unless another fits clearly better (1e-5 m):
-      // leaves and joints whose children are zero-length inherit it.
-      if (cost[a] + 1e-5 < cost[best]) best = a;
+      if (cost[a] < cost[best]) best = a;
     }
+    // A joint whose axis differs from its parent's turns its mirrored local
+    // rotation by a half turn (K_a L K_b with a != b), which the child then
+    // turns back: the positions are right, but a blend between a clip and
+    // its mirror swings through that half turn. So the parent's axis stays
+    // unless it misfits by a real part of the bones (Bandai's frames, turned
+    // by 90 degrees between joints), not by the few millimetres of an
+    // asymmetric capture skeleton (CMU's spines: 3-5% of the bone). Leaves
+    // and joints whose children are zero-length inherit it.
+    if (cost[inherited] <= kKeepParentAxisMisfit * length) best = inherited;
     axes[j] = best;
   }
   return axes;

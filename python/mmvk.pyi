@@ -121,7 +121,7 @@ class Search:
 
 class Crowd:
     """Motion-matched characters stepped from Python (the controller of `mmvk crowd`)."""
-    def __init__(self, db: Database, agents: Optional[int] = None, backend: str = "clusters",
+    def __init__(self, db: Database, agents: Optional[int] = None, backend: str = "auto",
                  rate: float = 30.0, seed: int = 1, device: Optional[int] = None,
                  scenario: Union[None, PathLike, Mapping[str, Any]] = None,
                  search_interval: float = 0.1, foot_ik: bool = True, record: bool = False,

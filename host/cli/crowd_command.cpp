@@ -17,7 +17,10 @@
 #include "crowd_backend.hpp"
 #include "crowd_run.hpp"
 #include "crowd_defaults.hpp"
+#include "crowd_limits.hpp"
+#include "data_settings.hpp"
 #include "default_data.hpp"
+#include "mmvk/manifest.hpp"
 #include "user_cache_dir.hpp"
 
 namespace mmvk::cli {
@@ -35,14 +38,28 @@ constexpr const char* kCrowdFiles =
     "and a run that would need more memory than this machine allows is refused\n"
     "with its estimate (docs/files-and-limits.md).\n";
 
+// ". Crowd settings: --correction-half-life 0.07": what the set's manifest
+// holds (its "crowd" block), or nothing when its files are missing.
+std::string shipped_settings(const crowd::ShippedData& data) {
+  std::error_code ec;
+  const Result<crowd::DataChoice> choice =
+      crowd::choose_data(std::filesystem::path(data.name), std::filesystem::canonical("/proc/self/exe", ec));
+  if (!choice) return "";
+  const Result<Manifest> manifest = load_manifest(choice->source);
+  if (!manifest) return "";
+  const Result<crowd::DataSettings> settings = crowd::parse_data_settings(manifest->crowd, choice->source.string());
+  if (!settings) return "";
+  const std::string text = crowd::describe_data_settings(*settings);
+  return text.empty() ? "" : ". Crowd settings: " + text;
+}
+
 // The sections after the options: files, the shipped motion sets (one entry
 // each, wrapped like the options) and the backends.
 std::string crowd_footer() {
   std::string out = kCrowdFiles;
   out += "\nshipped motion sets (--data NAME; the first is the default):\n";
   for (const crowd::ShippedData& data : crowd::shipped_data()) {
-    const std::string settings = ". Crowd settings: --correction-half-life " + number_text(data.correction_half_life);
-    out += help_entry(data.name, std::string(data.description) + settings, 22);
+    out += help_entry(data.name, std::string(data.description) + shipped_settings(data), 22);
   }
   return out + "\nbackends:\n" + crowd::crowd_backend_help();
 }
@@ -59,18 +76,25 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
            "the motion: a shipped set by name (below), an .mmdb (built with animation), a manifest or a folder of "
            "BVH (built once and cached in $XDG_CACHE_HOME/mmvk or ~/.cache/mmvk). Default: " +
                default_data_name());
+  // The bounds are checked by the crowd's validate() (crowd_settings.hpp) on the values given.
   cli.integer("--agents", options.agents, "N",
-              "characters (default " + std::to_string(crowd::kDefaultAgents) +
-                  ", at most 10,000,000; with --scenario, its count)", 1, 10'000'000);
-  cli.positive("--seconds", options.seconds, "S", "simulated time (default " + number_text(options.seconds) + "; 1 to 10,000,000 ticks)");
+              "characters (default " + std::to_string(crowd::kDefaultAgents) + ", at most " +
+                  thousands(crowd::kMaxAgents) + "; with --scenario, its count)",
+              0, std::numeric_limits<std::uint64_t>::max());
+  cli.positive("--seconds", options.seconds, "S",
+               "simulated time (default " + number_text(options.seconds) + "; 1 to " + thousands(crowd::kMaxTicks) +
+                   " ticks)");
   cli.positive("--rate", options.rate_hz, "HZ",
-               "simulation ticks per second (default " + number_text(options.rate_hz) +
-                   "; 1 to 1000: poses are interpolated between database frames)");
+               "simulation ticks per second (default " + number_text(options.rate_hz) + "; " +
+                   number_text(crowd::kMinRateHz) + " to " + number_text(crowd::kMaxRateHz) +
+                   ": poses are interpolated between database frames)");
   cli.positive("--search-interval", options.search_interval_s, "S",
                "seconds between a character's regular searches (default " + number_text(options.search_interval_s) +
-                   "; 0.001 to 3600)");
+                   "; " + number_text(crowd::kMinSearchIntervalS) + " to " + number_text(crowd::kMaxSearchIntervalS) +
+                   ")");
   cli.text("--backend", options.backend, "NAME",
-           "the search backend (default " + options.backend + ", on the best device)");
+           "the search backend (default " + options.backend +
+               ": a Vulkan backend on a GPU, else the fastest CPU backend; below)");
   cli.integer("--device", options.device, "N", "the Vulkan device index (default: the best one)");
   cli.integer("--seed", options.seed, "N", "the random scenario's seed (default " + std::to_string(options.seed) + ")", 0,
               std::numeric_limits<std::uint64_t>::max());
@@ -105,7 +129,7 @@ void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
             [](const std::string& text) { return parse_weight_list("--weights", text); });
   cli.positive("--correction-half-life", options.correction_half_life, "S",
                "half-life of the pull of each character's animated root towards its simulated position (default: "
-               "the shipped set's, below; other data " + number_text(crowd::kCorrectionHalfLife) +
+               "the data's, its manifest's \"crowd\" block; else " + number_text(crowd::kCorrectionHalfLife) +
                    " s; shorter holds the characters closer to their paths, with "
                "more root motion that the animation did not make)");
 }

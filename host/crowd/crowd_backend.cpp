@@ -80,18 +80,54 @@ BackendRegistry crowd_registry([[maybe_unused]] CrowdSearch& out, [[maybe_unused
 
 }  // namespace
 
-std::string crowd_backend_help() {
-  CrowdSearch unused;
-  return crowd_registry(unused, std::nullopt, {}).help();
+std::string resolve_backend(const std::string& name, [[maybe_unused]] std::optional<std::uint32_t> device,
+                            std::uint32_t frames, std::string& reason) {
+  reason.clear();
+  if (name != "auto") return name;
+#if defined(MMVK_HAS_VULKAN)
+  if (device) {
+    reason = "auto: Vulkan device " + std::to_string(*device) + " was asked for";
+    return kAutoGpuBackend;
+  }
+  const Result<std::vector<vulkan::DeviceInfo>> devices = vulkan::Context::enumerate_devices();
+  if (devices) {
+    for (const vulkan::DeviceInfo& info : *devices) {
+      if (info.type == VK_PHYSICAL_DEVICE_TYPE_CPU || info.type == VK_PHYSICAL_DEVICE_TYPE_OTHER) continue;
+      reason = "auto: " + info.name + " is a GPU";
+      return kAutoGpuBackend;
+    }
+  }
+  reason = devices && !devices->empty() ? "auto: no GPU, " + devices->front().name + " runs Vulkan on the CPU"
+                                        : std::string("auto: no Vulkan device");
+#else
+  reason = "auto: built without Vulkan";
+#endif
+  const bool large = frames > kAutoClusterFrames;
+  reason += std::string("; the fastest CPU backend for ") + (large ? "over " : "up to ") +
+            std::to_string(kAutoClusterFrames) + " frames";
+  return large ? kAutoLargeCpuBackend : kAutoCpuBackend;
 }
 
-Result<CrowdSearch> make_crowd_search(const std::string& name, std::optional<std::uint32_t> device,
+std::string crowd_backend_help() {
+  CrowdSearch unused;
+  const BackendRegistry registry = crowd_registry(unused, std::nullopt, {});
+  // "auto" first, in the registry's layout: a rule over its entries, not one of them.
+  std::size_t width = 0;
+  for (const BackendEntry& entry : registry.entries()) width = std::max(width, entry.name.size());
+  const std::string automatic = "  auto" + std::string(std::max<std::size_t>(width, 4) + 2 - 4, ' ') +
+                                "the default: " + kAutoGpuBackend + " on a GPU, else " + kAutoCpuBackend + " (" +
+                                kAutoLargeCpuBackend + " over " + std::to_string(kAutoClusterFrames) + " frames)\n";
+  return automatic + registry.help();
+}
+
+Result<CrowdSearch> make_crowd_search(const std::string& asked, std::optional<std::uint32_t> device,
                                       const Database& database, std::uint32_t agents, ThreadPool& pool,
                                       const std::filesystem::path& cache_dir) {
   CrowdSearch out;
+  const std::string name = resolve_backend(asked, device, database.frame_count(), out.choice);
   const BackendRegistry registry = crowd_registry(out, device, cache_dir);
   const BackendEntry* entry = registry.find(name);
-  if (!entry) return make_error("unknown backend '" + name + "' (known: " + registry.names() + ")");
+  if (!entry) return make_error("unknown backend '" + name + "' (known: auto, " + registry.names() + ")");
   BackendSpec spec;
   spec.name = name;
   spec.pool = &pool;

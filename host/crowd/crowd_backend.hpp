@@ -36,13 +36,33 @@ struct CrowdSearch {
   std::unique_ptr<AsyncSearch> deferred;     // on `backend`
   std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
   std::string pipeline_cache_note;           // why a pipeline cache file was not used, or ""
+  // What "auto" picked and why ("auto: no GPU, ..."); empty for a backend named.
+  std::string choice;
 };
+
+// The CPU backends "auto" picks where there is no GPU, the fastest for a
+// crowd on the CPU: fast-box on a database of up to kAutoClusterFrames
+// frames, clusters above, where its pruning pays for itself
+// (bench/RESULTS.md, "--backend auto", has the measurements).
+inline constexpr const char* kAutoCpuBackend = "fast-box";
+inline constexpr const char* kAutoLargeCpuBackend = "clusters";
+inline constexpr std::uint32_t kAutoClusterFrames = 50'000;
+// The Vulkan backend "auto" picks on a GPU.
+inline constexpr const char* kAutoGpuBackend = "vulkan-brute";
 
 // The backends `mmvk crowd --backend` accepts (the library's registry), one
 // line each with its description, for --help.
 std::string crowd_backend_help();
 
-// Makes `name` from the library's backend registry on `database` for up to
+// "auto", or `name` as given: a Vulkan backend (kAutoGpuBackend) where a
+// Vulkan device is a GPU (discrete, integrated or virtual) or `device`
+// names one; else, where the only Vulkan devices run on the CPU (llvmpipe)
+// or there is none, kAutoCpuBackend, or kAutoLargeCpuBackend for a database
+// of more than kAutoClusterFrames `frames`. `reason` gets why.
+std::string resolve_backend(const std::string& name, std::optional<std::uint32_t> device, std::uint32_t frames,
+                            std::string& reason);
+
+// Makes `name` ("auto": resolve_backend) from the library's backend registry on `database` for up to
 // `agents` queries per tick. `device` picks the Vulkan device (none: the
 // best one). A Vulkan context starts from the pipeline cache file in
 // `cache_dir` (none when empty); save_crowd_pipeline_cache keeps it.

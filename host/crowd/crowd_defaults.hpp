@@ -1,7 +1,7 @@
-// The controller settings the crowd runs with unless a flag or a shipped
-// data set (default_data.cpp) says otherwise, shared by `mmvk crowd`
-// (crowd_run.cpp) and the stepped crowd (crowd_session.hpp), with the
-// measurements that chose them.
+// The controller settings the crowd runs with unless a setting
+// (crowd_settings.hpp) or the data's "crowd" block (data_settings.hpp) says
+// otherwise, shared by `mmvk crowd`, the stepped crowd and mmvk.Crowd, with
+// the measurements that chose them.
 #pragma once
 
 #include <cstdint>
@@ -36,7 +36,7 @@ inline constexpr float kContinuingBias = -2.5f;
 //   Bandai, 60 Hz:   0.2 s: 0.048 m, 0.95 cm/s, 1.93;  0.15 s: 0.043, 0.89, 1.88;  0.1 s: 0.036, 0.87, 1.87
 // 0.1 s clamps the legs' reach more often (7.1% of foot-ticks on CMU against
 // 5.4%), so 0.15 s, for data of the user's; a shipped set carries its own
-// (default_data.cpp).
+// (its manifest's "crowd" block).
 inline constexpr float kCorrectionHalfLife = 0.15f;
 
 }  // namespace mmvk::crowd

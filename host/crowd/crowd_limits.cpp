@@ -14,6 +14,7 @@
 #include "mmvk/query_assembly.hpp"
 #include "mmvk/search.hpp"
 #include "mmvk/trajectory.hpp"
+#include "crowd_defaults.hpp"
 #include "recording.hpp"
 
 namespace mmvk::crowd {
@@ -58,28 +59,7 @@ std::uint64_t trajectory_points(const Database& database) {
 
 }  // namespace
 
-Status check_time_options(const CrowdOptions& o) {
-  if (!std::isfinite(o.rate_hz) || o.rate_hz < kMinRateHz || o.rate_hz > kMaxRateHz) {
-    return make_error("--rate " + number_text(o.rate_hz) + ": expected " + number_text(kMinRateHz) + " to " +
-                      number_text(kMaxRateHz) + " ticks per second (a tick of at most 1 s and at least 1 ms)");
-  }
-  if (!std::isfinite(o.search_interval_s) || o.search_interval_s < kMinSearchIntervalS ||
-      o.search_interval_s > kMaxSearchIntervalS) {
-    return make_error("--search-interval " + number_text(o.search_interval_s) + ": expected " +
-                      number_text(kMinSearchIntervalS) + " to " + number_text(kMaxSearchIntervalS) + " seconds");
-  }
-  if (!std::isfinite(o.seconds) || !(o.seconds > 0.0) || o.seconds * o.rate_hz > double(kMaxTicks) + 0.5) {
-    return make_error("--seconds " + number_text(o.seconds) + " at --rate " + number_text(o.rate_hz) + ": over " +
-                      std::to_string(kMaxTicks) + " ticks (--seconds x --rate)");
-  }
-  if (std::llround(o.seconds * o.rate_hz) < 1) {
-    return make_error("--seconds " + number_text(o.seconds) + " at --rate " + number_text(o.rate_hz) +
-                      " Hz is 0 ticks; simulate at least one tick (1 / rate seconds)");
-  }
-  return {};
-}
-
-std::uint64_t tick_count(const CrowdOptions& options) {
+std::uint64_t tick_count(const CrowdSettings& options) {
   return std::uint64_t(std::llround(options.seconds * options.rate_hz));
 }
 
@@ -90,8 +70,8 @@ std::uint64_t tick_count(const CrowdOptions& options) {
 // 1,614 MiB with --html (estimate 2,831); 1,000 agents for 2 s 23 MiB
 // (estimate 76). Over, never under; the per-joint term is the one to
 // revisit when the controller keeps more per joint.
-std::uint64_t estimate_crowd_bytes(const CrowdOptions& options, const Database& database, std::uint64_t agents,
-                                   std::uint64_t goals) {
+std::uint64_t estimate_crowd_bytes(const CrowdSettings& options, const RunOutputs& outputs, const Database& database,
+                                   std::uint64_t agents, std::uint64_t goals) {
   const std::uint64_t joints = database.animation() ? database.animation()->joint_count() : 1;
   const std::uint64_t dims = database.dims();
   const std::uint64_t points = trajectory_points(database);
@@ -116,7 +96,7 @@ std::uint64_t estimate_crowd_bytes(const CrowdOptions& options, const Database& 
   // backend's copy or upload of the features.
   const std::uint64_t frames = database.frame_count();
   bytes += frames * (dims * 4 * 2 + 32 + joints * 16 + 24);
-  if (options.html) {
+  if (outputs.html) {
     // The recording: every sample of every character (root, facing, frame,
     // desired and matched trajectories, up to 6 displayed leg joints), each
     // search and foot change as an event, the poses of the frames played;
@@ -132,9 +112,9 @@ std::uint64_t estimate_crowd_bytes(const CrowdOptions& options, const Database& 
         frames * joints * 12;
     bytes += recording * 4;
   }
-  if (options.trace) {
+  if (outputs.trace_agents > 0) {
     // --trace: the traced characters' world joints and contact bits per tick.
-    bytes += ticks * std::min<std::uint64_t>(options.trace_agents, agents) * (joints * 12 + 2);
+    bytes += ticks * std::min<std::uint64_t>(outputs.trace_agents, agents) * (joints * 12 + 2);
   }
   return bytes;
 }
@@ -148,8 +128,9 @@ std::uint64_t memory_limit_bytes() {
   return limit;
 }
 
-Status check_crowd_memory(const CrowdOptions& options, const Database& database, const Scenario* scenario) {
-  if (!scenario && options.scenario) return {};
+Status check_crowd_memory(const CrowdSettings& options, const RunOutputs& outputs, const Database& database,
+                          const Scenario* scenario, SettingNames names) {
+  if (!scenario && outputs.scenario_file) return {};
   std::uint64_t agents = 0;
   std::uint64_t goals = 0;
   if (scenario) {
@@ -157,17 +138,20 @@ Status check_crowd_memory(const CrowdOptions& options, const Database& database,
     for (const AgentPlan& plan : scenario->agents) goals += plan.goals.size();
   } else {
     const RandomScenarioOptions random;
-    agents = options.agents.value_or(random.agents);
+    agents = options.agents.value_or(kDefaultAgents);
     goals = agents * random.goals_per_agent;
   }
-  const std::uint64_t estimate = estimate_crowd_bytes(options, database, agents, goals);
+  const std::uint64_t estimate = estimate_crowd_bytes(options, outputs, database, agents, goals);
   const std::uint64_t limit = memory_limit_bytes();
   if (double(estimate) <= kMemoryShare * double(limit)) return {};
+  const std::string html = outputs.html ? setting_name(names, "html") : std::string();
+  const std::string lower = "; lower " + setting_name(names, "agents");
   return make_error(std::to_string(agents) + " agents for " + number_text(options.seconds) + " s" +
-                    (options.html ? " with --html" : "") + " would need about " + gib(estimate) + ", over " +
+                    (outputs.html ? " with " + html : "") + " would need about " + gib(estimate) + ", over " +
                     number_text(kMemoryShare * 100.0) + "% of the " + gib(limit) +
-                    " this process may use (physical memory, cgroup and ulimit); lower --agents" +
-                    (options.html ? ", --seconds or leave out --html" : " or --seconds"));
+                    " this process may use (physical memory, cgroup and ulimit)" + lower +
+                    (outputs.html ? ", " + setting_name(names, "seconds") + " or leave out " + html
+                                  : " or " + setting_name(names, "seconds")));
 }
 
 }  // namespace mmvk::crowd

@@ -1,6 +1,8 @@
-// One crowd run: open the database, lay out the scenario, make the search,
-// tick the world at a fixed rate and report what happened. The `mmvk crowd`
-// command line is a thin layer over run_crowd().
+// One `mmvk crowd` run: a session (crowd_session.hpp: the settings checked,
+// the database's motion, the scenario, the controller, the search and the
+// observers, set up as mmvk.Crowd sets them up), a loop of its own steering
+// at a fixed rate (trace and progress line after each tick) and its outputs.
+// The command line is a thin layer over run_crowd().
 //
 // Each tick (dt = 1 / rate_hz):
 //   1. steering: desired velocities from the characters' animated roots
@@ -8,8 +10,8 @@
 //   2. the controller's deferred tick: apply the previous tick's matches,
 //      play, predict, assemble the due characters' queries and submit them
 //      as one batch (on Vulkan the search runs while the host goes on);
-//   3. outside the timed step: the quality figures, the viewer's samples
-//      and the progress line.
+//   3. outside the timed step: the quality figures, the viewer's samples,
+//      the trace and the progress line.
 #pragma once
 
 #include <cstdio>

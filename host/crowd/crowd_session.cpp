@@ -1,13 +1,12 @@
 #include "crowd_session.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <utility>
 
 #include "clip_quality.hpp"
 #include "crowd_defaults.hpp"
-#include "crowd_limits.hpp"
+#include "data_settings.hpp"
 #include "gait_plan.hpp"
 #include "observed_search.hpp"
 #include "observed_tick.hpp"
@@ -20,20 +19,51 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-Status check_options(const CrowdSessionOptions& o) {
-  if (!o.scenario && o.agents == 0) return make_error("agents must be at least 1");
-  if (!o.scenario && o.agents > kMaxAgents) {
-    return make_error("agents: " + std::to_string(o.agents) + " is more than the crowd's limit of " +
-                      std::to_string(kMaxAgents));
+std::string data_name(const CrowdSessionOptions& o) {
+  return o.data_source.empty() ? std::string("the database") : o.data_source;
+}
+
+// The motion checked for a crowd: it has animation and walks.
+Result<GaitSpeeds> check_motion(const Database& database, const CrowdSessionOptions& o) {
+  const std::string caller = o.names == SettingNames::Flags ? "mmvk crowd" : "mmvk.Crowd";
+  if (!database.animation()) return make_error(data_name(o) + ": " + missing_animation_error(caller).message);
+  Result<GaitSpeeds> speeds = measure_gait_speeds(database);
+  if (!speeds) return make_error(data_name(o) + ": " + speeds.message());
+  return speeds;
+}
+
+// The scenario given, or the random one of the settings, its gaits
+// resolved, once the run is known to fit in memory.
+Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptions& o, const GaitSpeeds& speeds) {
+  RunOutputs outputs = o.outputs;
+  outputs.html = outputs.html || o.record;
+  Scenario scenario;
+  if (o.scenario) {
+    if (o.agents && *o.agents != o.scenario->agents.size()) {
+      return make_error(o.scenario->source + ": defines " + std::to_string(o.scenario->agents.size()) +
+                        " agents, but " + setting_name(o.names, "agents") + " asks for " + std::to_string(*o.agents) +
+                        " (leave " + setting_name(o.names, "agents") + " out with a scenario)");
+    }
+    MMVK_TRY(check_crowd_memory(o, outputs, database, &*o.scenario, o.names));
+    scenario = *o.scenario;
+  } else {
+    MMVK_TRY(check_crowd_memory(o, outputs, database, nullptr, o.names));
+    RandomScenarioOptions random;
+    random.agents = std::uint32_t(o.agents.value_or(kDefaultAgents));
+    random.seed = o.seed;
+    if (!speeds.has_run) random.run_fraction = 0.0f;  // data without a run gets no runners
+    scenario = make_random_scenario(random);
   }
-  if (!(o.rate_hz > 0.0) || !std::isfinite(o.rate_hz)) return make_error("rate must be a positive number (Hz)");
-  if (!(o.search_interval_s > 0.0) || !std::isfinite(o.search_interval_s)) {
-    return make_error("search_interval must be a positive number (seconds)");
-  }
-  if (o.correction_half_life && !(std::isfinite(*o.correction_half_life) && *o.correction_half_life > 0.0f)) {
-    return make_error("correction_half_life must be a positive number (seconds)");
-  }
-  return {};
+  MMVK_TRY(resolve_gaits(scenario, speeds));
+  return scenario;
+}
+
+// "1000 agents · CMU 16 walks and runs · vulkan-brute-force on llvmpipe".
+std::string page_title(const CrowdSessionOptions& o, std::uint32_t agents, const CrowdSearch& search) {
+  if (!o.title.empty()) return o.title;
+  const std::string device = search.device.substr(0, search.device.find(" ("));
+  return std::to_string(agents) + " agents \u00b7 " + (o.data_label.empty() ? "" : o.data_label + " \u00b7 ") +
+         std::string(search.backend->name()) + " on " + device;
 }
 
 }  // namespace
@@ -52,56 +82,47 @@ CrowdSession::~CrowdSession() = default;
 
 Result<std::unique_ptr<CrowdSession>> CrowdSession::create(const Database& database,
                                                            const CrowdSessionOptions& options) {
-  MMVK_TRY(check_options(options));
-  if (!database.animation()) return missing_animation_error("mmvk.Crowd");
-  MMVK_ASSIGN_OR_RETURN(GaitSpeeds speeds, measure_gait_speeds(database));
-  Scenario scenario;
-  if (options.scenario) {
-    scenario = *options.scenario;
-  } else {
-    RandomScenarioOptions random;
-    random.agents = options.agents;
-    random.seed = options.seed;
-    if (!speeds.has_run) random.run_fraction = 0.0f;  // data without a run gets no runners
-    scenario = make_random_scenario(random);
-  }
-  MMVK_TRY(resolve_gaits(scenario, speeds));
+  MMVK_TRY(validate(options, options.names));
+  MMVK_ASSIGN_OR_RETURN(GaitSpeeds speeds, check_motion(database, options));
+  MMVK_ASSIGN_OR_RETURN(const DataSettings data, data_settings(database, data_name(options)));
+  MMVK_ASSIGN_OR_RETURN(Scenario scenario, plan_scenario(database, options, speeds));
   std::unique_ptr<CrowdSession> s(new CrowdSession(database, std::move(scenario), std::move(speeds), options));
-  const std::uint32_t agents = s->agents_;
+  s->options_.scenario.reset();  // the session keeps its own copy, scenario_
+  MMVK_TRY(s->set_up(controller_params(options, data)));
+  return s;
+}
 
-  ControllerParams params;
-  params.search_interval = float(options.search_interval_s);
-  params.continuing_bias = kContinuingBias;
-  params.correction_half_life = options.correction_half_life.value_or(kCorrectionHalfLife);
-  params.foot_ik.enabled = options.foot_ik;
-  MMVK_ASSIGN_OR_RETURN(CrowdController controller, CrowdController::create(database, agents, params));
-  s->controller_.emplace(std::move(controller));
-  CrowdController& c = *s->controller_;
-  MMVK_TRY(apply_plan_tags(s->scenario_, database, c.query_params()));
-  for (std::uint32_t b = 0; b < agents; ++b) {
-    const AgentPlan& plan = s->scenario_.agents[b];
+// The controller, the search and the observers, in the order `mmvk crowd`
+// has always made them (the random draws and the chosen frames depend on it).
+Status CrowdSession::set_up(const ControllerParams& params) {
+  const CrowdSessionOptions& o = options_;
+  Result<CrowdController> created = CrowdController::create(database_, agents_, params);
+  if (!created) return make_error(data_name(o) + ": " + created.message());
+  controller_.emplace(std::move(created.value()));
+  CrowdController& c = *controller_;
+  MMVK_TRY(apply_plan_tags(scenario_, database_, c.query_params()));
+  MMVK_TRY(apply_query_settings(o, params, database_, o.names, c.query_params()));
+  for (std::uint32_t b = 0; b < agents_; ++b) {
+    const AgentPlan& plan = scenario_.agents[b];
     const float yaw = std::atan2(plan.goals[0][0] - plan.start[0], plan.goals[0][1] - plan.start[1]);
     MMVK_TRY(c.place(b, glm::vec3(plan.start[0], 0.0f, plan.start[1]), yaw));
   }
-  MMVK_ASSIGN_OR_RETURN(s->search_, make_crowd_search(options.backend, options.device, database, agents, s->pool_, {}));
-  s->observed_ = std::make_unique<ObservedSearch>(*s->search_.deferred, agents);
-  s->steering_ = std::make_unique<Steering>(s->scenario_, s->speeds_);
+  MMVK_ASSIGN_OR_RETURN(search_, make_crowd_search(o.backend, o.device, database_, agents_, pool_, o.cache_dir));
+  observed_ = std::make_unique<ObservedSearch>(*search_.deferred, agents_);
+  steering_ = std::make_unique<Steering>(scenario_, speeds_);
   // The clips first: their planted toe height is the crowd's floor.
-  const ClipQuality clips = measure_clip_quality(database, s->pool_);
-  s->clips_ = clips;
-  s->params_ = params;
-  s->quality_ = std::make_unique<QualityObserver>(c, params, clips, s->dt_, options.rate_hz, database.fps());
-  if (options.record) {
-    const auto per_sample = std::uint32_t(std::max(1.0, std::round(options.rate_hz / 10.0)));
-    const std::string title = !options.title.empty()
-                                  ? options.title
-                                  : std::to_string(agents) + " agents \u00b7 " + std::string(s->search_.backend->name());
-    s->recording_ = std::make_unique<RecordingObserver>(c, s->scenario_, title, float(s->dt_), per_sample);
+  clips_ = measure_clip_quality(database_, pool_);
+  params_ = params;
+  quality_ = std::make_unique<QualityObserver>(c, params, clips_, dt_, o.rate_hz, database_.fps());
+  if (o.record) {
+    // One sample every tenth of a second.
+    const auto per_sample = std::uint32_t(std::max(1.0, std::round(o.rate_hz / 10.0)));
+    recording_ = std::make_unique<RecordingObserver>(c, scenario_, page_title(o, agents_, search_), float(dt_),
+                                                     per_sample);
   }
-
-  s->x_.resize(agents), s->z_.resize(agents), s->vx_.resize(agents), s->vz_.resize(agents);
-  s->desired_.resize(agents), s->world_.resize(std::size_t{agents} * c.animation().joint_count());
-  return s;
+  x_.resize(agents_), z_.resize(agents_), vx_.resize(agents_), vz_.resize(agents_);
+  desired_.resize(agents_), world_.resize(std::size_t{agents_} * c.animation().joint_count());
+  return {};
 }
 
 Status CrowdSession::place(std::uint32_t b, float x, float z, float yaw, std::uint32_t frame) {
@@ -109,14 +130,17 @@ Status CrowdSession::place(std::uint32_t b, float x, float z, float yaw, std::ui
 }
 
 Status CrowdSession::step() {
+  // The tick's time counts the steering too.
+  const auto tick_start = Clock::now();
   const auto roots = controller_->root_positions();
   for (std::uint32_t b = 0; b < agents_; ++b) x_[b] = roots[b].x, z_[b] = roots[b].z;
   steering_->update(x_, z_, vx_, vz_, &pool_);
   for (std::uint32_t b = 0; b < agents_; ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
-  return tick(desired_, {});
+  return tick(desired_, {}, tick_start);
 }
 
 Status CrowdSession::step(std::span<const glm::vec3> desired_velocity, std::span<const float> desired_yaw) {
+  const auto tick_start = Clock::now();
   if (desired_velocity.size() != agents_) {
     return make_error("desired_velocity: " + std::to_string(desired_velocity.size()) + " rows for " +
                       std::to_string(agents_) + " agents");
@@ -126,16 +150,17 @@ Status CrowdSession::step(std::span<const glm::vec3> desired_velocity, std::span
                       std::to_string(agents_) + " agents");
   }
   for (std::uint32_t b = 0; b < agents_; ++b) desired_[b] = glm::vec3(desired_velocity[b].x, 0.0f, desired_velocity[b].z);
-  return tick(desired_, desired_yaw);
+  return tick(desired_, desired_yaw, tick_start);
 }
 
-// The loop body of run_crowd (crowd_run.cpp), for one tick.
-Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const float> desired_yaw) {
+Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const float> desired_yaw,
+                          Clock::time_point tick_start) {
   // The recording ends at the first page written.
   RecordingObserver* recording = html_written_ ? nullptr : recording_.get();
+  if (ticks_ == 0) figures_.reserve(tick_count(options_));
   MMVK_ASSIGN_OR_RETURN(const double tick_ms,
                         observed_tick(*controller_, *observed_, pool_, ticks_, float(dt_),
-                                      CrowdInput{desired, desired_yaw}, Clock::now(), world_,
+                                      CrowdInput{desired, desired_yaw}, tick_start, world_,
                                       {figures_, *quality_, recording}));
   wall_s_ += tick_ms / 1e3;
   ++ticks_;

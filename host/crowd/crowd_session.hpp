@@ -8,11 +8,13 @@
 //     handed to the controller as it is (CrowdController's CrowdInput).
 // Afterwards the caller reads the characters' roots, frames, contacts and
 // displayed joint positions, and at any time the run's summary (summary.hpp,
-// the same figures as `mmvk crowd --summary`). The Python module's
-// mmvk.Crowd is this class.
+// the same figures as `mmvk crowd --summary`). `mmvk crowd` (crowd_run.hpp)
+// is this class stepped by its own loop; the Python module's mmvk.Crowd is
+// this class stepped from Python.
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -25,6 +27,8 @@
 
 #include "clip_quality.hpp"
 #include "crowd_backend.hpp"
+#include "crowd_limits.hpp"
+#include "crowd_settings.hpp"
 #include "gait_speeds.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/database.hpp"
@@ -39,30 +43,34 @@ namespace mmvk::crowd {
 
 class ObservedSearch;
 
-struct CrowdSessionOptions {
+// The crowd's settings (crowd_settings.hpp: the defaults and bounds every
+// entry point shares) and what a session adds.
+struct CrowdSessionOptions : CrowdSettings {
+  // How errors name the settings: mmvk.Crowd's keywords, or `mmvk crowd`'s flags.
+  SettingNames names = SettingNames::Keywords;
   // The characters' starts, goals, speeds and tags; none: a random scenario
   // of `agents` characters from `seed` (as `mmvk crowd --agents N --seed S`).
   std::optional<Scenario> scenario;
-  std::uint32_t agents = 100;
-  std::uint64_t seed = 1;
-  double rate_hz = 30.0;            // ticks per simulated second
-  double search_interval_s = 0.1;   // each character's regular search period
-  std::string backend = "clusters"; // a backend registry name (mmvk/backends.hpp)
-  std::optional<std::uint32_t> device;  // Vulkan device index; none = the best
-  bool foot_ik = true;
-  // The root correction's half-life, seconds (> 0); none: the crowd's
-  // default (crowd_defaults.hpp).
-  std::optional<float> correction_half_life;
+  // What the caller keeps besides the characters, for the memory check.
+  RunOutputs outputs;
   // Keep the viewer's recording, for write_html().
   bool record = false;
-  std::string title;                // the viewer page's header; empty: made up
+  // The viewer page's header; empty: "N agents · <data_label> · <backend> on <device>".
+  std::string title;
+  std::string data_label;
+  // The data in messages (a file or a shipped set's name); empty: "the database".
+  std::string data_source;
+  // The Vulkan pipeline cache's folder; empty: none (crowd_backend.hpp).
+  std::filesystem::path cache_dir;
 };
 
 class CrowdSession {
  public:
-  // `database` must outlive the session. Errors name the option or field
-  // (a database without animation, an unknown backend, a scenario asking
-  // for a gait the data lacks, a bad rate).
+  // `database` must outlive the session. Checks every setting (validate(),
+  // then against the data: the memory, the costs) before it allocates for
+  // them. Errors name the setting or field (a database without animation,
+  // an unknown backend, a scenario asking for a gait the data lacks, a bad
+  // rate, an unknown key in the data's crowd settings).
   static Result<std::unique_ptr<CrowdSession>> create(const Database& database, const CrowdSessionOptions& options);
   ~CrowdSession();
   CrowdSession(const CrowdSession&) = delete;
@@ -81,11 +89,16 @@ class CrowdSession {
 
   std::uint32_t agents() const { return agents_; }
   double dt() const { return dt_; }
+  double rate_hz() const { return options_.rate_hz; }
   std::uint64_t ticks() const { return ticks_; }
   const CrowdController& controller() const { return *controller_; }
   const Scenario& scenario() const { return scenario_; }
   const GaitSpeeds& speeds() const { return speeds_; }
   const std::string& device() const { return search_.device; }
+  const CrowdSearch& search() const { return search_; }
+  const ControllerParams& params() const { return params_; }
+  // Milliseconds the last step was blocked on its search.
+  double last_search_ms() const { return figures_.last_search_ms(); }
   // The displayed world joint positions after the last step, [agents x
   // joints] metres (before the first step: the placed poses are not yet
   // shown, all zero).
@@ -98,7 +111,9 @@ class CrowdSession {
 
  private:
   CrowdSession(const Database& database, Scenario scenario, GaitSpeeds speeds, const CrowdSessionOptions& options);
-  Status tick(std::span<const glm::vec3> desired, std::span<const float> desired_yaw);
+  Status set_up(const ControllerParams& params);
+  Status tick(std::span<const glm::vec3> desired, std::span<const float> desired_yaw,
+              std::chrono::steady_clock::time_point tick_start);
 
   const Database& database_;
   Scenario scenario_;

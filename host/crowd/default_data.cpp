@@ -46,11 +46,8 @@ std::string hex(std::uint64_t value) {
 }  // namespace
 
 std::span<const ShippedData> shipped_data() {
-  // Correction half-lives: the largest that keeps each set's trajectory
-  // error at 1 s within 0.0415 m at 30 and 60 Hz (1,000 characters x 20 s):
-  // CMU 131 0.0405 / 0.0415 m at 0.15 s; CMU 16, whose takes are 1-2.5 s
-  // long at 2.5 times the pace, 0.0685 / 0.0705 m at 0.15 s, 0.0495 at 0.1 s,
-  // 0.0395 / 0.0405 m at 0.07 s.
+  // Each set's tuned crowd settings are in its manifest's "crowd" block
+  // (bench/RESULTS.md, "The default data", has how they were chosen).
   // The first is the default: cmu-walk-run, the one set at a pedestrian pace
   // with a run, meets cmu-walks' figures (trajectory error, sliding) at 30
   // and 60 Hz (bench/RESULTS.md, "The default data").
@@ -58,12 +55,10 @@ std::span<const ShippedData> shipped_data() {
       {"cmu-walk-run", "cmu16", "CMU 16 walks and runs",
        "CMU subject 16: walks (veer left, 90-degree left turn) at 1.6 m/s, jogs (90-degree turns, a jog "
        "to a stop) at 1.7-2.4 m/s, a run (veer right) at 3.6 m/s; tagged walk/jog/run. 6 short takes, 329 "
-       "frames (11 s) at 30 fps, mirrored, trajectories extrapolated past the takes' ends",
-       0.07f},
+       "frames (11 s) at 30 fps, mirrored, trajectories extrapolated past the takes' ends"},
       {"cmu-walks", "cmu131", "CMU 131 walks",
        "CMU subject 131: start/walk/stop and curved walks at 0.2-0.7 m/s (stylised, slow); no run. "
-       "8 takes, 2,876 frames at 30 fps, mirrored",
-       0.15f},
+       "8 takes, 2,876 frames at 30 fps, mirrored"},
   };
   return kShipped;
 }
@@ -90,12 +85,12 @@ std::vector<std::filesystem::path> shipped_manifest_candidates(const ShippedData
 Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,
                                const std::filesystem::path& executable) {
   const ShippedData* shipped = data ? find_shipped_data(data->string()) : &shipped_data()[0];
-  if (!shipped) return DataChoice{*data, data->string(), data->filename().string(), std::nullopt};
+  if (!shipped) return DataChoice{*data, data->string(), data->filename().string()};
   for (const auto& candidate : shipped_manifest_candidates(*shipped, executable)) {
     std::error_code ec;
     if (std::filesystem::exists(candidate, ec)) {
       return DataChoice{candidate, "the " + std::string(shipped->label) + " (" + std::string(shipped->name) + ")",
-                        std::string(shipped->label), shipped->correction_half_life};
+                        std::string(shipped->label)};
     }
   }
   return make_error("the shipped motion set '" + std::string(shipped->name) + "' (host/crowd/data/" +

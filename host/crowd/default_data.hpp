@@ -2,8 +2,9 @@
 // folder of BVH built once and cached, or one of the motion sets shipped in
 // host/crowd/data by name (--data cmu-walks). Without --data, the default
 // set: the trimmed CMU subject 16 walks and runs (cmu-walk-run).
-// A shipped set carries the crowd settings it was tuned with; each flag
-// overrides its setting (bench/RESULTS.md, "The default data").
+// A shipped set carries the crowd settings it was tuned with, in its
+// manifest's "crowd" block (data_settings.hpp); each flag overrides its
+// setting (bench/RESULTS.md, "The default data").
 //
 // A built database is cached as <cache dir>/crowd-<name>-<digest>.mmdb, where
 // the digest covers the manifest, every BVH it names and the .mmdb format
@@ -31,9 +32,6 @@ struct ShippedData {
   std::string_view folder;       // under host/crowd/data (installed: <prefix>/share/mmvk/crowd)
   std::string_view label;        // short, for the viewer's header: "CMU 131 walks"
   std::string_view description;  // what it holds, for --help and the README
-  // The crowd's root correction half-life (seconds, > 0) for this set:
-  // --correction-half-life overrides it.
-  float correction_half_life = 0.0f;
 };
 
 // Every shipped set; the first is the default.
@@ -54,8 +52,6 @@ struct DataChoice {
   std::filesystem::path source;  // an .mmdb, a manifest or a folder of BVH
   std::string label;             // for messages: "the CMU subject 131 walks (cmu-walks)"
   std::string short_label;       // for the viewer's header
-  // A shipped set's tuned crowd settings (ShippedData); none for other data.
-  std::optional<float> correction_half_life;
 };
 // `data` none: the default set. Error: a shipped set whose files are missing.
 Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,

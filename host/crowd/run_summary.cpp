@@ -25,6 +25,7 @@ CrowdSummary summarize_run(const RunParts& run) {
   }
   s.backend = std::string(run.search.backend->name());
   s.device = run.search.device;
+  s.backend_choice = run.search.choice;
   s.forced_searches = run.controller.totals().forced;
   s.no_candidate = run.controller.totals().no_candidate;
   s.foot_ik = run.foot_ik;

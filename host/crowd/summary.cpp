@@ -42,6 +42,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["runners"] = s.runners;
   j["backend"] = s.backend;
   j["device"] = s.device;
+  j["backend_choice"] = s.backend_choice.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.backend_choice);
   j["searches"] = s.searches;
   j["forced_searches"] = s.forced_searches;
   j["no_candidate"] = s.no_candidate;

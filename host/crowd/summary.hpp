@@ -29,6 +29,7 @@ struct CrowdSummary {
   std::uint64_t runners = 0;       // characters that prefer to run
   std::string backend;
   std::string device;              // "cpu" for CPU backends
+  std::string backend_choice;      // why --backend auto picked `backend`; empty: it was named
   // How fast.
   std::uint64_t searches = 0;      // queries searched
   std::uint64_t forced_searches = 0;

@@ -15,8 +15,11 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "crowd_defaults.hpp"
+#include "crowd_limits.hpp"
 #include "crowd_session.hpp"
 #include "errors.hpp"
+#include "mmvk/number_text.hpp"
 #include "mmvk/steering_input.hpp"
 #include "scenario.hpp"
 #include "summary.hpp"
@@ -68,7 +71,7 @@ class PyCrowd {
   }
 
   void run(double seconds) {
-    if (!(seconds >= 0.0) || !std::isfinite(seconds)) raise("seconds: expected a finite number >= 0");
+    check(crowd::check_tick_count(seconds, session_->rate_hz(), 0, "seconds", crowd::SettingNames::Keywords));
     const auto ticks = std::uint64_t(std::llround(seconds / session_->dt()));
     Status status;
     {
@@ -144,8 +147,9 @@ crowd::Scenario scenario_of(const py::object& scenario) {
   return take(crowd::load_scenario(path), kind_for_input(path));
 }
 
-// Crowd(db, ...): the options of `mmvk crowd`.
+// Crowd(db, ...): the options of `mmvk crowd`, with its defaults.
 void add_construction(py::class_<PyCrowd>& crowd) {
+  static const crowd::CrowdSettings kDefaults;
   crowd
       .def(py::init([](std::shared_ptr<Database> db, const py::object& agents, const std::string& backend,
                        double rate, std::uint64_t seed, const py::object& device, const py::object& scenario,
@@ -161,23 +165,19 @@ void add_construction(py::class_<PyCrowd>& crowd) {
              options.title = title;
              if (!device.is_none()) options.device = device.cast<std::uint32_t>();
              if (!correction_half_life.is_none()) options.correction_half_life = correction_half_life.cast<float>();
-             if (!scenario.is_none()) {
-               options.scenario = scenario_of(scenario);
-               if (!agents.is_none() && agents.cast<std::size_t>() != options.scenario->agents.size()) {
-                 raise(options.scenario->source + ": defines " + std::to_string(options.scenario->agents.size()) +
-                       " agents, but agents=" + std::to_string(agents.cast<std::size_t>()) +
-                       " (leave agents out with a scenario)");
-               }
-             } else if (!agents.is_none()) {
+             if (!scenario.is_none()) options.scenario = scenario_of(scenario);
+             if (!agents.is_none()) {
+               // Checked as given, before the session checks the rest (CrowdSession::create).
                const long long n = agents.cast<long long>();
-               if (n < 1) raise("agents must be at least 1");
-               options.agents = std::uint32_t(std::min<long long>(n, 0xFFFFFFFFLL));
+               check(crowd::check_agent_count(double(n), crowd::SettingNames::Keywords));
+               options.agents = std::uint64_t(n);
              }
              return std::make_unique<PyCrowd>(std::move(db), options);
            }),
-           py::arg("db"), py::arg("agents") = py::none(), py::arg("backend") = "clusters", py::arg("rate") = 30.0,
-           py::arg("seed") = 1, py::arg("device") = py::none(), py::arg("scenario") = py::none(),
-           py::arg("search_interval") = 0.1, py::arg("foot_ik") = true, py::arg("record") = false,
+           py::arg("db"), py::arg("agents") = py::none(), py::arg("backend") = kDefaults.backend,
+           py::arg("rate") = kDefaults.rate_hz, py::arg("seed") = kDefaults.seed, py::arg("device") = py::none(),
+           py::arg("scenario") = py::none(), py::arg("search_interval") = kDefaults.search_interval_s,
+           py::arg("foot_ik") = kDefaults.foot_ik, py::arg("record") = false,
            py::arg("title") = "", py::arg("correction_half_life") = py::none());
 }
 
@@ -316,18 +316,30 @@ void add_outputs(py::class_<PyCrowd>& crowd) {
       });;
 }
 
+// The class's docstring, its bounds from the crowd's limits (crowd_limits.hpp).
+const char* crowd_doc() {
+  static const std::string doc =
+      "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
+      "figures and defaults. Crowd(db, agents=None, backend='auto', rate=30.0, seed=1, device=None, scenario=None, "
+      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None). agents: the number of "
+      "characters (1 to " + std::to_string(crowd::kMaxAgents) + "), drawn with goals from seed (default " +
+      std::to_string(crowd::kDefaultAgents) + "), or scenario: a scenario JSON file or "
+      "dict (starts, goals, speeds, tags; `mmvk crowd --scenario`), which sets the count. backend 'auto': a Vulkan "
+      "backend on a GPU, else the fastest CPU backend. rate: " + number_text(crowd::kMinRateHz) + " to " +
+      number_text(crowd::kMaxRateHz) + " ticks per second; search_interval: " +
+      number_text(crowd::kMinSearchIntervalS) + " to " + number_text(crowd::kMaxSearchIntervalS) +
+      " s. correction_half_life: seconds of the pull of each character's animated root towards its simulated "
+      "position (None: the database's, from its manifest's \"crowd\" block, else " +
+      number_text(crowd::kCorrectionHalfLife) + "; `mmvk crowd "
+      "--correction-half-life`). Every setting is checked before anything is allocated. record=True keeps the "
+      "viewer's recording for write_html().";
+  return doc.c_str();
+}
+
 }  // namespace
 
 void bind_crowd(py::module_& m) {
-  py::class_<PyCrowd> crowd(
-      m, "Crowd",
-      "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
-      "figures. Crowd(db, agents=None, backend='clusters', rate=30.0, seed=1, device=None, scenario=None, "
-      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None). agents: the number of characters, drawn with "
-      "goals from seed (default 100), or scenario: a scenario JSON file or dict (starts, goals, speeds, tags; "
-      "`mmvk crowd --scenario`), which sets the count. correction_half_life: seconds of the pull of each "
-      "character's animated root towards its simulated position (None: 0.15; `mmvk crowd --correction-half-life`; "
-      "the shipped cmu-walk-run set is tuned for 0.07). record=True keeps the viewer's recording for write_html().");
+  py::class_<PyCrowd> crowd(m, "Crowd", crowd_doc());
   add_construction(crowd);
   add_stepping(crowd);
   add_settings(crowd);

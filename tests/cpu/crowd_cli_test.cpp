@@ -91,7 +91,7 @@ TEST_F(CrowdCli, DefaultDataIsBuiltOnceThenCachedAndTheSummaryHasEveryKey) {
 
 TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
   expect_failure("--agents 5 --seconds 1 --backend warp-drive", "unknown backend 'warp-drive'");
-  expect_failure("--agents 0", "--agents expects an integer in [1, 10000000], got '0'");
+  expect_failure("--agents 0", "--agents 0: expected 1 to 1048576 characters");
   expect_failure("--rate 0", "--rate expects a positive number");
   expect_failure("--rate -30", "--rate expects a positive number");
   expect_failure("--rate inf", "--rate expects a positive number");
@@ -100,10 +100,22 @@ TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
   expect_failure("--trace-agents 2", "--trace-agents needs --trace FILE");
   expect_failure("--search-interval 0", "--search-interval expects a positive number");
   expect_failure("--seconds nan", "--seconds expects a positive number");
-  expect_failure("--agents many", "--agents expects an integer");
+  expect_failure("--agents many", "--agents expects a non-negative integer, got 'many'");
   expect_failure("--data /nonexistent/db.mmdb", "/nonexistent/db.mmdb");
   expect_failure("--frobnicate", "unknown option '--frobnicate'");
   expect_failure("--agents 5 --seconds 1 --backend reference --device 0", "--device picks a Vulkan device");
+  // The bounds checked on the value given (issue 34), not on its rounded print.
+  expect_failure("--rate 0.9999999", "--rate 0.9999999: expected 1 to 1000");
+  expect_failure("--search-interval 3600.001", "--search-interval 3600.001: expected 0.001 to 3600");
+  expect_failure("--seconds 333333.4", "--seconds 333333.4 at --rate 30: over 10000000 ticks");
+  // The documented bound is the search's batch limit.
+  expect_failure("--agents 1048577", "--agents 1048577: expected 1 to 1048576 characters");
+}
+
+TEST_F(CrowdCli, TheLargestAgentCountIsAccepted) {
+  // Checked up to the database (--agents is within its bound), then refused
+  // by an unreadable data path rather than by the count.
+  expect_failure("--agents 1048576 --data /nonexistent/db.mmdb", "/nonexistent/db.mmdb: no such file");
 }
 
 TEST_F(CrowdCli, ControlsAndTraceErrorsNameTheOption) {
@@ -116,6 +128,18 @@ TEST_F(CrowdCli, ControlsAndTraceErrorsNameTheOption) {
   expect_failure(run + "--continuing-multiplier -1", "--continuing-multiplier must be >= 0");
   expect_failure(run + "--correction-half-life 0", "--correction-half-life expects a positive number");
   expect_failure(run + "--correction-half-life nan", "--correction-half-life expects a positive number");
+  // Values whose costs would overflow float fail before the run, naming the
+  // option and the value (issue 34), not as a search error after it.
+  for (const char* value : {"--continuing-bias 3.4e38", "--continuing-multiplier 3.4e38",
+                            "--weights hip_velocity=3.4e38"}) {
+    const auto result = run_command(mmvk_ + " crowd " + run + value);
+    EXPECT_EQ(result.exit_code, 1) << value << "\n" << result.output;
+    const std::string option = std::string(value).substr(0, std::string(value).find(' '));
+    const std::string given = std::string(value).substr(option.size() + 1);
+    const std::string named = option + " " + given.substr(0, given.find("3.4e38")) + "3.4e+38: the search's costs";
+    EXPECT_NE(result.output.find(named), std::string::npos) << value << "\n" << result.output;
+    EXPECT_EQ(result.output.find("ticks in"), std::string::npos) << value << "\n" << result.output;
+  }
   const std::string trace = (dir_ / "t.f32").string();
   expect_failure(run + "--trace " + trace + " --trace-agents 5", "--trace-agents 5 must be in [1, 3]");
   expect_failure(run + "--trace " + trace + " --summary " + trace, "name the same file");
@@ -202,6 +226,27 @@ TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
                                    "--correction-half-life 0.2 --summary " + summary.string());
   ASSERT_EQ(flagged.exit_code, 0) << flagged.output;
   EXPECT_EQ(read_summary(summary)["correction_half_life_s"].get<double>(), 0.2);
+}
+
+TEST_F(CrowdCli, UsersDataCarriesItsOwnCrowdSettings) {
+  // A manifest's "crowd" block sets the data's tuning; a flag still wins;
+  // an unknown key is an error naming it.
+  const auto manifest = [&](const std::string& name, const std::string& crowd) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path) << R"({"fps": 30, "crowd": )" << crowd << R"(, "clips": [{"file": ")"
+                        << (shipped_ / "131_01.bvh").string() << R"(", "tags": ["walk"]}]})";
+    return path.string();
+  };
+  const fs::path summary = dir_ / "own-summary.json";
+  const std::string own = manifest("own.json", R"({"correction_half_life": 0.11, "continuing_bias": -2})");
+  const auto ran = run_command(mmvk_ + " crowd --data " + own + " --agents 4 --seconds 1 --summary " +
+                               summary.string());
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  EXPECT_NEAR(read_summary(summary)["correction_half_life_s"].get<double>(), 0.11, 1e-6);
+  expect_failure("--agents 4 --seconds 1 --data " + manifest("bad.json", R"({"correction_halflife": 0.1})"),
+                 "crowd.correction_halflife: unknown crowd setting (known: correction_half_life, continuing_bias");
+  expect_failure("--agents 4 --seconds 1 --data " + manifest("neg.json", R"({"correction_half_life": -1})"),
+                 "crowd.correction_half_life: expected a positive number of seconds");
 }
 
 TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {

@@ -132,6 +132,25 @@ TEST(DatabaseIo, ImportUnitsMakeAVersion4FileAndRoundTrip) {
   }
 }
 
+TEST(DatabaseIo, CrowdSettingsMakeAVersion6FileAndRoundTrip) {
+  const Database without = make_database();
+  DatabaseParts parts = without.parts();
+  parts.crowd_settings = R"({"correction_half_life":0.07})";
+  Result<Database> with = Database::create(std::move(parts));
+  ASSERT_TRUE(with.ok()) << with.message();
+  const std::string bytes = serialize_database(*with);
+  EXPECT_EQ(bytes[8], char(6));
+  Result<Database> back = deserialize_database(bytes, "db.mmdb");
+  ASSERT_TRUE(back.ok()) << back.message();
+  EXPECT_EQ(back->crowd_settings(), R"({"correction_half_life":0.07})");
+  EXPECT_EQ(serialize_database(*back), bytes);
+  EXPECT_EQ(back->content_hash(), without.content_hash()) << "crowd settings do not change what a search sees";
+  EXPECT_TRUE(deserialize_database(serialize_database(without), "db.mmdb")->crowd_settings().empty());
+  for (std::size_t size = 0; size < bytes.size(); size += 7) {
+    EXPECT_FALSE(deserialize_database(std::string_view(bytes).substr(0, size), "db.mmdb").ok()) << size;
+  }
+}
+
 TEST(DatabaseIo, TruncatedFilesAreRejectedAtEveryLength) {
   const std::string bytes = serialize_database(make_database());
   for (std::size_t length = 0; length < bytes.size(); length += (length < 128 || length + 128 > bytes.size()) ? 1 : 97) {

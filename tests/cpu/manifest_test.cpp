@@ -166,6 +166,18 @@ TEST(Manifest, ContactsBlock) {
   EXPECT_EQ(manifest->contacts.left_toe, "@left_toe");
 }
 
+TEST(Manifest, TheCrowdBlockIsKeptAsItsJsonText) {
+  Result<Manifest> manifest =
+      parse_manifest_json(R"({"crowd": {"correction_half_life": 0.07}, "clips": ["a.bvh"]})", "m.json", "/base");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  EXPECT_EQ(manifest->crowd, R"({"correction_half_life":0.07})");
+  manifest = parse_manifest_json(R"({"clips": ["a.bvh"]})", "m.json", "/base");
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  EXPECT_TRUE(manifest->crowd.empty());
+  EXPECT_NE(manifest_error(R"({"crowd": [1], "clips": ["a.bvh"]})").find("m.json: crowd: expected an object"),
+            std::string::npos);
+}
+
 TEST(Manifest, ContactsErrorsNameTheField) {
   const auto error = [](std::string_view contacts) {
     return manifest_error(std::string(R"({"contacts": )") + std::string(contacts) + R"(, "clips": ["a.bvh"]})");

@@ -124,5 +124,64 @@ def test_arrays_and_errors(db, tmp_path):
     assert crowd.write_html(tmp_path / "crowd.html") > 1000
     with pytest.raises(ValueError, match="unknown backend"):
         mmvk.Crowd(db, agents=2, backend="nope")
-    with pytest.raises(ValueError, match="correction_half_life must be a positive number"):
+    with pytest.raises(ValueError, match="correction_half_life 0: expected a positive number"):
         mmvk.Crowd(db, agents=2, correction_half_life=0.0)
+
+
+CMU16 = CMU131.parent.parent / "cmu16" / "manifest.json"
+
+
+def test_crowd_and_the_command_line_agree_on_the_default_data(cli, tmp_path):
+    """The same data, seed and settings: mmvk.Crowd and `mmvk crowd` (its default
+    data, cmu-walk-run, with the correction half-life of its manifest's "crowd"
+    block) choose the same frames and report the same figures."""
+    db16 = mmvk.build(CMU16)
+    crowd = mmvk.Crowd(db16, agents=30, backend="fast-box", seed=7)
+    crowd.run(2.0)
+    summary = crowd.summary()
+    out = tmp_path / "crowd.json"
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))
+    subprocess.run([str(cli), "crowd", "--agents", "30", "--seconds", "2", "--backend", "fast-box", "--seed", "7",
+                    "--summary", str(out)], check=True, capture_output=True, env=env)
+    want = json.loads(out.read_text())
+    assert want["correction_half_life_s"] == pytest.approx(0.07)
+    for key in ["agents", "ticks", "searches", "chosen_frames_hash", "goals_reached", "correction_half_life_s",
+                "runners", "backend"]:
+        assert summary[key] == want[key], key
+    for key in ["trajectory_error_m_1s", "foot_sliding_cm_s", "transitions_per_agent_s", "walk_mps", "run_mps",
+                "knee_speed_p99_deg_s"]:
+        assert summary[key] == pytest.approx(want[key], rel=1e-6), key
+
+
+def test_settings_are_checked_before_anything_is_allocated(db):
+    # The command line's bounds (issue 34): a rate of 1e9 fails at once
+    # instead of allocating gigabytes.
+    with pytest.raises(ValueError, match=r"rate 1e\+09: expected 1 to 1000"):
+        mmvk.Crowd(db, agents=2, rate=1e9)
+    with pytest.raises(ValueError, match=r"rate 0.9999999: expected 1 to 1000"):
+        mmvk.Crowd(db, agents=2, rate=0.9999999)
+    with pytest.raises(ValueError, match=r"search_interval 1e-300: expected 0.001 to 3600"):
+        mmvk.Crowd(db, agents=2, search_interval=1e-300)
+    with pytest.raises(ValueError, match=r"agents 1048577: expected 1 to 1048576"):
+        mmvk.Crowd(db, agents=1048577)
+    with pytest.raises(ValueError, match=r"agents -1: expected 1 to"):
+        mmvk.Crowd(db, agents=-1)
+    crowd = mmvk.Crowd(db, agents=2, backend="fast-box")
+    with pytest.raises(ValueError, match=r"seconds 1e\+09 at rate 30: over 10000000 ticks"):
+        crowd.run(1e9)
+
+
+def test_the_databases_crowd_block_tunes_the_crowd(db):
+    manifest = json.loads(CMU131.read_text())
+    manifest["clips"] = [dict(c, file=str(CMU131.parent / c["file"])) for c in manifest["clips"][:2]]
+    manifest["crowd"] = {"correction_half_life": 0.11}
+    tuned = mmvk.build(manifest)
+    crowd = mmvk.Crowd(tuned, agents=2, backend="fast-box")
+    crowd.step()
+    assert crowd.summary()["correction_half_life_s"] == pytest.approx(0.11)
+    # Kept in the .mmdb; a keyword still wins.
+    assert mmvk.Crowd(tuned, agents=2, backend="fast-box", correction_half_life=0.2).summary()[
+        "correction_half_life_s"] == pytest.approx(0.2)
+    manifest["crowd"] = {"correction_halflife": 0.1}
+    with pytest.raises(ValueError, match=r"crowd.correction_halflife: unknown crowd setting"):
+        mmvk.Crowd(mmvk.build(manifest), agents=2, backend="fast-box")

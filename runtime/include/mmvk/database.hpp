@@ -63,6 +63,9 @@ struct DatabaseParts {
   // The skeleton and per-frame poses (animation_data.hpp); absent in a
   // database built with --no-animation or loaded from a format 1 file.
   std::optional<AnimationData> animation;
+  // The manifest's "crowd" block as JSON text (a crowd host's tuned settings
+  // for this data), or empty; not part of content_hash().
+  std::string crowd_settings;
 };
 
 class Database {
@@ -85,6 +88,8 @@ class Database {
   std::span<const Clip> clips() const { return parts_.clips; }
   // The animation section, or null when the database has none.
   const AnimationData* animation() const { return parts_.animation ? &*parts_.animation : nullptr; }
+  // DatabaseParts::crowd_settings: JSON text of an object, or empty.
+  const std::string& crowd_settings() const { return parts_.crowd_settings; }
 
   // Per-frame metadata, [frame_count] each (the clip's values repeated, or
   // DatabaseParts' per-frame values, so backends index them by frame without

@@ -16,6 +16,9 @@
 //   "contacts": { "enter_speed": 0.1, "exit_speed": 0.2, ... },
 //                              // foot contact detection: any FootContactParams
 //                              // field by name (foot_contacts.hpp; defaults there)
+//   "crowd": { "correction_half_life": 0.07, ... },
+//                              // settings a crowd host tuned for this data, kept in
+//                              // the database as they are (Database::crowd_settings)
 //   "clips": [
 //     { "file": "walk.bvh",    // relative paths are relative to the manifest's folder
 //       "range": [0.5, 1.4],   // only this part of the file, seconds (default: all of it)
@@ -147,6 +150,10 @@ struct Manifest {
   std::vector<BonePair> mirror_bones;     // overrides mirror_pairs()' heuristics
   std::vector<SidecarMirror> mirror_map;
   FootContactParams contacts;      // the animation's contacts and the foot_contact channel
+  // The "crowd" object as JSON text, or empty: read by the crowd host
+  // (host/crowd/data_settings.hpp), which names its unknown keys; the build
+  // only carries it into the database.
+  std::string crowd;
   std::vector<ManifestClip> clips;
 };
 

@@ -125,6 +125,13 @@ Status validate_search(const Database& database, const QueryBatch& batch, std::u
 // whose results are written later (a paged device search).
 Status validate_queries(const Database& database, const QueryBatch& batch, std::uint32_t k);
 
+// True when every query inside the database's range (|q_d| <= max|row_d| in
+// each dim, as queries made from the data's own poses are) can be searched
+// with `params` without its costs overflowing float: the bound
+// validate_search checks per query, for a host to check its settings
+// (weights, continuing bias and multiplier) once, before it searches.
+bool params_fit_cost_bound(const Database& database, const QueryParams& params);
+
 // Sets the weight of the channel named `channel` in `params` (finite, >= 0;
 // 0 turns the channel off); the error names an unknown channel.
 Status set_channel_weight(const FeatureSchema& schema, QueryParams& params, std::string_view channel, float weight);

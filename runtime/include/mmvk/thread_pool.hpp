@@ -21,6 +21,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "mmvk/status.hpp"
@@ -54,10 +55,32 @@ class ThreadPool {
 
   unsigned thread_count() const { return static_cast<unsigned>(workers_.size()) + 1; }
 
+  // A non-owning reference to parallel_for's body, callable as
+  // body(begin, end, thread_index): a lambda converts to it without the
+  // heap allocation std::function makes for one capturing more than two
+  // references (each search call of a crowd tick passes one).
+  class Body {
+   public:
+    template <class F>
+      requires(!std::is_same_v<std::remove_cvref_t<F>, Body> &&
+               std::is_invocable_v<F&, std::size_t, std::size_t, unsigned>)
+    Body(F&& body) noexcept  // implicit, as std::function is
+        : object_(const_cast<void*>(static_cast<const void*>(std::addressof(body)))),
+          call_([](void* object, std::size_t begin, std::size_t end, unsigned thread) {
+            (*static_cast<std::remove_reference_t<F>*>(object))(begin, end, thread);
+          }) {}
+    void operator()(std::size_t begin, std::size_t end, unsigned thread) const { call_(object_, begin, end, thread); }
+
+   private:
+    void* object_;
+    void (*call_)(void*, std::size_t, std::size_t, unsigned);
+  };
+
   // Calls body(begin, end, thread_index) over chunks of [0, count); at most
-  // thread_count() chunks run at once, thread_index < thread_count().
+  // thread_count() chunks run at once, thread_index < thread_count(). The
+  // body must live until the call returns (a temporary lambda does).
   // Not reentrant: one parallel_for at a time per pool.
-  void parallel_for(std::size_t count, const std::function<void(std::size_t, std::size_t, unsigned)>& body);
+  void parallel_for(std::size_t count, Body body);
 
  private:
   void worker_loop(unsigned index);
@@ -74,7 +97,7 @@ class ThreadPool {
   std::condition_variable done_;
   // Written under mutex_; generation_ and pending_ are also read without it
   // by the spinning threads, which then take mutex_ before they act.
-  const std::function<void(std::size_t, std::size_t, unsigned)>* body_ = nullptr;
+  const Body* body_ = nullptr;
   std::size_t count_ = 0;
   std::atomic<std::size_t> generation_{0};
   std::atomic<unsigned> pending_{0};

@@ -83,7 +83,7 @@ ThreadPool::~ThreadPool() {
   for (std::thread& worker : workers_) worker.join();
 }
 
-void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::size_t, std::size_t, unsigned)>& body) {
+void ThreadPool::parallel_for(std::size_t count, Body body) {
   if (count == 0) return;
   const unsigned parts = thread_count();
   if (parts == 1 || count == 1) {
@@ -113,7 +113,7 @@ void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::s
 void ThreadPool::worker_loop(unsigned index) {
   std::size_t seen_generation = 0;
   for (;;) {
-    const std::function<void(std::size_t, std::size_t, unsigned)>* body = nullptr;
+    const Body* body = nullptr;
     std::size_t count = 0;
     const auto called = [&] {
       return stopping_.load(std::memory_order_acquire) ||

@@ -252,9 +252,10 @@ Status add_frame_modifiers(const ProcessedClip& processed, const Clip& clip, con
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
                           const FootContactParams& contacts,
                           const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
-                          const std::string& source) {
+                          const std::string& source, const std::string& crowd_settings) {
   if (clips.empty()) return make_error(source + ": no clips");
   DatabaseParts parts;
+  parts.crowd_settings = crowd_settings;
   parts.schema = schema;
   parts.fps = fps;
   const std::uint32_t dims = schema.dims();
@@ -452,7 +453,8 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     clip.clips.clear();
   }
   MMVK_ASSIGN_OR_RETURN(Database database,
-                        assemble(clips, manifest.schema, fps, manifest.contacts, options.animation, manifest.mirror_bones, source));
+                        assemble(clips, manifest.schema, fps, manifest.contacts, options.animation, manifest.mirror_bones, source,
+                                 manifest.crowd));
   MMVK_TRY(detail::check_cost_overflow(database, source));
   return database;
 }
@@ -473,7 +475,7 @@ Result<Database> build_database_from_motions(std::span<const MotionClip> clips, 
     processed.push_back(std::move(*one));
   }
   MMVK_ASSIGN_OR_RETURN(Database database, assemble(processed, settings.schema, fps, settings.contacts,
-                                                    settings.animation, {}, "build_database_from_motions"));
+                                                    settings.animation, {}, "build_database_from_motions", ""));
   MMVK_TRY(detail::check_cost_overflow(database, "build_database_from_motions"));
   return database;
 }

@@ -311,12 +311,13 @@ std::string serialize_database(const Database& database) {
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
   // The oldest version that holds the database, so that older builds read
-  // what they can: 5 with an animation section (its contact layout), else 4
+  // what they can: 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
   // with import units, else 3 with per-frame modifiers, else 2.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
   const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
                                  [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
-  const std::uint32_t version = parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
+  const std::uint32_t version =
+      !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
   file.u32(version);
   file.u32(0);
   file.u64(0);
@@ -356,6 +357,7 @@ std::string serialize_database(const Database& database) {
   if (units) {
     for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
+  if (version >= 6) file.str(parts.crowd_settings);
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
 
@@ -517,6 +519,7 @@ class PayloadReader {
         for (Clip& clip : parts.clips) (void)in_.f32(clip.metres_per_unit);
       }
     }
+    if (version_ >= 6 && !in_.str(parts.crowd_settings)) return corrupt("crowd settings");
     if (version_ >= 2) {
       std::uint8_t has_animation = 0;
       if (!in_.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");

@@ -419,7 +419,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   const Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"clips\"");
   MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "mirror_bones",
-                                          "mirror_map", "contacts", "clips"}));
+                                          "mirror_map", "contacts", "crowd", "clips"}));
 
   Manifest manifest;
   manifest.source = name;
@@ -444,6 +444,10 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
     MMVK_READ(manifest.mirror_map, read_mirror_map(root["mirror_map"], manifest.schema, at + "mirror_map"));
   }
   if (root.contains("contacts")) MMVK_READ(manifest.contacts, read_contacts(root["contacts"], at + "contacts"));
+  if (root.contains("crowd")) {
+    if (!root["crowd"].is_object()) return make_error(at + "crowd: expected an object of crowd settings");
+    manifest.crowd = root["crowd"].dump();
+  }
   MMVK_TRY(read_clips_field(root, at, base_dir, mirror_all, manifest));
   return manifest;
 }

@@ -39,6 +39,7 @@ struct FastSearch::Workspace {
   };
   std::vector<Thread> threads;
   std::vector<Match> partial;  // [parts x B x k] when one query is split over threads
+  std::vector<Match> merged;   // [parts x k]: one query's lists, merged (kept, so a search allocates nothing)
 };
 
 FastSearch::FastSearch(const Database& database, ThreadPool& pool, FastSearchOptions options)
@@ -292,7 +293,7 @@ Status FastSearch::search(const QueryBatch& batch, std::uint32_t k, std::span<Ma
                      std::span<Match>(partial).subspan(part * count * k, count * k), thread);
       }
     });
-    std::vector<Match> merged;
+    std::vector<Match>& merged = workspace_->merged;
     merged.reserve(std::size_t{parts} * k);
     for (std::size_t q = 0; q < count; ++q) {
       merged.clear();

@@ -36,6 +36,12 @@ Status set_channel_weight(const FeatureSchema& schema, QueryParams& params, std:
   return {};
 }
 
+bool params_fit_cost_bound(const Database& database, const QueryParams& params) {
+  const double bound = cost_bound(database, database.max_abs_features(), params, database.max_multiplier(),
+                                  database.max_abs_bias());
+  return bound <= detail::kMaxCostBound;
+}
+
 Status validate_queries(const Database& database, const QueryBatch& batch, std::uint32_t k) {
   if (database.frame_count() == 0) return make_error("search: the database is empty");
   if (k < 1 || k > kMaxK) {
@@ -65,18 +71,20 @@ Status validate_queries(const Database& database, const QueryBatch& batch, std::
   const std::size_t channels = database.schema().channels.size();
   for (std::size_t q = 0; q < batch.params.size(); ++q) {
     const QueryParams& p = batch.params[q];
-    const std::string where = "search: query " + std::to_string(q) + ": ";
+    // The message is built only on failure: this loop runs on every query
+    // of every crowd tick, which allocates nothing.
+    const auto where = [q] { return "search: query " + std::to_string(q) + ": "; };
     if (p.continuing_frame != kNoFrame && p.continuing_frame >= database.frame_count()) {
-      return make_error(where + "continuing_frame " + std::to_string(p.continuing_frame) + " is out of range (" +
+      return make_error(where() + "continuing_frame " + std::to_string(p.continuing_frame) + " is out of range (" +
                         std::to_string(database.frame_count()) + " frames)");
     }
-    if (!std::isfinite(p.continuing_bias)) return make_error(where + "continuing_bias is not finite");
+    if (!std::isfinite(p.continuing_bias)) return make_error(where() + "continuing_bias is not finite");
     if (!std::isfinite(p.continuing_multiplier) || p.continuing_multiplier < 0.0f) {
-      return make_error(where + "continuing_multiplier must be finite and >= 0");
+      return make_error(where() + "continuing_multiplier must be finite and >= 0");
     }
     for (std::size_t c = 0; c < channels; ++c) {
       if (!std::isfinite(p.channel_weights[c]) || p.channel_weights[c] < 0.0f) {
-        return make_error(where + "weight of channel '" + database.schema().channels[c].name +
+        return make_error(where() + "weight of channel '" + database.schema().channels[c].name +
                           "' must be finite and >= 0");
       }
     }

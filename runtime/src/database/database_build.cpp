@@ -10,6 +10,7 @@
 #include "mmvk/bvh.hpp"
 #include "mmvk/character.hpp"
 #include "mmvk/features.hpp"
+#include "mmvk/import_check.hpp"
 #include "mmvk/normalization.hpp"
 #include "mmvk/scene_import.hpp"
 #include "database/animation_build.hpp"
@@ -323,6 +324,17 @@ void mirror_sidecars(const Manifest& manifest, std::vector<std::vector<float>>& 
   }
 }
 
+bool tagged_walk(const ManifestClip& meta) {
+  return std::find(meta.tags.begin(), meta.tags.end(), "walk") != meta.tags.end();
+}
+
+// The import's plausibility (import_check.hpp), unless the manifest accepts
+// whatever it measures.
+Status check_plausible_import(const Manifest& manifest, const Motion& motion, const ImportContext& context) {
+  if (manifest.import.accept_implausible) return {};
+  return check_import(measure_import(motion), context);
+}
+
 // One motion a clip's file holds: a BVH's, or one animation of a scene file.
 struct SourceMotion {
   std::string animation;  // the scene animation's name; empty for BVH
@@ -342,6 +354,9 @@ Result<std::vector<SourceMotion>> import_clip_file(const Manifest& manifest, con
     options.animation = meta.animation;
     MMVK_ASSIGN_OR_RETURN(SceneImport scene, import_scene(meta.file, options));
     for (SceneAnimation& animation : scene.animations) {
+      const ImportContext context{meta.file.string() + " (animation '" + animation.name + "')", scene.metres_per_unit,
+                                  scene.units_from, manifest.import.up_axis, scene.axes_from, tagged_walk(meta)};
+      MMVK_TRY(check_plausible_import(manifest, animation.motion, context));
       motions.push_back({std::move(animation.name), std::move(animation.motion), scene.metres_per_unit});
     }
     return motions;
@@ -357,6 +372,14 @@ Result<std::vector<SourceMotion>> import_clip_file(const Manifest& manifest, con
   // The units the import used, recorded so that `mmvk inspect` can show them.
   const float units = manifest.import.metres_per_unit > 0.0f ? manifest.import.metres_per_unit
                                                              : guess_metres_per_unit(*bvh);
+  const bool given_axis = manifest.import.up_axis_given;
+  const ImportContext context{
+      meta.file.string(), units,
+      manifest.import.metres_per_unit > 0.0f ? "the manifest's import.metres_per_unit" : "guessed from the skeleton's size",
+      manifest.import.up_axis,
+      given_axis ? std::string("the manifest's import.up_axis") : std::string("BVH files are read Y-up unless told"),
+      tagged_walk(meta)};
+  MMVK_TRY(check_plausible_import(manifest, *motion, context));
   motions.push_back({"", std::move(*motion), units});
   return motions;
 }

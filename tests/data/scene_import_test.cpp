@@ -284,6 +284,30 @@ TEST(SceneImport, SeveralAnimationsAreSeveralClipsNamedAfterThem) {
       << missing.message();
 }
 
+TEST(SceneImport, WrongUnitsOrUpAxisOnAGltfAreRefused) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  write_gltf(walk, dir, "walk", "walk");
+  auto build = [&](const std::string& import) {
+    const std::string text = R"({"fps": 30, "import": )" + import + R"(, "clips": ["walk.gltf"]})";
+    auto manifest = mmvk::parse_manifest_json(text, "w.json", dir);
+    EXPECT_TRUE(manifest.ok()) << manifest.message();
+    return mmvk::build_database(*manifest);
+  };
+  const auto centimetres = build(R"({"metres_per_unit": 100})");  // metres read as if they were hectometres
+  ASSERT_FALSE(centimetres.ok());
+  EXPECT_NE(centimetres.message().find("walk.gltf (animation 'walk'): implausible import: standing height"),
+            std::string::npos) << centimetres.message();
+  EXPECT_NE(centimetres.message().find("set \"import\": {\"metres_per_unit\": 1}"), std::string::npos)
+      << centimetres.message();
+  const auto z_up = build(R"({"up_axis": "z"})");  // glTF is Y-up
+  ASSERT_FALSE(z_up.ok());
+  EXPECT_NE(z_up.message().find("the body is not upright along +Y"), std::string::npos) << z_up.message();
+  EXPECT_NE(z_up.message().find("set \"import\": {\"up_axis\": \"y\"}"), std::string::npos) << z_up.message();
+  EXPECT_TRUE(build(R"({"up_axis": "z", "accept_implausible": true})").ok());
+  EXPECT_TRUE(build(R"({"up_axis": "y"})").ok());
+}
+
 TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {
   const auto cli = mmvk::test::cli_binary();
   if (!cli) GTEST_SKIP() << "no mmvk command line in this build";

@@ -47,7 +47,8 @@ bool is_scene_path(const std::filesystem::path& path);
 // joints) one animation may produce: a hostile duration or rate is an error,
 // not an allocation.
 inline constexpr std::uint64_t kMaxSceneFileBytes = std::uint64_t{1} << 30;
-inline constexpr std::uint64_t kMaxSceneSamples = std::uint64_t{1} << 27;
+// (2^25 samples is 0.9 GB of local transforms.)
+inline constexpr std::uint64_t kMaxSceneSamples = std::uint64_t{1} << 25;
 
 struct SceneImportOptions {
   // metres_per_unit > 0 overrides the file's units; up_axis_given makes
@@ -59,6 +60,8 @@ struct SceneImportOptions {
   float fps = 0.0f;
   // Only the animation of this name; empty = every animation in the file.
   std::string animation;
+  // The most samples (frames x joints) of one animation; more is an error.
+  std::uint64_t max_samples = kMaxSceneSamples;
 };
 
 struct SceneAnimation {

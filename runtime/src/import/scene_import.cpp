@@ -133,15 +133,15 @@ std::string animation_label(const aiAnimation& animation, unsigned index) {
 
 // One animation sampled into a Motion over the tree's joints.
 Result<Motion> sample_animation(const NodeTree& tree, const aiAnimation& animation, float fps,
-                                const std::string& where) {
+                                std::uint64_t max_samples, const std::string& where) {
   const double ticks = animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0;
   const double duration = animation.mDuration / ticks;
   if (!(duration >= 0.0) || !std::isfinite(duration)) return make_error(where + ": its duration is not finite and >= 0");
   const double frames = std::round(duration * fps) + 1.0;
-  if (frames * double(tree.joints.size()) > double(kMaxSceneSamples)) {
+  if (frames * double(tree.joints.size()) > double(max_samples)) {
     char text[200];
     std::snprintf(text, sizeof(text), ": %.6g s at %g fps is %.6g frames of %zu joints, over the limit of %llu samples",
-                  duration, double(fps), frames, tree.joints.size(), static_cast<unsigned long long>(kMaxSceneSamples));
+                  duration, double(fps), frames, tree.joints.size(), static_cast<unsigned long long>(max_samples));
     return make_error(where + text);
   }
   Motion motion;
@@ -181,7 +181,7 @@ Result<SceneImport> import_loaded(const aiScene* scene, const std::string& ext, 
     MMVK_ASSIGN_OR_RETURN(NodeTree tree,
                           detail::build_node_tree(*scene, &animation, to_mmvk, out.metres_per_unit, where));
     const float fps = options.fps > 0.0f ? options.fps : key_rate(animation);
-    MMVK_ASSIGN_OR_RETURN(Motion motion, sample_animation(tree, animation, fps, where));
+    MMVK_ASSIGN_OR_RETURN(Motion motion, sample_animation(tree, animation, fps, options.max_samples, where));
     out.animations.push_back({animation.mName.C_Str(), std::move(motion)});
   }
   if (out.animations.empty()) {

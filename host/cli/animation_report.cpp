@@ -21,7 +21,11 @@ const char* encoding_name(RotationEncoding encoding) {
 void print_animation(const Database& database) {
   const AnimationData* a = database.animation();
   if (a == nullptr) {
-    std::printf("animation: none (features only; rebuild without --no-animation to add poses)\n");
+    // The file does not say why: the causes, so as not to blame a flag the
+    // user never passed.
+    std::printf("animation: none (features only: the clips' skeletons differ, which the build warned of, or it was "
+                "built with --no-animation, or it is a format 1 file; rebuild from clips of one skeleton to add "
+                "poses)\n");
     return;
   }
   std::printf("animation: %zu joints (%zu translated per frame), rotations %s; %zu bytes per frame in the file, "

@@ -84,8 +84,10 @@ Status check_paths(const BuildArgs& args, const Manifest& manifest) {
   std::error_code ec;
   const bool folder = std::filesystem::is_directory(args.input, ec);
   std::vector<NamedPath> paths = {{"-o", args.output, true}};
-  // A BVH file is its manifest's one clip, and is named as an input below.
-  if (folder || !is_bvh_path(args.input)) paths.push_back({folder ? "the BVH folder" : "the manifest", args.input, false});
+  // A motion file is its manifest's one clip, and is named as an input below.
+  if (folder || !is_motion_path(args.input)) {
+    paths.push_back({folder ? "the motion folder" : "the manifest", args.input, false});
+  }
   if (args.schema) paths.push_back({"--schema", *args.schema, false});
   for (const std::filesystem::path& file : manifest_input_files(manifest)) paths.push_back({"the input", file, false});
   return check_command_paths(paths);

@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "help_format.hpp"
+#include "mmvk/database_io.hpp"
 
 namespace {
 
@@ -17,7 +18,7 @@ constexpr const mmvk::cli::Command* kCommands[] = {
     &mmvk::cli::kQueryCommand, &mmvk::cli::kCrowdCommand,   &mmvk::cli::kClustersCommand};
 
 std::string usage() {
-  std::string text = "usage: mmvk <command> [options]\n\ncommands:\n";
+  std::string text = "usage: mmvk <command> [options]\n       mmvk --version\n\ncommands:\n";
   for (const mmvk::cli::Command* command : kCommands) {
     text += mmvk::cli::help_entry(std::string(command->name) + " " + std::string(command->arguments),
                                   command->summary, 47, 100);
@@ -63,6 +64,14 @@ int main(int argc, char** argv) {
     }
     std::fputs(usage().c_str(), stdout);
     return check_stdout("help", 0);
+  }
+  if (args[0] == "--version" || args[0] == "-V") {
+    // What a bug report needs: the program's version and the .mmdb format
+    // it writes (and so which older mmvk can read its databases).
+    std::printf("mmvk %s\ndatabase format: writes .mmdb version %u at most (the oldest that holds the database), "
+                "reads versions 1 to %u\n",
+                MMVK_VERSION, unsigned(mmvk::kDatabaseFormatVersion), unsigned(mmvk::kDatabaseFormatVersion));
+    return check_stdout("--version", 0);
   }
   const std::string_view command = args[0];
   int exit_code = 1;

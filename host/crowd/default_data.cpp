@@ -1,7 +1,10 @@
 #include "default_data.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <string_view>
 #include <system_error>
+#include <vector>
 
 #include "cache_entry.hpp"
 #include "mmvk/hash.hpp"
@@ -98,10 +101,51 @@ Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,
                     ") was not found beside the program or in its source tree; pass --data DIR|manifest.json|db.mmdb");
 }
 
+namespace {
+
+// Edits (insert, delete, replace one character) between two names.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// A missing --data that looks like a name (no folder, no extension) gets the
+// nearest shipped set's name and the list: "cmu-walk" was meant as
+// "cmu-walks" far more often than as a path.
+std::string missing_data_message(const std::filesystem::path& source) {
+  std::string message = source.string() + ": no such file or folder";
+  if (source.has_parent_path() || source.has_extension()) return message;
+  const ShippedData* nearest = nullptr;
+  std::size_t best = 0;
+  std::string names;
+  for (const ShippedData& set : shipped_data()) {
+    names += (names.empty() ? "" : ", ") + std::string(set.name);
+    const std::size_t distance = edit_distance(source.string(), set.name);
+    if (nearest == nullptr || distance < best) nearest = &set, best = distance;
+  }
+  message += ", nor a shipped motion set";
+  if (nearest != nullptr && best <= std::max<std::size_t>(2, nearest->name.size() / 3)) {
+    message += ": did you mean '" + std::string(nearest->name) + "'?";
+  }
+  return message + " (shipped: " + names + ")";
+}
+
+}  // namespace
+
 Result<OpenedDatabase> open_database(const std::filesystem::path& source, const std::filesystem::path& cache_dir,
                                      const std::function<void(const std::string&)>& say) {
   std::error_code ec;
-  if (!std::filesystem::exists(source, ec)) return make_error(source.string() + ": no such file or folder");
+  if (!std::filesystem::exists(source, ec)) return make_error(missing_data_message(source));
   if (source.extension() == ".mmdb") {
     MMVK_ASSIGN_OR_RETURN(Database database, load_database(source));
     return OpenedDatabase{std::move(database), source, false};

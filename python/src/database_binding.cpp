@@ -141,8 +141,8 @@ std::shared_ptr<Database> build(const py::object& source, const py::object& sche
     std::error_code ec;
     if (fields.empty()) {
       manifest = take(load_manifest_or_directory(path), kind);
-    } else if (std::filesystem::is_directory(path, ec) || is_bvh_path(path)) {
-      // A folder's (or a BVH file's) manifest as JSON, so that the fields
+    } else if (std::filesystem::is_directory(path, ec) || is_motion_path(path)) {
+      // A folder's (or a motion file's) manifest as JSON, so that the fields
       // are read by the manifest's own parser (and named in its errors).
       const Manifest listed = take(load_manifest_or_directory(path), kind);
       nlohmann::json clips = nlohmann::json::array();

@@ -250,7 +250,7 @@ TEST(Manifest, FolderOfBvhUsesDefaults) {
   std::filesystem::create_directory(empty);
   Result<Manifest> none = load_manifest_or_directory(empty);
   ASSERT_FALSE(none.ok());
-  EXPECT_NE(none.message().find("no .bvh files"), std::string::npos);
+  EXPECT_NE(none.message().find("no motion files (.bvh"), std::string::npos);
   Result<Manifest> missing = load_manifest_or_directory(dir / "absent");
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.message().find("absent"), std::string::npos);

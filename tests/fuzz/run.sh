@@ -18,6 +18,19 @@ seeds="$build/seeds"
 rm -rf "$seeds"
 "$build/tests/fuzz/fuzz_make_seeds" "$seeds" tests/corpus/bvh
 
+# Scene files: assimp-testmodels' animated skeletons, each behind the byte
+# that picks its format (fuzz_scene_import.cpp: 0 .fbx, 1 .gltf, 3 .dae).
+models=/usr/share/assimp/models
+mkdir -p "$seeds/scene"
+scene_seed() {  # selector-byte file
+  [ -f "$2" ] && { printf "\\$(printf '%03o' "$1")"; cat "$2"; } >"$seeds/scene/$(basename "$2")"
+  return 0
+}
+scene_seed 0 "$models/FBX/animation_with_skeleton.fbx"
+scene_seed 0 "$models/FBX/huesitos.fbx"
+scene_seed 1 "$models/glTF2/simple_skin/simple_skin.gltf"
+scene_seed 3 "$models/Collada/box_nested_animation.dae"
+
 run() {  # target corpus-name [dict]
   local target=$1 corpus=$2 dict=${3:-}
   local work="$build/corpus/$target" findings="$build/findings/$target"
@@ -41,3 +54,4 @@ run fuzz_query_rows query
 run fuzz_search_diff search_diff
 run fuzz_scenario_json scenario tests/fuzz/json.dict
 run fuzz_pose_targets pose_targets tests/fuzz/json.dict
+run fuzz_scene_import scene

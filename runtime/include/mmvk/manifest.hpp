@@ -20,7 +20,9 @@
 //                              // settings a crowd host tuned for this data, kept in
 //                              // the database as they are (Database::crowd_settings)
 //   "clips": [
-//     { "file": "walk.bvh",    // relative paths are relative to the manifest's folder
+//     { "file": "walk.bvh",    // relative paths are relative to the manifest's folder;
+//                              // .bvh, or .fbx/.gltf/.glb/.dae through assimp (scene_import.hpp)
+//       "animation": "Walk",   // scene files: only this animation (default: each one, a clip apiece)
 //       "range": [0.5, 1.4],   // only this part of the file, seconds (default: all of it)
 //       "name": "walk",        // default: the file name without extension
 //       "tags": ["walk"], "loop": false, "mirror": false,
@@ -110,7 +112,13 @@ struct CostRange {
 };
 
 struct ManifestClip {
-  std::filesystem::path file;      // the BVH file (resolved: absolute or relative to the working directory)
+  // The BVH, FBX, glTF or COLLADA file (resolved: absolute or relative to
+  // the working directory).
+  std::filesystem::path file;
+  // For an FBX, glTF or COLLADA file: the one animation of this name;
+  // empty = every animation, each its own clip named after it (the clip's
+  // name when the file has one animation).
+  std::string animation;
   // The part of the file the clip takes: frames f (at the build's rate) with
   // begin <= f / fps < end; none = the whole file. With `loop`, a cycle cut
   // out of a longer take; the clip's other time ranges count from its begin.
@@ -163,16 +171,19 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
                                      const std::filesystem::path& base_dir);
 Result<Manifest> load_manifest(const std::filesystem::path& path);
 
-// Whether `path` names a BVH file by its extension (.bvh, any case), as
-// folders and build sources tell BVH from manifests.
+// Whether `path` names a BVH file by its extension (.bvh, any case).
 bool is_bvh_path(const std::filesystem::path& path);
 
-// A manifest with defaults for every *.bvh (case-insensitive extension)
+// Whether `path` names a motion file by its extension, as folders and build
+// sources tell motion from manifests: BVH or a scene file (is_scene_path()).
+bool is_motion_path(const std::filesystem::path& path);
+
+// A manifest with defaults for every motion file (is_motion_path())
 // directly in `dir`, sorted by file name; clip names are the file stems.
 Result<Manifest> manifest_from_directory(const std::filesystem::path& dir);
 
-// A manifest file, a folder of BVH or one BVH file (*.bvh, one clip with the
-// folder's defaults), whichever `path` is.
+// A manifest file, a folder of motion files or one motion file (one clip
+// with the folder's defaults), whichever `path` is.
 Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path);
 
 // Every file a build of `manifest` reads besides the manifest itself: each

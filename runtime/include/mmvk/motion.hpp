@@ -56,6 +56,14 @@ struct ImportOptions {
   float metres_per_unit = 0.0f;
   // The file's up axis; Z-up files are rotated into mmvk's Y-up frame.
   UpAxis up_axis = UpAxis::Y;
+  // Whether up_axis was given (a manifest's "up_axis"): BVH files are Y-up
+  // unless told, while FBX and COLLADA files say their axes themselves and
+  // keep them unless this is set (scene_import.hpp).
+  bool up_axis_given = false;
+  // The build's plausibility check of the imported motion (import_check.hpp)
+  // reports instead of stopping the build when this is set (a manifest's
+  // "import": {"accept_implausible": true}: a child, a giant, a crawl).
+  bool accept_implausible = false;
 };
 
 // Rotation channels compose in the file's channel order as intrinsic

@@ -135,20 +135,53 @@ Result<ClipAnimation> extract_clip_animation(const Motion& motion, const Charact
   return out;
 }
 
+namespace {
+
+// How `clip`'s hierarchy differs from `first`'s, in a few words.
+std::string skeleton_difference(const Skeleton& clip, const Skeleton& first) {
+  if (clip.size() != first.size()) {
+    return std::to_string(clip.size()) + " joints against " + std::to_string(first.size());
+  }
+  for (std::size_t j = 0; j < clip.size(); ++j) {
+    if (clip.names[j] != first.names[j]) return "joint " + std::to_string(j) + " is '" + clip.names[j] + "', not '" + first.names[j] + "'";
+    if (clip.parents[j] != first.parents[j]) return "joint '" + clip.names[j] + "' has another parent";
+  }
+  return "the same joints";
+}
+
+// The section holds one skeleton: the error names every clip whose
+// hierarchy differs from the first clip's (a few, then a count), how, and
+// what to do about it.
+Status check_one_skeleton(std::span<const ClipAnimation> clips) {
+  const ClipAnimation& first = clips[0];
+  constexpr std::size_t kNamed = 4;
+  std::string named;
+  std::size_t differing = 0;
+  for (const ClipAnimation& clip : clips) {
+    if (clip.skeleton.names == first.skeleton.names && clip.skeleton.parents == first.skeleton.parents) continue;
+    if (differing++ < kNamed) {
+      named += (named.empty() ? "" : "; ") + clip.source + " (" + skeleton_difference(clip.skeleton, first.skeleton) + ")";
+    }
+  }
+  if (differing == 0) return {};
+  if (differing > kNamed) named += "; and " + std::to_string(differing - kNamed) + " more";
+  return make_error("no animation section: the section holds one skeleton, and " + std::to_string(differing) +
+                    " clip" + (differing == 1 ? "'s hierarchy differs" : "s' hierarchies differ") + " from " +
+                    first.source + "'s (" + std::to_string(first.skeleton.size()) + " joints): " + named +
+                    ". Build each skeleton's clips into a database of its own (or retarget them to one "
+                    "skeleton) to animate them; --no-animation builds the features alone without this warning");
+}
+
+}  // namespace
+
 Result<AnimationData> assemble_animation(std::span<const ClipAnimation> clips, const FootContactParams& contacts,
                                          RotationEncoding encoding, std::span<const BonePair> mirror_bones) {
   if (clips.empty()) return make_error("animation: no clips");
   const ClipAnimation& first = clips[0];
   const std::size_t joints = first.skeleton.size();
   std::uint64_t frames = 0;
-  for (const ClipAnimation& clip : clips) {
-    if (clip.skeleton.names != first.skeleton.names || clip.skeleton.parents != first.skeleton.parents) {
-      return make_error("no animation section: " + clip.source + " and " + first.source +
-                        " have different skeletons (joint names or parents), and the section holds one skeleton; "
-                        "build clips of one skeleton to animate them");
-    }
-    frames += clip.frame_count;
-  }
+  MMVK_TRY(check_one_skeleton(clips));
+  for (const ClipAnimation& clip : clips) frames += clip.frame_count;
   AnimationData out;
   out.skeleton = first.skeleton;
   Result<std::vector<int>> pairs = mirror_pairs(out.skeleton, mirror_bones);

@@ -97,8 +97,9 @@ Status AnimationData::validate(std::uint32_t frames) const {
 
 Error missing_animation_error(std::string_view what) {
   return make_error(std::string(what) +
-                    ": the database has no animation section (it was built with --no-animation or by an mmvk "
-                    "older than format 2); rebuild it with `mmvk build` (without --no-animation)");
+                    ": the database has no animation section: its clips' skeletons differ (the build warned, "
+                    "naming them: build one skeleton per database), it was built with --no-animation, or it is "
+                    "a format 1 file; rebuild it with `mmvk build` from clips of one skeleton");
 }
 
 }  // namespace mmvk

@@ -178,7 +178,13 @@ Result<TagMask> Database::tag_mask(std::span<const std::string> names) const {
         found = true;
       }
     }
-    if (!found) return make_error("unknown tag '" + name + "'");
+    if (!found) {
+      std::string known;
+      for (const std::string& tag : parts_.tag_names) known += (known.empty() ? "" : ", ") + tag;
+      return make_error("unknown tag '" + name + "': " +
+                        (known.empty() ? std::string("the database has no tags (a manifest's clips give them)")
+                                       : "the database's tags are " + known + " (exact, case-sensitive)"));
+    }
   }
   return mask;
 }

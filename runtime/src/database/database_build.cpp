@@ -10,7 +10,9 @@
 #include "mmvk/bvh.hpp"
 #include "mmvk/character.hpp"
 #include "mmvk/features.hpp"
+#include "mmvk/import_check.hpp"
 #include "mmvk/normalization.hpp"
+#include "mmvk/scene_import.hpp"
 #include "database/animation_build.hpp"
 #include "database/cost_overflow.hpp"
 
@@ -323,29 +325,85 @@ void mirror_sidecars(const Manifest& manifest, std::vector<std::vector<float>>& 
   }
 }
 
-LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const AnimationBuildOptions& animation) {
-  LoadedClip out;
-  auto fail = [&](std::string message) {
-    out.error = make_error(std::move(message));
-    return std::move(out);
-  };
+bool tagged_walk(const ManifestClip& meta) {
+  return std::find(meta.tags.begin(), meta.tags.end(), "walk") != meta.tags.end();
+}
+
+// The import's plausibility (import_check.hpp), unless the manifest accepts
+// whatever it measures.
+Status check_plausible_import(const Manifest& manifest, const Motion& motion, const ImportContext& context) {
+  if (manifest.import.accept_implausible) return {};
+  return check_import(measure_import(motion), context);
+}
+
+// One motion a clip's file holds: a BVH's, or one animation of a scene file.
+struct SourceMotion {
+  std::string animation;  // the scene animation's name; empty for BVH
+  Motion motion;
+  float metres_per_unit = 0.0f;
+};
+
+// The motions of a manifest clip's file: one for a BVH; one per animation
+// (or the one the clip names) for FBX, glTF and COLLADA, sampled at the
+// manifest's fps.
+Result<std::vector<SourceMotion>> import_clip_file(const Manifest& manifest, const ManifestClip& meta) {
+  std::vector<SourceMotion> motions;
+  if (is_scene_path(meta.file)) {
+    SceneImportOptions options;
+    options.import = manifest.import;
+    options.fps = manifest.fps;
+    options.animation = meta.animation;
+    MMVK_ASSIGN_OR_RETURN(SceneImport scene, import_scene(meta.file, options));
+    for (SceneAnimation& animation : scene.animations) {
+      const ImportContext context{meta.file.string() + " (animation '" + animation.name + "')", scene.metres_per_unit,
+                                  scene.units_from, manifest.import.up_axis, scene.axes_from, tagged_walk(meta)};
+      MMVK_TRY(check_plausible_import(manifest, animation.motion, context));
+      motions.push_back({std::move(animation.name), std::move(animation.motion), scene.metres_per_unit});
+    }
+    return motions;
+  }
+  if (!meta.animation.empty()) {
+    return make_error(meta.file.string() + ": \"animation\" names an animation of an FBX, glTF or COLLADA file; "
+                      "a BVH holds one motion");
+  }
   Result<BvhFile> bvh = load_bvh(meta.file);
-  if (!bvh.ok()) return fail(bvh.message());
+  if (!bvh.ok()) return bvh.error();
   Result<Motion> motion = motion_from_bvh(*bvh, manifest.import);
-  if (!motion.ok()) return fail(motion.message());
+  if (!motion.ok()) return motion.error();
+  // The units the import used, recorded so that `mmvk inspect` can show them.
+  const float units = manifest.import.metres_per_unit > 0.0f ? manifest.import.metres_per_unit
+                                                             : guess_metres_per_unit(*bvh);
+  const bool given_axis = manifest.import.up_axis_given;
+  const ImportContext context{
+      meta.file.string(), units,
+      manifest.import.metres_per_unit > 0.0f ? "the manifest's import.metres_per_unit" : "guessed from the skeleton's size",
+      manifest.import.up_axis,
+      given_axis ? std::string("the manifest's import.up_axis") : std::string("BVH files are read Y-up unless told"),
+      tagged_walk(meta)};
+  MMVK_TRY(check_plausible_import(manifest, *motion, context));
+  motions.push_back({"", std::move(*motion), units});
+  return motions;
+}
+
+// The clip of one motion of the file (and its mirror) appended to `out`.
+Status load_motion(const Manifest& manifest, const ManifestClip& meta, SourceMotion& source,
+                   const AnimationBuildOptions& animation, LoadedClip& out) {
+  std::optional<Motion> motion(std::move(source.motion));
   out.source_fps = motion->fps;
   const std::uint32_t source_frames = motion->frame_count;
-
   std::vector<std::vector<float>> custom;
   for (const FeatureChannel& channel : manifest.schema.channels) {
     if (!reads_sidecar(channel.kind)) continue;
-    Result<std::vector<float>> values = load_custom_sidecar(meta.file, channel, source_frames);
-    if (!values.ok()) return fail(values.message());
-    custom.push_back(std::move(*values));
+    if (is_scene_path(meta.file)) {
+      return make_error(meta.file.string() + ": channel '" + channel.name +
+                        "' reads a sidecar file, which only BVH clips have");
+    }
+    MMVK_ASSIGN_OR_RETURN(std::vector<float> values, load_custom_sidecar(meta.file, channel, source_frames));
+    custom.push_back(std::move(values));
   }
   if (manifest.fps > 0.0f && !same_rate(manifest.fps, motion->fps)) {
     Result<Motion> resampled = resample(*motion, manifest.fps);
-    if (!resampled.ok()) return fail(meta.file.string() + ": " + resampled.message());
+    if (!resampled.ok()) return make_error(meta.file.string() + ": " + resampled.message());
     for (std::size_t i = 0, c = 0; c < manifest.schema.channels.size(); ++c) {
       const FeatureChannel& channel = manifest.schema.channels[c];
       if (!reads_sidecar(channel.kind)) continue;
@@ -353,14 +411,13 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
                                   resampled->frame_count, resampled->fps);
       ++i;
     }
-    motion = std::move(resampled);
+    motion = std::move(*resampled);
   }
   if (meta.range) {
     // The part of the file the clip takes, at the build's rate.
     const std::string field = (meta.field.empty() ? meta.file.string() + ": clip '" + meta.name + "'" : meta.field) +
                               ".range";
-    Status inside = check_inside(*meta.range, motion->frame_count, motion->fps, field);
-    if (!inside.ok()) return fail(inside.message());
+    MMVK_TRY(check_inside(*meta.range, motion->frame_count, motion->fps, field));
     std::uint32_t first = motion->frame_count, end = 0;
     for (std::uint32_t f = 0; f < motion->frame_count; ++f) {
       if (in_range(f, motion->fps, *meta.range)) first = std::min(first, f), end = f + 1;
@@ -369,24 +426,43 @@ LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const A
   }
   const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation,
                                      manifest.contacts};
-  Result<ProcessedClip> processed = process_motion(meta, *motion, custom, false, settings);
-  if (!processed.ok()) return fail(processed.message());
-  // The units the import used, recorded so that `mmvk inspect` can show them.
-  const float units = manifest.import.metres_per_unit > 0.0f ? manifest.import.metres_per_unit
-                                                             : guess_metres_per_unit(*bvh);
-  processed->clip.metres_per_unit = units;
-  out.clips.push_back(std::move(*processed));
-  if (meta.mirror) {
-    Result<Motion> mirrored = mirror(*motion, manifest.mirror_bones);
-    if (!mirrored.ok()) {
-      return fail((manifest.mirror_bones.empty() ? "" : manifest.source + ": ") + meta.file.string() +
-                  ": mirroring: " + mirrored.message());
+  MMVK_ASSIGN_OR_RETURN(ProcessedClip processed, process_motion(meta, *motion, custom, false, settings));
+  processed.clip.metres_per_unit = source.metres_per_unit;
+  out.clips.push_back(std::move(processed));
+  if (!meta.mirror) return {};
+  Result<Motion> mirrored = mirror(*motion, manifest.mirror_bones);
+  if (!mirrored.ok()) {
+    return make_error((manifest.mirror_bones.empty() ? "" : manifest.source + ": ") + meta.file.string() +
+                      ": mirroring: " + mirrored.message());
+  }
+  mirror_sidecars(manifest, custom);
+  MMVK_ASSIGN_OR_RETURN(ProcessedClip processed_mirror, process_motion(meta, *mirrored, custom, true, settings));
+  processed_mirror.clip.metres_per_unit = source.metres_per_unit;
+  out.clips.push_back(std::move(processed_mirror));
+  return {};
+}
+
+LoadedClip load_clip(const Manifest& manifest, const ManifestClip& meta, const AnimationBuildOptions& animation) {
+  LoadedClip out;
+  Result<std::vector<SourceMotion>> motions = import_clip_file(manifest, meta);
+  if (!motions.ok()) {
+    out.error = motions.error();
+    return out;
+  }
+  for (SourceMotion& source : *motions) {
+    // Several animations of one file are several clips, named after them
+    // (an unnamed one after the file and its place in it).
+    ManifestClip named = meta;
+    if (motions->size() > 1) {
+      named.name = source.animation.empty() ? meta.name + "_" + std::to_string(&source - motions->data())
+                                            : source.animation;
     }
-    mirror_sidecars(manifest, custom);
-    Result<ProcessedClip> processed_mirror = process_motion(meta, *mirrored, custom, true, settings);
-    if (!processed_mirror.ok()) return fail(processed_mirror.message());
-    processed_mirror->clip.metres_per_unit = units;
-    out.clips.push_back(std::move(*processed_mirror));
+    Status loaded = load_motion(manifest, named, source, animation, out);
+    if (!loaded.ok()) {
+      const std::string which = source.animation.empty() ? "" : " (animation '" + source.animation + "')";
+      out.error = make_error(loaded.message() + which);
+      return out;
+    }
   }
   return out;
 }

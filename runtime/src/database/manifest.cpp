@@ -1,4 +1,5 @@
 #include "mmvk/manifest.hpp"
+#include "mmvk/scene_import.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -130,7 +131,7 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   }
   if (!object.is_object()) return make_error(where + ": expected an object (or a file name)");
   MMVK_TRY(check_fields(object, where,
-                        {"file", "range", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias",
+                        {"file", "animation", "range", "name", "tags", "loop", "mirror", "cost_multiplier", "cost_bias",
                          "do_not_use", "block_transition", "tag_ranges", "cost_ranges"}));
   ManifestClip clip;
   clip.field = where;
@@ -140,6 +141,10 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (file.empty()) return make_error(where + ".file: empty");
   clip.file = base_dir / file;
   clip.name = clip.file.stem().string();
+  if (object.contains("animation")) {
+    MMVK_READ(clip.animation, read_string(object["animation"], where + ".animation"));
+    if (clip.animation.empty()) return make_error(where + ".animation: empty (leave it out for every animation)");
+  }
   if (object.contains("range")) MMVK_READ(clip.range, read_range(object["range"], where + ".range"));
   if (object.contains("name")) MMVK_READ(clip.name, read_string(object["name"], where + ".name"));
   if (object.contains("tags")) {
@@ -352,7 +357,11 @@ Status read_import_field(const Json& root, const std::string& at, Manifest& mani
   if (!root.contains("import")) return {};
   const Json& import = root["import"];
   if (!import.is_object()) return make_error(at + "import: expected an object");
-  MMVK_TRY(check_fields(import, at + "import", {"metres_per_unit", "up_axis"}));
+  MMVK_TRY(check_fields(import, at + "import", {"metres_per_unit", "up_axis", "accept_implausible"}));
+  if (import.contains("accept_implausible")) {
+    MMVK_READ(manifest.import.accept_implausible,
+              read_bool(import["accept_implausible"], at + "import.accept_implausible"));
+  }
   if (import.contains("metres_per_unit")) {
     MMVK_READ(manifest.import.metres_per_unit, json_float(import["metres_per_unit"], at + "import.metres_per_unit"));
     if (manifest.import.metres_per_unit < 0.0f) {
@@ -362,6 +371,7 @@ Status read_import_field(const Json& root, const std::string& at, Manifest& mani
   if (import.contains("up_axis")) {
     std::string axis;
     MMVK_READ(axis, read_string(import["up_axis"], at + "import.up_axis"));
+    manifest.import.up_axis_given = true;
     if (axis == "y" || axis == "Y") {
       manifest.import.up_axis = UpAxis::Y;
     } else if (axis == "z" || axis == "Z") {
@@ -466,6 +476,8 @@ bool is_bvh_path(const std::filesystem::path& path) {
   return ext == ".bvh";
 }
 
+bool is_motion_path(const std::filesystem::path& path) { return is_bvh_path(path) || is_scene_path(path); }
+
 namespace {
 
 // The manifest of BVH files with default options, one clip per file named by
@@ -488,10 +500,10 @@ Result<Manifest> manifest_from_directory(const std::filesystem::path& dir) {
   std::error_code error;
   std::vector<std::filesystem::path> files;
   for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
-    if (it->is_regular_file(error) && is_bvh_path(it->path())) files.push_back(it->path());
+    if (it->is_regular_file(error) && is_motion_path(it->path())) files.push_back(it->path());
   }
   if (error) return make_error(dir.string() + ": cannot list the folder: " + error.message());
-  if (files.empty()) return make_error(dir.string() + ": no .bvh files in the folder");
+  if (files.empty()) return make_error(dir.string() + ": no motion files (.bvh, .fbx, .gltf, .glb, .dae) in the folder");
   std::sort(files.begin(), files.end());
   return manifest_of_clip_files(dir.string(), files);
 }
@@ -500,8 +512,8 @@ Result<Manifest> load_manifest_or_directory(const std::filesystem::path& path) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) return manifest_from_directory(path);
   if (!std::filesystem::exists(path, error)) return make_error(path.string() + ": no such file or folder");
-  // A BVH file given where a manifest is expected is one clip, as in a folder.
-  if (is_bvh_path(path)) return manifest_of_clip_files(path.string(), {path});
+  // A motion file given where a manifest is expected is one clip, as in a folder.
+  if (is_motion_path(path)) return manifest_of_clip_files(path.string(), {path});
   return load_manifest(path);
 }
 

@@ -1,0 +1,338 @@
+// FBX, glTF and COLLADA through assimp (mmvk/scene_import.hpp), on
+// assimp-testmodels' animated skeletons and on glTF files this test writes
+// from the project's BVH clips.
+//
+// - The imported motion's forward kinematics, and the built database's,
+//   agree with the scene's own node transforms, evaluated here from assimp's
+//   keys with glm (lerp, slerp) and its node matrices, at sampled times.
+// - A glTF written from a CMU clip (its joints as nodes, the root's
+//   translation and every joint's rotation as 120 fps keys) gives the same
+//   features as the BVH within 1e-3 (normalized units; float32 keys).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#include <glm/gtc/quaternion.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "mmvk/bvh.hpp"
+#include "mmvk/database_build.hpp"
+#include "mmvk/manifest.hpp"
+#include "mmvk/motion.hpp"
+#include "mmvk/pose_batch.hpp"
+#include "mmvk/scene_import.hpp"
+#include "support/command.hpp"
+#include "support/test_data.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mmvk::Motion;
+
+const fs::path kModels = "/usr/share/assimp/models";
+
+// The file, or a failure under MMVK_REQUIRE_DATA=1 (CI installs
+// assimp-testmodels), else a skip.
+#define MMVK_REQUIRE_TEST_MODEL(path)                                                            \
+  if (!fs::exists(path)) {                                                                       \
+    const char* required = std::getenv("MMVK_REQUIRE_DATA");                                     \
+    if (required && std::string(required) == "1") FAIL() << path << " missing (apt-get install assimp-testmodels)"; \
+    GTEST_SKIP() << path << " not installed";                                                    \
+  }
+
+// The scene's world node positions at `seconds`, evaluated independently of
+// the importer: keys interpolated with glm, node matrices multiplied down.
+std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, const aiAnimation& animation,
+                                                        double seconds) {
+  const double ticks = (animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0) *
+                       std::min(seconds, animation.mDuration / (animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0));
+  std::map<std::string, const aiNodeAnim*> channels;
+  for (unsigned c = 0; c < animation.mNumChannels; ++c) channels[animation.mChannels[c]->mNodeName.C_Str()] = animation.mChannels[c];
+  auto at = [&](const auto* keys, unsigned count, auto convert, auto blend) {
+    unsigned k = 0;
+    while (k + 1 < count && keys[k + 1].mTime <= ticks) ++k;
+    if (k + 1 >= count || ticks <= keys[0].mTime) return convert(keys[ticks <= keys[0].mTime ? 0 : k].mValue);
+    const float t = float((ticks - keys[k].mTime) / (keys[k + 1].mTime - keys[k].mTime));
+    return blend(convert(keys[k].mValue), convert(keys[k + 1].mValue), t);
+  };
+  auto vec = [](const aiVector3D& v) { return glm::vec3(v.x, v.y, v.z); };
+  auto quat = [](const aiQuaternion& q) { return glm::quat(q.w, q.x, q.y, q.z); };
+  auto mix = [](glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; };
+  auto slerp = [](glm::quat a, glm::quat b, float t) { return glm::slerp(a, glm::dot(a, b) < 0 ? -b : b, t); };
+  std::map<std::string, glm::vec3> out;
+  std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{{scene.mRootNode, aiMatrix4x4()}};
+  while (!stack.empty()) {
+    auto [node, parent] = stack.back();
+    stack.pop_back();
+    aiMatrix4x4 local = node->mTransformation;
+    if (auto it = channels.find(node->mName.C_Str()); it != channels.end()) {
+      const aiNodeAnim& ch = *it->second;
+      const glm::vec3 p = at(ch.mPositionKeys, ch.mNumPositionKeys, vec, mix);
+      const glm::quat r = glm::normalize(at(ch.mRotationKeys, ch.mNumRotationKeys, quat, slerp));
+      const glm::vec3 s = at(ch.mScalingKeys, ch.mNumScalingKeys, vec, mix);
+      local = aiMatrix4x4(aiVector3D(s.x, s.y, s.z), aiQuaternion(r.w, r.x, r.y, r.z), aiVector3D(p.x, p.y, p.z));
+    }
+    const aiMatrix4x4 global = parent * local;
+    out.emplace(node->mName.C_Str(), glm::vec3(global.a4, global.b4, global.c4));
+    for (unsigned c = 0; c < node->mNumChildren; ++c) stack.push_back({node->mChildren[c], global});
+  }
+  return out;
+}
+
+struct ModelCase {
+  const char* file;
+  std::size_t joints;  // the skeleton the import must find
+};
+
+// Every animated skeleton of assimp-testmodels that assimp 5.2.5 reads.
+const ModelCase kModelCases[] = {
+    {"FBX/animation_with_skeleton.fbx", 15},  // Armature + the skin's 14 bones
+    {"FBX/huesitos.fbx", 10},
+    {"glTF2/simple_skin/simple_skin.gltf", 2},  // the skin's two joints
+    {"Collada/box_nested_animation.dae", 2},    // Armature + its bone
+    {"Collada/anims_with_full_rotations_between_keys.DAE", 64},  // 64 animated boxes under one node
+};
+
+TEST(SceneImport, ForwardKinematicsAgreesWithAssimp) {
+  for (const ModelCase& model : kModelCases) {
+    SCOPED_TRACE(model.file);
+    const fs::path path = kModels / model.file;
+    MMVK_REQUIRE_TEST_MODEL(path);
+    mmvk::SceneImportOptions options;
+    options.fps = 30.0f;
+    const auto imported = mmvk::import_scene(path, options);
+    ASSERT_TRUE(imported.ok()) << imported.message();
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path.string(), 0);
+    ASSERT_NE(scene, nullptr);
+    ASSERT_EQ(imported->animations.size(), scene->mNumAnimations);
+    const Motion& motion = imported->animations[0].motion;
+    ASSERT_EQ(motion.joint_count(), model.joints);
+    std::vector<glm::vec3> positions(motion.joint_count());
+    std::vector<glm::quat> rotations(motion.joint_count());
+    float extent = 0.0f;  // the tolerance scales with the skeleton's size
+    for (const glm::vec3& offset : motion.skeleton.rest_offsets) extent = std::max(extent, glm::length(offset));
+    const std::uint32_t last = motion.frame_count - 1;
+    for (const std::uint32_t frame : {0u, last / 3, last / 2, last}) {
+      mmvk::forward_kinematics(motion, frame, positions, rotations);
+      const auto expected = assimp_world_positions(*scene, *scene->mAnimations[0], frame / 30.0);
+      for (std::size_t j = 0; j < motion.joint_count(); ++j) {
+        const glm::vec3 want = expected.at(motion.skeleton.names[j]) * imported->metres_per_unit;
+        EXPECT_LT(glm::length(positions[j] - want), 1e-4f * std::max(extent, 1.0f))
+            << "frame " << frame << " joint " << motion.skeleton.names[j];
+      }
+    }
+  }
+}
+
+// --- A glTF written from a BVH clip --------------------------------------
+
+void append_floats(std::string& bin, std::span<const float> values) {
+  bin.append(reinterpret_cast<const char*>(values.data()), values.size_bytes());
+}
+
+// Writes `motion` as `stem`.gltf and `stem`.bin in `dir`: its joints as
+// nodes (static translation: the frame-0 local position; the root's
+// animated), one animation named `animation` with a rotation channel per
+// joint, keys at the motion's frames.
+fs::path write_gltf(const Motion& motion, const fs::path& dir, const std::string& stem, const std::string& animation) {
+  using nlohmann::json;
+  const std::size_t joints = motion.joint_count(), frames = motion.frame_count;
+  std::string bin;
+  json accessors = json::array(), views = json::array(), nodes = json::array(), channels = json::array(),
+       samplers = json::array();
+  auto add_accessor = [&](std::span<const float> values, const char* type, std::size_t count, json extra) {
+    views.push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", values.size_bytes()}});
+    append_floats(bin, values);
+    json accessor = {{"bufferView", views.size() - 1}, {"componentType", 5126}, {"count", count}, {"type", type}};
+    accessor.update(extra);
+    accessors.push_back(accessor);
+    return accessors.size() - 1;
+  };
+  std::vector<float> times(frames);
+  for (std::size_t f = 0; f < frames; ++f) times[f] = float(f) / motion.fps;
+  const std::size_t input = add_accessor(times, "SCALAR", frames, {{"min", {times.front()}}, {"max", {times.back()}}});
+  for (std::size_t j = 0; j < joints; ++j) {
+    const glm::vec3 p = motion.local_positions[j];
+    json node = {{"name", motion.skeleton.names[j]}, {"translation", {p.x, p.y, p.z}}};
+    json children = json::array();
+    for (std::size_t c = 0; c < joints; ++c) {
+      if (motion.skeleton.parents[c] == int(j)) children.push_back(c);
+    }
+    if (!children.empty()) node["children"] = children;
+    nodes.push_back(node);
+    std::vector<float> values;
+    for (std::size_t f = 0; f < frames; ++f) {
+      const glm::quat q = motion.local_rotations[motion.index(std::uint32_t(f), j)];
+      values.insert(values.end(), {q.x, q.y, q.z, q.w});
+    }
+    samplers.push_back({{"input", input}, {"output", add_accessor(values, "VEC4", frames, json::object())}, {"interpolation", "LINEAR"}});
+    channels.push_back({{"sampler", samplers.size() - 1}, {"target", {{"node", j}, {"path", "rotation"}}}});
+    if (motion.skeleton.parents[j] >= 0) continue;
+    values.clear();
+    for (std::size_t f = 0; f < frames; ++f) {
+      const glm::vec3 q = motion.local_positions[motion.index(std::uint32_t(f), j)];
+      values.insert(values.end(), {q.x, q.y, q.z});
+    }
+    samplers.push_back({{"input", input}, {"output", add_accessor(values, "VEC3", frames, json::object())}, {"interpolation", "LINEAR"}});
+    channels.push_back({{"sampler", samplers.size() - 1}, {"target", {{"node", j}, {"path", "translation"}}}});
+  }
+  const json gltf = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}},
+                     {"nodes", nodes}, {"accessors", accessors}, {"bufferViews", views},
+                     {"buffers", {{{"byteLength", bin.size()}, {"uri", stem + ".bin"}}}},
+                     {"animations", {{{"name", animation}, {"channels", channels}, {"samplers", samplers}}}}};
+  std::ofstream(dir / (stem + ".bin"), std::ios::binary) << bin;
+  std::ofstream(dir / (stem + ".gltf")) << gltf.dump();
+  return dir / (stem + ".gltf");
+}
+
+Motion load_bvh_motion(const fs::path& path) {
+  const auto bvh = mmvk::load_bvh(path);
+  EXPECT_TRUE(bvh.ok()) << bvh.message();
+  auto motion = mmvk::motion_from_bvh(*bvh, {});
+  EXPECT_TRUE(motion.ok()) << motion.message();
+  return std::move(*motion);
+}
+
+mmvk::Database build_one(const fs::path& file, const fs::path& dir) {
+  const std::string text = R"({"fps": 30, "clips": [{"file": ")" + file.string() + R"("}]})";
+  auto manifest = mmvk::parse_manifest_json(text, "one.json", dir);
+  EXPECT_TRUE(manifest.ok()) << manifest.message();
+  auto database = mmvk::build_database(*manifest);
+  EXPECT_TRUE(database.ok()) << database.message();
+  return std::move(*database);
+}
+
+TEST(SceneImport, BuiltDatabasePosesAgreeWithAssimp) {
+  // The database's animation needs a character (hips, legs): a CMU walk
+  // written as glTF, its poses read back against assimp's nodes.
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  const fs::path path = write_gltf(walk, dir, "walk", "walk");
+  const mmvk::Database database = build_one(path, dir);
+  const mmvk::AnimationData* a = database.animation();
+  ASSERT_NE(a, nullptr);
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path.string(), 0);
+  ASSERT_NE(scene, nullptr);
+  const std::size_t joints = a->joint_count();
+  std::vector<glm::quat> rotations(joints);
+  std::vector<glm::vec3> translations(joints), world(joints);
+  for (const std::uint32_t frame : {0u, a->frame_count / 3, a->frame_count / 2, a->frame_count - 1}) {
+    mmvk::sample_pose(*a, frame, rotations, translations);
+    mmvk::forward_kinematics_batch(a->skeleton, rotations, translations, std::span(&a->root_positions[frame], 1),
+                                   std::span(&a->root_yaws[frame], 1), world);
+    const auto expected = assimp_world_positions(*scene, *scene->mAnimations[0], frame / 30.0);
+    for (std::size_t j = 0; j < joints; ++j) {
+      EXPECT_LT(glm::length(world[j] - expected.at(a->skeleton.names[j])), 1e-4f)
+          << "frame " << frame << " joint " << a->skeleton.names[j];
+    }
+  }
+}
+
+TEST(SceneImport, GltfFromABvhClipGivesItsFeatures) {
+  const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const fs::path gltf = write_gltf(load_bvh_motion(bvh), dir, "walk", "walk_veer_left");
+  const mmvk::Database from_bvh = build_one(bvh, dir);
+  const mmvk::Database from_gltf = build_one(gltf, dir);
+  ASSERT_EQ(from_gltf.frame_count(), from_bvh.frame_count());
+  ASSERT_EQ(from_gltf.dims(), from_bvh.dims());
+  const auto a = from_bvh.features(), b = from_gltf.features();
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  EXPECT_LT(worst, 1e-3f) << "largest feature difference (normalized units)";
+  EXPECT_EQ(from_gltf.clips()[0].metres_per_unit, 1.0f);  // glTF is metres
+}
+
+TEST(SceneImport, SeveralAnimationsAreSeveralClipsNamedAfterThem) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  const fs::path first = write_gltf(walk, dir, "a", "stride");
+  // Two animations in one file: the second a copy of the first, renamed.
+  std::ifstream in(first);
+  nlohmann::json gltf = nlohmann::json::parse(in);
+  nlohmann::json second = gltf["animations"][0];
+  second["name"] = "stride_again";
+  gltf["animations"].push_back(second);
+  std::ofstream(dir / "two.gltf") << gltf.dump();
+  const mmvk::Database database = build_one(dir / "two.gltf", dir);
+  ASSERT_EQ(database.clips().size(), 2u);
+  EXPECT_EQ(database.clips()[0].name, "stride");
+  EXPECT_EQ(database.clips()[1].name, "stride_again");
+  // One of them by name; a name the file lacks lists those it has.
+  const std::string pick = R"({"clips": [{"file": "two.gltf", "animation": "stride_again"}]})";
+  auto manifest = mmvk::parse_manifest_json(pick, "pick.json", dir);
+  ASSERT_TRUE(manifest.ok()) << manifest.message();
+  const auto picked = mmvk::build_database(*manifest);
+  ASSERT_TRUE(picked.ok()) << picked.message();
+  ASSERT_EQ(picked->clips().size(), 1u);
+  EXPECT_EQ(picked->clips()[0].name, "two");
+  manifest->clips[0].animation = "jump";
+  const auto missing = mmvk::build_database(*manifest);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.message().find("two.gltf: no animation named 'jump'; the file has 'stride', 'stride_again'"),
+            std::string::npos)
+      << missing.message();
+}
+
+TEST(SceneImport, WrongUnitsOrUpAxisOnAGltfAreRefused) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  write_gltf(walk, dir, "walk", "walk");
+  auto build = [&](const std::string& import) {
+    const std::string text = R"({"fps": 30, "import": )" + import + R"(, "clips": ["walk.gltf"]})";
+    auto manifest = mmvk::parse_manifest_json(text, "w.json", dir);
+    EXPECT_TRUE(manifest.ok()) << manifest.message();
+    return mmvk::build_database(*manifest);
+  };
+  const auto centimetres = build(R"({"metres_per_unit": 100})");  // metres read as if they were hectometres
+  ASSERT_FALSE(centimetres.ok());
+  EXPECT_NE(centimetres.message().find("walk.gltf (animation 'walk'): implausible import: standing height"),
+            std::string::npos) << centimetres.message();
+  EXPECT_NE(centimetres.message().find("set \"import\": {\"metres_per_unit\": 1}"), std::string::npos)
+      << centimetres.message();
+  const auto z_up = build(R"({"up_axis": "z"})");  // glTF is Y-up
+  ASSERT_FALSE(z_up.ok());
+  EXPECT_NE(z_up.message().find("the body is not upright along +Y"), std::string::npos) << z_up.message();
+  EXPECT_NE(z_up.message().find("set \"import\": {\"up_axis\": \"y\"}"), std::string::npos) << z_up.message();
+  EXPECT_TRUE(build(R"({"up_axis": "z", "accept_implausible": true})").ok());
+  EXPECT_TRUE(build(R"({"up_axis": "y"})").ok());
+}
+
+TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {
+  const auto cli = mmvk::test::cli_binary();
+  if (!cli) GTEST_SKIP() << "no mmvk command line in this build";
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  const fs::path gltf = write_gltf(walk, dir, "walk", "walk");
+  const auto built = mmvk::test::run_command(cli->string() + " build " + gltf.string() + " -o " +
+                                             (dir / "walk.mmdb").string() + " --fps 30");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const auto inspected = mmvk::test::run_command(cli->string() + " inspect " + (dir / "walk.mmdb").string());
+  ASSERT_EQ(inspected.exit_code, 0) << inspected.output;
+  EXPECT_NE(inspected.output.find("walk"), std::string::npos) << inspected.output;
+}
+
+TEST(SceneImport, ErrorsNameTheFile) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  std::ofstream(dir / "fake.fbx") << "not an fbx at all";
+  const auto fake = mmvk::import_scene(dir / "fake.fbx", {});
+  ASSERT_FALSE(fake.ok());
+  EXPECT_NE(fake.message().find("fake.fbx: assimp could not read it"), std::string::npos) << fake.message();
+  const fs::path still = kModels / "glTF2/BoxTextured-glTF/BoxTextured.gltf";
+  MMVK_REQUIRE_TEST_MODEL(still);
+  const auto box = mmvk::import_scene(still, {});
+  ASSERT_FALSE(box.ok());
+  EXPECT_NE(box.message().find("BoxTextured.gltf: no animation in the file"), std::string::npos) << box.message();
+}
+
+}  // namespace

@@ -36,6 +36,7 @@ struct CrowdSearch {
   std::unique_ptr<AsyncSearch> deferred;     // on `backend`
   std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
   std::string pipeline_cache_note;           // why a pipeline cache file was not used, or ""
+  std::string driver_cache_note;             // why the driver's shader cache is off (driver_cache.hpp), or ""
 };
 
 // The backends `mmvk crowd --backend` accepts (the library's registry), one

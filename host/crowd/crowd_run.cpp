@@ -157,6 +157,7 @@ void log_start(std::FILE* log, const CrowdOptions& options, const std::string& d
   if (!speeds.has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds.no_run_reason.c_str());
   std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
                search.device.c_str());
+  if (!search.driver_cache_note.empty()) std::fprintf(log, "mmvk crowd: note: %s\n", search.driver_cache_note.c_str());
   if (!search.pipeline_cache_note.empty()) {
     std::fprintf(log, "mmvk crowd: note: %s\n", search.pipeline_cache_note.c_str());
   }

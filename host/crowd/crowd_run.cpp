@@ -253,6 +253,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   // writable, none of them an input or another output (crowd_paths.hpp).
   MMVK_TRY(check_crowd_paths(options, data.source));
   MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
+  MMVK_TRY(check_crowd_paths_with_database(options, data.source, opened.path));
   const Database& db = opened.database;
   MMVK_ASSIGN_OR_RETURN(const GaitSpeeds speeds, check_motion(db, data.label));
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, plan_scenario(options, db, speeds));

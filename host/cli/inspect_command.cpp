@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/hash.hpp"
+#include "mmvk/input_text.hpp"
 #include "mmvk/normalization.hpp"
 #include "animation_report.hpp"
 #include "units_report.hpp"
@@ -20,28 +21,16 @@ namespace mmvk::cli {
 
 namespace {
 
+// Names are shown with the input-text rule (mmvk/input_text.hpp); a path
+// the user typed and the joined lists are longer than one name, so they get
+// bounds of their own.
+constexpr std::size_t kMaxPathBytes = 4096;
+constexpr std::size_t kMaxListBytes = 1024;
+
 constexpr const char* kInspectDescription =
     "Prints the database's frames, clips, fps, tags, frame flag counts, the metres per file unit the import used, "
     "the skeleton's standing height, the walk and run speeds the crowd measures and, per channel and dimension, the "
     "normalization offset and scale and the raw (unnormalized) mean, std, min and max.";
-
-// Names come from files anyone can write: control characters (an escape
-// sequence in a clip name) are shown as \xHH instead of reaching the terminal.
-std::string printable(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 || byte == 0x7f) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof(escaped), "\\x%02x", byte);
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
 
 std::string tag_list(const Database& db, TagMask mask) {
   std::string out;
@@ -144,7 +133,7 @@ void print_json(const Database& db, const std::string& path, const Counts& count
 }
 
 void print_summary(const Database& db, const std::string& path, const Counts& counts) {
-  std::printf("%s: %s (%.1f s), %s (%zu mirrored, %zu looping), %u dims, %g fps\n", printable(path).c_str(),
+  std::printf("%s: %s (%.1f s), %s (%zu mirrored, %zu looping), %u dims, %g fps\n", printable_text(path, kMaxPathBytes).c_str(),
               counted(db.frame_count(), "frame").c_str(), db.frame_count() / double(db.fps()),
               counted(db.clips().size(), "clip").c_str(), counts.mirrored, counts.looping, db.dims(), double(db.fps()));
   std::printf("content hash: %s\n", hash_hex(db.content_hash()).c_str());
@@ -156,7 +145,7 @@ void print_summary(const Database& db, const std::string& path, const Counts& co
   const std::vector<std::uint64_t>& tag_frames = counts.tag_frames;
   std::printf("tags (%zu):", tag_frames.size());
   for (std::size_t t = 0; t < tag_frames.size(); ++t) {
-    std::printf(" %s (%s frames)%s", printable(db.tag_names()[t]).c_str(), thousands(tag_frames[t]).c_str(),
+    std::printf(" %s (%s frames)%s", printable_text(db.tag_names()[t]).c_str(), thousands(tag_frames[t]).c_str(),
                 t + 1 < tag_frames.size() ? "," : "");
   }
   std::printf("%s\n", tag_frames.empty() ? " none" : "");
@@ -183,12 +172,12 @@ void print_channels(const Database& db) {
   std::printf("\nchannels (raw values: metres, m/s; normalized = (raw - offset) / scale):\n");
   for (std::size_t c = 0; c < schema.channels.size(); ++c) {
     const FeatureChannel& channel = schema.channels[c];
-    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", printable(channel.name).c_str(),
+    std::printf("  %-24s %-20s %-12s weight %-6g %s\n", printable_text(channel.name).c_str(),
                 channel_kind_name(channel.kind).data(), normalization_name(channel.normalization).data(),
-                double(channel.weight), printable(channel_detail(channel)).c_str());
+                double(channel.weight), printable_text(channel_detail(channel), kMaxListBytes).c_str());
     std::printf("    %-32s %10s %10s %10s %10s %10s %10s\n", "dimension", "offset", "scale", "mean", "std", "min", "max");
     for (std::uint32_t d = schema.offset(c); d < schema.offset(c) + channel.dims(); ++d) {
-      std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", printable(schema.dim_name(d)).c_str(),
+      std::printf("    %-32s %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", printable_text(schema.dim_name(d)).c_str(),
                   double(db.normalization()[d].offset), double(db.normalization()[d].scale), raw[d].mean, raw[d].std,
                   raw[d].min, raw[d].max);
     }
@@ -200,9 +189,9 @@ void print_clips(const Database& db) {
               "mirrored", "mult", "bias", "tags");
   for (std::size_t c = 0; c < db.clips().size(); ++c) {
     const Clip& clip = db.clips()[c];
-    std::printf("  %5zu  %-40s %8u %8u  %-5s %-8s %6g %6g  %s\n", c, printable(clip.name).c_str(), clip.first_frame,
+    std::printf("  %5zu  %-40s %8u %8u  %-5s %-8s %6g %6g  %s\n", c, printable_text(clip.name).c_str(), clip.first_frame,
                 clip.frame_count, clip.loop ? "yes" : "no", clip.mirrored ? "yes" : "no", double(clip.cost_multiplier),
-                double(clip.cost_bias), printable(tag_list(db, clip.tags)).c_str());
+                double(clip.cost_bias), printable_text(tag_list(db, clip.tags), kMaxListBytes).c_str());
   }
 }
 

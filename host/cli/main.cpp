@@ -1,5 +1,6 @@
 // mmvk: build, inspect, export and query motion matching databases.
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <new>
@@ -56,6 +57,10 @@ int check_stdout(std::string_view command, int exit_code) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Past `ulimit -f`, the kernel's default for SIGXFSZ kills the process
+  // mid-write and leaves the temp file; ignored, write() fails with EFBIG
+  // ("File too large"), which every writer reports and cleans up after.
+  std::signal(SIGXFSZ, SIG_IGN);
   std::vector<std::string_view> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     if (args.empty()) {

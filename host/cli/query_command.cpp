@@ -14,6 +14,7 @@
 #include "cli_args.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
+#include "driver_cache.hpp"
 #include "mmvk/backends.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/database_io.hpp"
@@ -212,6 +213,13 @@ Status make_backend(BackendHolder& holder, const Database& db, const QueryArgs& 
       std::fputs("mmvk query: training k-means cluster tables (default parameters; train them once with\n"
                  "  `mmvk clusters` and pass --clusters to reuse them)\n",
                  stderr);
+    }
+  }
+  // Before the first Vulkan context (driver_cache.hpp): a full disk under
+  // the driver's shader cache would crash the driver.
+  if (name.starts_with("vulkan")) {
+    if (const std::string note = crowd::guard_driver_shader_cache(); !note.empty()) {
+      std::fprintf(stderr, "mmvk query: note: %s\n", note.c_str());
     }
   }
   MMVK_ASSIGN_OR_RETURN(holder.backend, registry.make(spec, db));

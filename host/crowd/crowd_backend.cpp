@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "driver_cache.hpp"
 #include "mmvk/backends.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
@@ -133,6 +134,9 @@ Result<CrowdSearch> make_crowd_search(const std::string& asked, std::optional<st
   spec.pool = &pool;
   spec.max_batch = std::min(kPageQueries, std::max<std::uint32_t>(agents, 1));
   spec.max_k = 1;
+  // Before the first Vulkan context: a full disk under the driver's own
+  // shader cache would crash the driver (driver_cache.hpp).
+  if (name.starts_with("vulkan")) out.driver_cache_note = guard_driver_shader_cache();
   MMVK_ASSIGN_OR_RETURN(out.backend, registry.make(spec, database));
   out.deferred = out.backend->make_async(agents);
 #if defined(MMVK_HAS_VULKAN)

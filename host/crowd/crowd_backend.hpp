@@ -38,6 +38,7 @@ struct CrowdSearch {
   std::string pipeline_cache_note;           // why a pipeline cache file was not used, or ""
   // What "auto" picked and why ("auto: no GPU, ..."); empty for a backend named.
   std::string choice;
+  std::string driver_cache_note;             // why the driver's shader cache is off (driver_cache.hpp), or ""
 };
 
 // The CPU backends "auto" picks where there is no GPU, the fastest for a

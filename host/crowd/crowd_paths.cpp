@@ -31,8 +31,22 @@ std::vector<NamedPath> crowd_paths(const CrowdOptions& options, const std::files
   return paths;
 }
 
+// As export refuses it: the sidecar beside a device or FIFO would be a new
+// file in /dev (as root, --trace /dev/null made /dev/null.json).
 Status check_crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source) {
+  if (options.trace && is_stream_path(*options.trace)) {
+    return make_error("--trace " + options.trace->string() + " is a device or FIFO: its sidecar would be " +
+                      trace_sidecar_path(*options.trace).string() + " beside it; write the trace to a file");
+  }
   return check_command_paths(crowd_paths(options, data_source));
+}
+
+Status check_crowd_paths_with_database(const CrowdOptions& options, const std::filesystem::path& data_source,
+                                       const std::filesystem::path& database) {
+  if (database.empty()) return {};
+  std::vector<NamedPath> paths = crowd_paths(options, data_source);
+  paths.push_back({"the cache entry", database, false});
+  return check_command_paths(paths);
 }
 
 }  // namespace mmvk::crowd

@@ -19,5 +19,12 @@ namespace mmvk::crowd {
 // source: --data, a shipped set's manifest or the default one).
 std::vector<NamedPath> crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source);
 Status check_crowd_paths(const CrowdOptions& options, const std::filesystem::path& data_source);
+// The same check with the database the run opened (`database`: the cache
+// entry it read or built, or the --data .mmdb) as one more input, once its
+// name is known (after the build, before the first tick): `--html` naming
+// the cache entry would have replaced the entry with the page. Nothing when
+// `database` is empty (not cached).
+Status check_crowd_paths_with_database(const CrowdOptions& options, const std::filesystem::path& data_source,
+                                       const std::filesystem::path& database);
 
 }  // namespace mmvk::crowd

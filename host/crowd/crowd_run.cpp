@@ -57,6 +57,7 @@ void log_start(std::FILE* log, const CrowdOptions& options, const std::string& d
   if (!speeds.has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds.no_run_reason.c_str());
   std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
                search.device.c_str());
+  if (!search.driver_cache_note.empty()) std::fprintf(log, "mmvk crowd: note: %s\n", search.driver_cache_note.c_str());
   if (!search.pipeline_cache_note.empty()) {
     std::fprintf(log, "mmvk crowd: note: %s\n", search.pipeline_cache_note.c_str());
   }
@@ -116,6 +117,7 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
   // writable, none of them an input or another output (crowd_paths.hpp).
   MMVK_TRY(check_crowd_paths(options, data.source));
   MMVK_ASSIGN_OR_RETURN(OpenedDatabase opened, open_crowd_database(data, options, log));
+  MMVK_TRY(check_crowd_paths_with_database(options, data.source, opened.path));
   MMVK_ASSIGN_OR_RETURN(const CrowdSessionOptions session, session_options(options, data));
   MMVK_ASSIGN_OR_RETURN(std::unique_ptr<CrowdSession> crowd, CrowdSession::create(opened.database, session));
   log_start(log, options, data.label, *crowd);

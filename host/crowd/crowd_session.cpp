@@ -156,7 +156,7 @@ Status CrowdSession::step(std::span<const glm::vec3> desired_velocity, std::span
 Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const float> desired_yaw,
                           Clock::time_point tick_start) {
   // The recording ends at the first page written.
-  RecordingObserver* recording = html_written_ ? nullptr : recording_.get();
+  RecordingObserver* recording = finished_ ? nullptr : recording_.get();
   if (ticks_ == 0) figures_.reserve(tick_count(options_));
   MMVK_ASSIGN_OR_RETURN(const double tick_ms,
                         observed_tick(*controller_, *observed_, pool_, ticks_, float(dt_),
@@ -177,10 +177,13 @@ CrowdSummary CrowdSession::summary() const {
 
 Result<std::size_t> CrowdSession::write_html(const std::filesystem::path& path) {
   if (!recording_) return make_error("write_html: the crowd was made without record=True, so nothing was recorded");
-  if (html_written_) return make_error("write_html: the recording was already written (it ends at the first page)");
-  html_written_ = true;
-  Recording recording = recording_->finish(pool_);
-  return write_viewer_html(path, recording);
+  // Refused before the recording ends: a page of no ticks shows nothing,
+  // and the steps that follow are still recorded.
+  if (ticks_ == 0) return make_error("write_html: nothing was recorded yet (step the crowd first)");
+  // The recording ends at the first page, but is kept: a write that fails
+  // (a missing folder, a full disk) can be retried with the same run.
+  if (!finished_) finished_ = recording_->finish(pool_);
+  return write_viewer_html(path, *finished_);
 }
 
 }  // namespace mmvk::crowd

@@ -34,6 +34,7 @@
 #include "mmvk/database.hpp"
 #include "mmvk/status.hpp"
 #include "mmvk/thread_pool.hpp"
+#include "recording.hpp"
 #include "scenario.hpp"
 #include "steering.hpp"
 #include "summary.hpp"
@@ -106,7 +107,9 @@ class CrowdSession {
   // The run so far: the figures `mmvk crowd --summary` writes.
   CrowdSummary summary() const;
   // Writes the viewer page of the steps so far (options.record); the
-  // recording ends there, so it may be called once. Returns the bytes written.
+  // recording ends at the first call, and every later call writes the same
+  // page (a retry after a failed write loses nothing). An error before the
+  // first step. Returns the bytes written.
   Result<std::size_t> write_html(const std::filesystem::path& path);
 
  private:
@@ -138,7 +141,7 @@ class CrowdSession {
   std::vector<float> x_, z_, vx_, vz_;
   std::vector<glm::vec3> desired_, world_;
   double wall_s_ = 0.0;  // the ticks' own time, summed
-  bool html_written_ = false;
+  std::optional<Recording> finished_;  // the recording, once write_html ended it
 };
 
 }  // namespace mmvk::crowd

@@ -8,6 +8,7 @@
 
 #include "crowd_limits.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/input_text.hpp"
 #include "mmvk/json_check.hpp"
 #include "random.hpp"
 
@@ -19,7 +20,7 @@ using Json = nlohmann::json;
 
 Status check_fields(const Json& object, const std::string& where, const std::set<std::string>& known) {
   for (const auto& item : object.items()) {
-    if (!known.count(item.key())) return make_error(where + item.key() + ": unknown field");
+    if (!known.count(item.key())) return make_error(where + printable_text(item.key()) + ": unknown field");
   }
   return {};
 }
@@ -62,7 +63,7 @@ Result<SpeedPreference> read_speed(const Json& value, const std::string& where) 
     const std::string name = value.get<std::string>();
     if (name == "walk") return SpeedPreference{Gait::Walk, 1.0f};
     if (name == "run") return SpeedPreference{Gait::Run, 1.0f};
-    return make_error(where + ": expected \"walk\", \"run\" or metres/second, got \"" + name + "\"");
+    return make_error(where + ": expected \"walk\", \"run\" or metres/second, got " + quoted_text(name));
   }
   Result<float> metres = read_number(value, where);
   if (!metres) return make_error(where + ": expected \"walk\", \"run\" or metres/second");

@@ -1,9 +1,11 @@
 // mmvk.Crowd: the crowd host's CrowdSession (host/crowd/crowd_session.hpp)
 // stepped from Python, by its own steering or by another simulator's.
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,9 +34,28 @@ using crowd::CrowdSessionOptions;
 
 namespace {
 
+// A session reached through its object's lock, held while this lives: a
+// property read or write_html from one thread while another steps waits
+// its turn instead of reading a session in the middle of a tick.
+template <class Session>
+class HeldSession {
+ public:
+  HeldSession(std::unique_lock<std::mutex> lock, Session& session) : lock_(std::move(lock)), session_(session) {}
+  Session* operator->() const { return &session_; }
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+  Session& session_;
+};
+
+// How long a run() steps with the GIL released before it takes it back to
+// check for signals, so Ctrl-C stops a long run with KeyboardInterrupt.
+constexpr auto kSignalCheckInterval = std::chrono::milliseconds(100);
+
 class PyCrowd {
  public:
   PyCrowd(std::shared_ptr<Database> database, const CrowdSessionOptions& options) : database_(std::move(database)) {
+    if (!database_) throw py::type_error("db: expected an mmvk.Database, got None");
     Result<std::unique_ptr<CrowdSession>> made = make_error("");
     {
       py::gil_scoped_release released;
@@ -48,6 +69,7 @@ class PyCrowd {
   }
 
   void step(const py::object& desired_velocity, const py::object& desired_facing) {
+    const auto held = lock();
     if (desired_velocity.is_none()) {
       if (!desired_facing.is_none()) raise("desired_facing: given without desired_velocity");
       Status status;
@@ -65,6 +87,7 @@ class PyCrowd {
   // Velocities from the host's positions at the end of this tick
   // (PositionSteering, mmvk/steering_input.hpp).
   void step_toward(const py::object& next_positions, const py::object& desired_facing) {
+    const auto held = lock();
     read_xz(next_positions, "next_positions", next_);
     check(positions_->velocities(session_->controller().simulation(), next_, float(session_->dt()), velocity_));
     steer(desired_facing);
@@ -73,24 +96,45 @@ class PyCrowd {
   void run(double seconds) {
     check(crowd::check_tick_count(seconds, session_->rate_hz(), 0, "seconds", crowd::SettingNames::Keywords));
     const auto ticks = std::uint64_t(std::llround(seconds / session_->dt()));
+    const auto held = lock();
     Status status;
-    {
-      py::gil_scoped_release released;
-      for (std::uint64_t t = 0; t < ticks && status.ok(); ++t) status = session_->step();
+    for (std::uint64_t t = 0; t < ticks && status.ok();) {
+      {
+        py::gil_scoped_release released;
+        const auto until = std::chrono::steady_clock::now() + kSignalCheckInterval;
+        do {
+          status = session_->step();
+          ++t;
+        } while (t < ticks && status.ok() && std::chrono::steady_clock::now() < until);
+      }
+      // Ctrl-C (or any handler that raises) ends the run between ticks.
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     }
     check(status);
   }
 
   void place(std::uint32_t index, float x, float z, float yaw, std::uint32_t frame) {
+    const auto held = lock();
     check(session_->place(index, x, z, yaw, frame));
     positions_->reset();  // a teleport is no motion of the host's
   }
 
-  const CrowdSession& session() const { return *session_; }
-  CrowdSession& session() { return *session_; }
+  HeldSession<const CrowdSession> session() const { return {lock(), *session_}; }
+  HeldSession<CrowdSession> session() { return {lock(), *session_}; }
   std::uint32_t agents() const { return agents_; }
 
  private:
+  // The object's lock. Taken without the GIL when another thread holds it:
+  // that thread may need the GIL to finish (a run checks for signals).
+  std::unique_lock<std::mutex> lock() const {
+    std::unique_lock<std::mutex> held(mutex_, std::try_to_lock);
+    if (!held.owns_lock()) {
+      py::gil_scoped_release released;
+      held.lock();
+    }
+    return held;
+  }
+
   // (x, z) rows, or (x, y, z) with y ignored: [agents x 2|3] float32 into out.
   void read_xz(const py::object& value, const char* what, std::vector<glm::vec3>& out) const {
     const auto a = py::reinterpret_borrow<py::array>(value);
@@ -122,6 +166,9 @@ class PyCrowd {
   std::uint32_t agents_ = 0;
   std::vector<glm::vec3> velocity_, next_;  // [agents]
   std::optional<PositionSteering> positions_;  // step_toward's
+  // One call at a time: a session is not thread-safe, and two threads
+  // stepping, or one reading while another steps, corrupted it.
+  mutable std::mutex mutex_;
 };
 
 // A copy of `values` ([n x 3] floats as glm::vec3) as float32 [n x 3].
@@ -210,18 +257,23 @@ void add_stepping(py::class_<PyCrowd>& crowd) {
 void add_settings(py::class_<PyCrowd>& crowd) {
   crowd
       .def_property_readonly("agents", &PyCrowd::agents, "The number of characters.")
-      .def_property_readonly("rate", [](const PyCrowd& c) { return 1.0 / c.session().dt(); }, "Ticks per second.")
-      .def_property_readonly("dt", [](const PyCrowd& c) { return c.session().dt(); }, "Seconds per tick.")
-      .def_property_readonly("ticks", [](const PyCrowd& c) { return c.session().ticks(); }, "Ticks stepped so far.")
-      .def_property_readonly("time", [](const PyCrowd& c) { return double(c.session().ticks()) * c.session().dt(); },
+      .def_property_readonly("rate", [](const PyCrowd& c) { return 1.0 / c.session()->dt(); }, "Ticks per second.")
+      .def_property_readonly("dt", [](const PyCrowd& c) { return c.session()->dt(); }, "Seconds per tick.")
+      .def_property_readonly("ticks", [](const PyCrowd& c) { return c.session()->ticks(); }, "Ticks stepped so far.")
+      .def_property_readonly("time",
+                             [](const PyCrowd& c) {
+                               const auto session = c.session();  // one lock for both reads
+                               return double(session->ticks()) * session->dt();
+                             },
                              "Simulated seconds so far.")
-      .def_property_readonly("device", [](const PyCrowd& c) { return c.session().device(); }, "Where the search runs.")
-      .def_property_readonly("walk_speed", [](const PyCrowd& c) { return c.session().speeds().walk_mps; },
+      .def_property_readonly("device", [](const PyCrowd& c) { return c.session()->device(); }, "Where the search runs.")
+      .def_property_readonly("walk_speed", [](const PyCrowd& c) { return c.session()->speeds().walk_mps; },
                              "The database's typical walking speed, m/s.")
       .def_property_readonly(
           "run_speed",
           [](const PyCrowd& c) -> py::object {
-            const auto& s = c.session().speeds();
+            const auto session = c.session();
+            const auto& s = session->speeds();
             return s.has_run ? py::object(py::float_(s.run_mps)) : py::none();
           },
           "The database's typical running speed, m/s, or None when the data has no run.")
@@ -229,7 +281,8 @@ void add_settings(py::class_<PyCrowd>& crowd) {
           "goals",
           [](const PyCrowd& c) {
             std::vector<std::vector<std::array<float, 2>>> goals;
-            for (const auto& plan : c.session().scenario().agents) goals.push_back(plan.goals);
+            const auto session = c.session();
+            for (const auto& plan : session->scenario().agents) goals.push_back(plan.goals);
             return goals;
           },
           "Each character's goal points [(x, z), ...] (its own steering visits them in turn).");
@@ -241,17 +294,18 @@ void add_state_arrays(py::class_<PyCrowd>& crowd) {
       .def_property_readonly(
           "root_positions",
           [](const PyCrowd& c) {
-            return vec3_array(c.session().controller().root_positions(), {py::ssize_t(c.agents()), 3});
+            return vec3_array(c.session()->controller().root_positions(), {py::ssize_t(c.agents()), 3});
           },
           "Each character's root (as displayed), float32 [agents x 3], metres, y = 0. Arrays are copies.")
       .def_property_readonly(
           "root_yaws",
-          [](const PyCrowd& c) { return copy_array(c.session().controller().root_yaws(), {py::ssize_t(c.agents())}); },
+          [](const PyCrowd& c) { return copy_array(c.session()->controller().root_yaws(), {py::ssize_t(c.agents())}); },
           "Each character's facing, float32 [agents], radians about +Y (0 faces +Z; facing = (sin, cos)).")
       .def_property_readonly(
           "simulated_positions",
           [](const PyCrowd& c) {
-            const auto sim = c.session().controller().simulation();
+            const auto session = c.session();
+            const auto sim = session->controller().simulation();
             py::array_t<float> out({py::ssize_t(c.agents()), py::ssize_t(3)});
             float* o = out.mutable_data();
             for (std::size_t b = 0; b < sim.size(); ++b) {
@@ -262,22 +316,23 @@ void add_state_arrays(py::class_<PyCrowd>& crowd) {
           "Each character's simulated root (the spring that follows the desired velocity), float32 [agents x 3].")
       .def_property_readonly(
           "frames",
-          [](const PyCrowd& c) { return copy_array(c.session().controller().frames(), {py::ssize_t(c.agents())}); },
+          [](const PyCrowd& c) { return copy_array(c.session()->controller().frames(), {py::ssize_t(c.agents())}); },
           "The database frame each character plays, uint32 [agents].")
       .def_property_readonly(
           "contacts",
-          [](const PyCrowd& c) { return copy_array(c.session().controller().contacts(), {py::ssize_t(c.agents())}); },
+          [](const PyCrowd& c) { return copy_array(c.session()->controller().contacts(), {py::ssize_t(c.agents())}); },
           "Foot contact bits of each character's frame, uint8 [agents] (Animation.contacts).")
       .def_property_readonly(
           "foot_locked",
           [](const PyCrowd& c) {
-            return copy_array(c.session().controller().foot_locked(), {py::ssize_t(c.agents()), 2});
+            return copy_array(c.session()->controller().foot_locked(), {py::ssize_t(c.agents()), 2});
           },
           "1 while a foot (left, right) is held where it was planted, uint8 [agents x 2].")
       .def_property_readonly(
           "joint_positions",
           [](const PyCrowd& c) {
-            const auto world = c.session().world_positions();
+            const auto session = c.session();
+            const auto world = session->world_positions();
             const auto joints = py::ssize_t(world.size() / std::max<std::size_t>(c.agents(), 1));
             return vec3_array(world, {py::ssize_t(c.agents()), joints, 3});
           },
@@ -291,7 +346,7 @@ void add_outputs(py::class_<PyCrowd>& crowd) {
       .def(
           "summary",
           [](const PyCrowd& c) {
-            const std::string json = crowd::summary_to_json(c.session().summary());
+            const std::string json = crowd::summary_to_json(c.session()->summary());
             return py::module_::import("json").attr("loads")(json);
           },
           "The run so far as a dict: the figures of `mmvk crowd --summary` (trajectory_error_m_1s, "
@@ -300,10 +355,11 @@ void add_outputs(py::class_<PyCrowd>& crowd) {
           "write_html",
           [](PyCrowd& c, const py::object& path) {
             const std::filesystem::path p = to_path(path, "path");
+            auto session = c.session();
             Result<std::size_t> written = make_error("");
             {
               py::gil_scoped_release released;
-              written = c.session().write_html(p);
+              written = session->write_html(p);
             }
             return take(std::move(written), ErrorKind::OS);
           },
@@ -311,7 +367,8 @@ void add_outputs(py::class_<PyCrowd>& crowd) {
           "Writes the viewer page (one self-contained HTML file) of the steps so far; needs record=True. The "
           "recording ends there. Returns the bytes written.")
       .def("__repr__", [](const PyCrowd& c) {
-        return "<mmvk.Crowd: " + std::to_string(c.agents()) + " agents, " + std::to_string(c.session().ticks()) +
+        const std::uint64_t ticks = c.session()->ticks();
+        return "<mmvk.Crowd: " + std::to_string(c.agents()) + " agents, " + std::to_string(ticks) +
                " ticks>";
       });;
 }

@@ -20,6 +20,7 @@
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/json_check.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/thread_pool.hpp"
 
@@ -108,31 +109,60 @@ py::array normalized_features(const Database& db, const py::handle& raw) {
   return out;
 }
 
+// `text` parsed with the library's checks (mmvk/json_check.hpp: duplicate
+// keys, bytes after the value, nesting depth), so that the merge path below
+// refuses what build(path) and `mmvk build` refuse, and never walks or
+// dumps a document nested deeply enough to overflow the stack.
+nlohmann::json strict_json(const std::string& text, const std::string& source) {
+  check(check_json_text(text, source));
+  nlohmann::json parsed = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (parsed.is_discarded()) raise(source + ": not valid JSON");  // unreachable after the check
+  return parsed;
+}
+
 // The manifest JSON with `fields` set over its top-level fields.
 std::string merged_manifest(const std::string& text, const nlohmann::json& fields, const std::string& source) {
-  nlohmann::json manifest = nlohmann::json::parse(text, nullptr, false);
-  if (manifest.is_discarded() || !manifest.is_object()) {
+  nlohmann::json manifest = strict_json(text, source);
+  if (!manifest.is_object()) {
     raise(source + ": not a JSON object, so the fields given to build() cannot be added to it");
   }
   for (const auto& [key, value] : fields.items()) manifest[key] = value;
-  return manifest.dump();
+  // A path that is not UTF-8 is replaced (and then not found, naming it)
+  // instead of throwing from the dump.
+  return manifest.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// A dict (the manifest fields, a manifest or schema dict) as JSON text. A
+// float that JSON cannot hold (nan, inf) is named first: JSON has no
+// spelling for it, and json.dumps would write one that no parser reads.
+std::string dict_json(const py::handle& dict, const std::string& what) {
+  for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(dict)) {
+    if (py::isinstance<py::float_>(value) && !std::isfinite(value.cast<double>())) {
+      raise(std::string(py::str(key)) + ": expected a finite number, got " + std::string(py::str(value)));
+    }
+  }
+  try {
+    return py::str(py::module_::import("json").attr("dumps")(dict, py::arg("allow_nan") = false)).cast<std::string>();
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_ValueError) && !e.matches(PyExc_TypeError)) throw;
+    raise(what + ": " + std::string(py::str(e.value())));  // a nested nan, or a value JSON cannot hold
+  }
 }
 
 // mmvk.build: `source` a manifest file, a folder of BVH or a manifest dict;
 // `schema` a schema file or dict; `fields` manifest fields over the source's.
 std::shared_ptr<Database> build(const py::object& source, const py::object& schema, const py::kwargs& kwargs) {
-  const py::module_ json = py::module_::import("json");
-  nlohmann::json fields = nlohmann::json::parse(py::str(json.attr("dumps")(kwargs)).cast<std::string>());
+  nlohmann::json fields = strict_json(dict_json(kwargs, "the manifest fields"), "the manifest fields");
   if (!schema.is_none()) {
     if (py::isinstance<py::dict>(schema)) {
-      fields["schema"] = nlohmann::json::parse(py::str(json.attr("dumps")(schema)).cast<std::string>());
+      fields["schema"] = strict_json(dict_json(schema, "schema"), "schema");
     } else {
       fields["schema"] = std::filesystem::absolute(to_path(schema, "schema")).string();
     }
   }
   Manifest manifest;
   if (py::isinstance<py::dict>(source)) {
-    const std::string text = py::str(json.attr("dumps")(source)).cast<std::string>();
+    const std::string text = dict_json(source, "source");
     manifest = take(parse_manifest_json(merged_manifest(text, fields, "the manifest dict"), "the manifest dict",
                                         std::filesystem::current_path()));
   } else {
@@ -149,7 +179,7 @@ std::shared_ptr<Database> build(const py::object& source, const py::object& sche
       for (const ManifestClip& clip : listed.clips) {
         clips.push_back({{"file", std::filesystem::absolute(clip.file).string()}});
       }
-      const std::string text = nlohmann::json{{"clips", clips}}.dump();
+      const std::string text = nlohmann::json{{"clips", clips}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
       manifest = take(parse_manifest_json(merged_manifest(text, fields, path.string()), path.string(), path));
     } else {
       ReadOptions options;

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <pybind11/numpy.h>
@@ -15,6 +16,7 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "driver_cache.hpp"
 #include "errors.hpp"
 #include "mmvk/backends.hpp"
 #include "mmvk/cluster_table.hpp"
@@ -92,17 +94,38 @@ BackendRegistry registry([[maybe_unused]] void* context, [[maybe_unused]] std::o
   return r;
 }
 
+// An option taken out of `options` (what is left is unknown), checked with
+// its name in errors.
 template <class T>
 T option(py::dict& options, const char* name, T fallback) {
   if (!options.contains(name)) return fallback;
-  T value = options[name].cast<T>();
+  const py::object given = options[name];
   PyDict_DelItemString(options.ptr(), name);
-  return value;
+  if constexpr (std::is_same_v<T, bool>) {
+    if (!py::isinstance<py::bool_>(given)) throw py::type_error(std::string(name) + ": expected True or False");
+    return given.cast<bool>();
+  } else {
+    return integer_as<T>(given, name);
+  }
+}
+
+// k before the results are allocated: it sizes them (the backends check it
+// too, after the allocation).
+void check_k(std::uint32_t k) {
+  if (k < 1 || k > kMaxK) {
+    throw py::value_error("k: expected 1 to " + std::to_string(kMaxK) + ", got " + std::to_string(k));
+  }
+}
+
+// A continuing frame as the backends take it: -1 (any negative) none.
+std::uint32_t continuing_frame(long long frame) {
+  return frame < 0 ? kNoFrame : std::uint32_t(std::min<long long>(frame, kNoFrame - 1LL));
 }
 
 PySearch::PySearch(std::shared_ptr<Database> database, const std::string& backend, const py::object& device,
                    const py::kwargs& given)
     : database_(std::move(database)) {
+  if (!database_) throw py::type_error("db: expected an mmvk.Database, got None");
   py::dict options = given.attr("copy")();  // known options are taken out of the copy
   const auto threads = option<unsigned>(options, "threads", 0);
   pool_ = take(ThreadPool::create(threads));
@@ -130,12 +153,19 @@ PySearch::PySearch(std::shared_ptr<Database> database, const std::string& backen
           "max_tile, warm_up)");
   }
   std::optional<std::uint32_t> device_index;
-  if (!device.is_none()) device_index = device.cast<std::uint32_t>();
+  if (!device.is_none()) device_index = integer_as<std::uint32_t>(device, "device");
   void* context = nullptr;
 #if defined(MMVK_HAS_VULKAN)
   context = &context_;
 #endif
   const BackendRegistry backends = registry(context, device_index);
+  // Before the first Vulkan context (host/crowd/driver_cache.hpp): a full
+  // disk under the driver's shader cache would crash the driver.
+  if (backend.starts_with("vulkan")) {
+    if (const std::string note = crowd::guard_driver_shader_cache(); !note.empty()) {
+      if (PyErr_WarnEx(PyExc_RuntimeWarning, note.c_str(), 1) != 0) throw py::error_already_set();
+    }
+  }
   Result<std::unique_ptr<SearchBackend>> made = make_error("");
   {
     py::gil_scoped_release released;  // k-means training and kernel compiles take a while
@@ -159,6 +189,7 @@ py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py:
                            const py::object& weights, float continuing_bias, float continuing_multiplier,
                            std::uint32_t exclusion_window) {
   const Database& db = *database_;
+  check_k(k);
   const FloatRows rows = float_rows(queries, db.dims(), "queries", false);
   const std::size_t batch = rows.rows;
 
@@ -171,16 +202,22 @@ py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py:
   if (!weights.is_none()) {
     const auto weight_dict = weights.cast<py::dict>();
     for (const auto& [channel, weight] : weight_dict) {
-      check(set_channel_weight(db.schema(), base, channel.cast<std::string>(), weight.cast<float>()));
+      if (!py::isinstance<py::str>(channel)) {
+        throw py::type_error("weights: expected channel names (str) as keys, got " +
+                             std::string(py::str(py::type::of(channel).attr("__name__"))));
+      }
+      const std::string name = channel.cast<std::string>();
+      const float value = float_argument(weight, "weights['" + name + "']");
+      check(set_channel_weight(db.schema(), base, name, value));
     }
   }
   // Per-query params only when a query differs from the defaults (an empty
   // span means default params for every query).
   std::vector<QueryParams> params;
   if (!continuing.is_none()) {
-    if (py::isinstance<py::int_>(continuing)) {
-      const long long frame = continuing.cast<long long>();
-      base.continuing_frame = frame < 0 ? kNoFrame : std::uint32_t(std::min<long long>(frame, kNoFrame - 1LL));
+    // One frame for all: a Python int or a NumPy integer scalar (not an array).
+    if (PyIndex_Check(continuing.ptr()) && !py::isinstance<py::array>(continuing)) {
+      base.continuing_frame = continuing_frame(integer_as<long long>(continuing, "continuing"));
       params.assign(batch, base);
     } else {
       const auto frames = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(continuing);
@@ -190,8 +227,7 @@ py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py:
       }
       params.assign(batch, base);
       for (std::size_t b = 0; b < batch; ++b) {
-        const long long frame = frames.at(b);
-        params[b].continuing_frame = frame < 0 ? kNoFrame : std::uint32_t(std::min<long long>(frame, kNoFrame - 1LL));
+        params[b].continuing_frame = continuing_frame(frames.at(b));
       }
     }
   } else if (!(base.require_all == 0 && base.exclude_any == 0 && base.continuing_bias == 0.0f &&
@@ -220,6 +256,7 @@ py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py:
 }
 
 double PySearch::native_seconds(const py::object& queries, std::uint32_t k, std::uint32_t calls) {
+  check_k(k);
   const FloatRows rows = float_rows(queries, database_->dims(), "queries", false);
   std::vector<Match> out(rows.rows * std::size_t(k));
   const QueryBatch batch{rows.values, {}, rows.rows};

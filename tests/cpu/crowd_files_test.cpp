@@ -6,6 +6,7 @@
 // in the test's folder (skipped where mknod is refused), never /dev.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -217,6 +218,48 @@ TEST_F(CrowdFiles, AFifoOutputIsWrittenInPlace) {
   ASSERT_EQ(ran.exit_code, 0) << ran.output;
   EXPECT_EQ(test::file_type(dir_ / "page"), "fifo");
   EXPECT_TRUE(contains(read_text(dir_ / "copy.html"), "mmvk-data")) << read_text(dir_ / "copy.html").size();
+}
+
+// Issue 34: the cache entry the run reads is an input: `--html ENTRY` made
+// the entry an HTML page.
+TEST_F(CrowdFiles, TheCacheEntryIsAnInput) {
+  ASSERT_EQ(crowd("--agents 3 --seconds 0.2").exit_code, 0);
+  const fs::path entry = cache_entry();
+  ASSERT_FALSE(entry.empty());
+  const std::string bytes = read_text(entry);
+  const auto ran = crowd("--agents 3 --seconds 0.2 --html " + entry.string());
+  expect_failure(ran, {"the cache entry", "--html", "name the same file"}, "--html over the cache entry");
+  EXPECT_EQ(read_text(entry), bytes);
+}
+
+// Issue 34: an output FIFO nobody reads blocked the run forever (the
+// second of two outputs on one FIFO, after the reader of the first left,
+// hung the same way); it fails after kFifoReaderWait (10 s).
+TEST_F(CrowdFiles, AFifoWithoutAReaderFailsInsteadOfHanging) {
+  ASSERT_TRUE(test::make_fifo(dir_ / "page"));
+  const auto start = std::chrono::steady_clock::now();
+  const auto ran = crowd("--agents 3 --seconds 0.2 --html " + (dir_ / "page").string());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  expect_failure(ran, {"page: is a FIFO that no reader opened within 10 s"}, "--html FIFO without a reader");
+  EXPECT_NE(ran.exit_code, 124) << "timed out (blocked): " << ran.output;
+  EXPECT_LT(seconds, 120.0);
+  EXPECT_EQ(test::file_type(dir_ / "page"), "fifo");
+}
+
+// Issue 34: past `ulimit -f` the kernel killed the run with SIGXFSZ and left
+// its temp file; ignored, the write fails with EFBIG and the temp goes.
+TEST_F(CrowdFiles, AFileSizeLimitIsAnErrorNotASignal) {
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  // 64 blocks of 512 bytes: the page is megabytes.
+  const auto ran = run_command("ulimit -f 64 && " + mmvk_ + " crowd --backend fast-box --data " +
+                               (data_ / "manifest.json").string() + " --agents 3 --seconds 0.5 --html " +
+                               (out / "page.html").string());
+  expect_failure(ran, {"page.html", "File too large"}, "ulimit -f");
+  EXPECT_TRUE(fs::is_empty(out)) << "a temp file was left";
+  for (const auto& entry : fs::recursive_directory_iterator(dir_ / "cache")) {
+    EXPECT_FALSE(contains(entry.path().filename().string(), ".tmp-")) << entry.path();
+  }
 }
 
 }  // namespace

@@ -87,8 +87,11 @@ TEST_F(DeviceNodesCli, OutputsToANullDeviceAreWrittenInPlace) {
 
 // A default sidecar would be a new file beside the device (in /dev).
 TEST_F(DeviceNodesCli, DefaultSidecarsBesideADeviceAreRefused) {
+  // Issue 34: --trace on a device made NODE.json beside it, as export did not.
   for (const std::string& command : {mmvk_ + " export " + db_ + " --features " + node("null"),
-                                     mmvk_ + " export " + db_ + " --animation " + node("null")}) {
+                                     mmvk_ + " export " + db_ + " --animation " + node("null"),
+                                     mmvk_ + " crowd --backend fast-box --data " + db_ +
+                                         " --agents 3 --seconds 0.2 --trace " + node("null")}) {
     const auto ran = run_command(command);
     EXPECT_GE(ran.exit_code, 1) << command << "\n" << ran.output;
     EXPECT_LE(ran.exit_code, 127) << command << "\n" << ran.output;

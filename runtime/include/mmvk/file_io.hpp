@@ -10,6 +10,7 @@
 // had; a device, FIFO or socket is written in place, never renamed over.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -54,8 +55,9 @@ enum class OutputPolicy : std::uint8_t {
   // link stays); a symlink to nothing is an error. A character device, FIFO
   // or socket (/dev/null, a named pipe) is written in place, never renamed
   // over, and /dev/stdout, /dev/stderr, /dev/fd/N and /proc/self/fd/N are
-  // written through that open descriptor (so `>>` appends). A FIFO blocks
-  // until a reader opens it, as a shell's `>` does.
+  // written through that open descriptor (so `>>` appends). A FIFO waits
+  // for a reader to open it, as a shell's `>` does, but at most
+  // kFifoReaderWait: then it is an error, never a hang.
   UserPath,
   // A file mmvk names itself (a cache entry): whatever stands at the path,
   // a symlink or a device node included, is replaced by a regular file;
@@ -63,17 +65,25 @@ enum class OutputPolicy : std::uint8_t {
   CacheEntry,
 };
 
+// How long opening a FIFO output waits for a reader.
+inline constexpr std::chrono::milliseconds kFifoReaderWait{10000};
+
 // One output being written: open() picks the way (see OutputPolicy) and, for
 // a replaced file, creates the temp file exclusively (O_CREAT | O_EXCL |
 // O_NOFOLLOW, a random name beside the target, so nothing planted there is
-// followed); write() appends; commit() flushes (fsync) and renames the temp
+// followed: "<name>.tmp-<pid>-<random>"). A writer killed mid-write leaves
+// its temp file behind, so open() first removes the temp files in the
+// target's folder whose writer (the PID in their name) is no longer
+// running, and which belong to this user. write() appends; commit() flushes (fsync) and renames the temp
 // file over the target. Destroyed uncommitted, the temp file is removed and
 // the target is left as it was. A replaced file keeps the mode of the file it
 // replaces (new files: 0644 less the umask). Errors name the path and the step
 // (a full disk, /dev/full, fails write() or commit()).
 class OutputFile {
  public:
-  static Result<OutputFile> open(const std::filesystem::path& path, OutputPolicy policy = OutputPolicy::UserPath);
+  // `fifo_reader_wait`: how long a FIFO waits for its reader.
+  static Result<OutputFile> open(const std::filesystem::path& path, OutputPolicy policy = OutputPolicy::UserPath,
+                                 std::chrono::milliseconds fifo_reader_wait = kFifoReaderWait);
 
   OutputFile(OutputFile&& other) noexcept;
   OutputFile& operator=(OutputFile&& other) noexcept;

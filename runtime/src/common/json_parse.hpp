@@ -13,8 +13,11 @@
 
 namespace mmvk::detail {
 
-// Parses `text`; errors name `source`: "not valid JSON" (bytes after the
-// value included), a NUL byte, or a duplicate key (mmvk/json_check.hpp).
+// Parses `text` with the checks of mmvk/json_check.hpp, in time linear in
+// its size; errors name `source`: "not valid JSON at byte N: <reason>"
+// (bytes after the value included), a NUL byte, a duplicate key or nesting
+// deeper than kMaxJsonDepth. What it returns may be walked and dumped
+// recursively.
 Result<nlohmann::json> parse_json_text(std::string_view text, const std::string& source);
 
 // A JSON number as a finite float; errors name `where` ("expected a number",

@@ -9,12 +9,15 @@
 // temp file is created exclusively under a random name.
 #include "mmvk/file_io.hpp"
 
+#include "common/temp_files.hpp"
+#include "mmvk/number_text.hpp"
+
 #include <fcntl.h>
-#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
@@ -104,26 +107,35 @@ Result<Resolved> resolve_output(const fs::path& path, OutputPolicy policy) {
   return Resolved{Way::Replace, target, -1, st.st_mode & 07777};
 }
 
-fs::path folder_of(const fs::path& target) { return target.has_parent_path() ? target.parent_path() : fs::path("."); }
+using detail::folder_of;
 
-// A random temp name beside the target. Predictable names are harmless with
-// O_EXCL | O_NOFOLLOW (a planted file only costs a retry), but random ones
-// cannot be planted in advance at all.
-fs::path temp_name(const fs::path& target, unsigned attempt) {
-  std::uint64_t random = 0;
-  if (::getrandom(&random, sizeof(random), GRND_NONBLOCK) != static_cast<ssize_t>(sizeof(random))) {
-    random = (std::uint64_t(::getpid()) << 32) ^ (std::uint64_t(attempt) * 0x9E3779B97F4A7C15ull);
+// A FIFO opened for writing: open() with O_NONBLOCK fails with ENXIO while
+// no reader has it open, so the wait for one is a poll with a deadline
+// instead of a blocking open that never returns. Once open, writes block
+// as usual (the reader is there).
+int open_fifo(const fs::path& path, std::chrono::milliseconds wait) {
+  const auto deadline = std::chrono::steady_clock::now() + wait;
+  for (;;) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd >= 0) {
+      const int flags = ::fcntl(fd, F_GETFL);
+      if (flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        const int error = errno;
+        ::close(fd);
+        errno = error;
+        return -1;
+      }
+      return fd;
+    }
+    if (errno != ENXIO || std::chrono::steady_clock::now() >= deadline) return -1;
+    ::usleep(20000);
   }
-  char suffix[24];
-  std::snprintf(suffix, sizeof(suffix), ".tmp-%012llx", static_cast<unsigned long long>(random & 0xFFFFFFFFFFFFull));
-  std::string name = target.filename().string();
-  if (name.size() > 200) name = "mmvk";  // stay under NAME_MAX with the suffix
-  return folder_of(target) / (name + suffix);
 }
 
 }  // namespace
 
-Result<OutputFile> OutputFile::open(const fs::path& path, OutputPolicy policy) {
+Result<OutputFile> OutputFile::open(const fs::path& path, OutputPolicy policy,
+                                    std::chrono::milliseconds fifo_reader_wait) {
   MMVK_ASSIGN_OR_RETURN(const Resolved resolved, resolve_output(path, policy));
   OutputFile out;
   out.path_ = path;
@@ -138,7 +150,16 @@ Result<OutputFile> OutputFile::open(const fs::path& path, OutputPolicy policy) {
     }
     case Way::InPlace: {
       // No O_CREAT and no O_TRUNC: the device or FIFO stays what it is.
-      out.fd_ = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+      struct stat kind {};
+      if (::stat(path.c_str(), &kind) == 0 && S_ISFIFO(kind.st_mode)) {
+        out.fd_ = open_fifo(path, fifo_reader_wait);
+        if (out.fd_ < 0 && errno == ENXIO) {
+          return make_error(path.string() + ": is a FIFO that no reader opened within " +
+                            number_text(double(fifo_reader_wait.count()) / 1000.0) + " s; not written");
+        }
+      } else {
+        out.fd_ = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+      }
       if (out.fd_ < 0) return make_error(describe_errno(path, "cannot open for writing"));
       struct stat st {};
       if (::fstat(out.fd_, &st) != 0 || S_ISREG(st.st_mode) || S_ISDIR(st.st_mode)) {
@@ -150,9 +171,10 @@ Result<OutputFile> OutputFile::open(const fs::path& path, OutputPolicy policy) {
       break;
   }
   out.target_ = resolved.target;
+  detail::reap_stale_temps(folder_of(resolved.target));
   int error = 0;
   for (unsigned attempt = 0; attempt < 64; ++attempt) {
-    fs::path temp = temp_name(resolved.target, attempt);
+    fs::path temp = detail::temp_name(resolved.target, attempt);
     out.fd_ = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (out.fd_ >= 0) {
       out.temp_ = std::move(temp);

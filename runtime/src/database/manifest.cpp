@@ -14,6 +14,7 @@
 #include "common/json_parse.hpp"
 #include "common/name_table.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/input_text.hpp"
 
 namespace mmvk {
 
@@ -26,7 +27,9 @@ Status check_fields(const Json& object, const std::string& where, const std::set
   for (const auto& item : object.items()) {
     // `where` is either "file: " (top level) or "file: clips[2]" (nested).
     const bool top = !where.empty() && where.back() == ' ';
-    if (!known.count(item.key())) return make_error(where + (top ? "" : ".") + item.key() + ": unknown field");
+    if (!known.count(item.key())) {
+      return make_error(where + (top ? "" : ".") + printable_text(item.key()) + ": unknown field");
+    }
   }
   return {};
 }
@@ -313,8 +316,8 @@ std::string_view edge_rule_name(EdgeRule rule) {
 Result<EdgeRule> parse_edge_rule(std::string_view name) {
   const std::span<const EdgeRuleEntry> table(kEdgeRules);
   if (const EdgeRuleEntry* entry = detail::find_named(table, &EdgeRuleEntry::name, name)) return entry->rule;
-  return make_error("expected " + detail::name_list(table, &EdgeRuleEntry::name, '"', true) + ", got \"" +
-                    std::string(name) + "\"");
+  return make_error("expected " + detail::name_list(table, &EdgeRuleEntry::name, '"', true) + ", got " +
+                    quoted_text(name));
 }
 
 namespace {
@@ -377,7 +380,7 @@ Status read_import_field(const Json& root, const std::string& at, Manifest& mani
     } else if (axis == "z" || axis == "Z") {
       manifest.import.up_axis = UpAxis::Z;
     } else {
-      return make_error(at + "import.up_axis: expected \"y\" or \"z\", got \"" + axis + "\"");
+      return make_error(at + "import.up_axis: expected \"y\" or \"z\", got " + quoted_text(axis));
     }
   }
   return {};

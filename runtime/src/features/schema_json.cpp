@@ -8,6 +8,7 @@
 #include "common/json_parse.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/input_text.hpp"
 #include "mmvk/normalization.hpp"
 
 namespace mmvk {
@@ -146,7 +147,7 @@ Result<FeatureChannel> parse_channel(const Json& object, const std::string& wher
                                                "curves", "offsets_seconds", "dims", "window_seconds", "weight",
                                                "normalization"};
   for (const auto& item : object.items()) {
-    if (!kKnown.count(item.key())) return make_error(where + "." + item.key() + ": unknown field");
+    if (!kKnown.count(item.key())) return make_error(where + "." + printable_text(item.key()) + ": unknown field");
   }
   FeatureChannel channel;
   MMVK_ASSIGN_OR_RETURN(const ChannelKindInfo* const info, parse_name_and_kind(object, where, channel));
@@ -167,7 +168,7 @@ Result<FeatureSchema> parse_schema_json(std::string_view json_text, std::string_
   Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"channels\"");
   for (const auto& item : root.items()) {
-    if (item.key() != "channels") return make_error(name + ": " + item.key() + ": unknown field");
+    if (item.key() != "channels") return make_error(name + ": " + printable_text(item.key()) + ": unknown field");
   }
   if (!root.contains("channels") || !root["channels"].is_array()) {
     return make_error(name + ": channels: expected an array of channel objects");

@@ -8,6 +8,7 @@
 
 #include "common/name_table.hpp"
 #include "mmvk/character.hpp"
+#include "mmvk/input_text.hpp"
 
 namespace mmvk {
 
@@ -70,11 +71,18 @@ constexpr std::array<RoleNames, 14> kRoles{{
     {"hips", "hips (pelvis)", {"hips", "hip", "pelvis", "root", "", "", "", "", "", ""}},
 }};
 
+// The joints' names as messages show them: names come from the BVH file, so
+// each is escaped and cut (printable_text), and a skeleton of thousands of
+// joints lists its first kListedJoints.
 std::string list_joints(const Skeleton& skeleton) {
+  constexpr std::size_t kListedJoints = 100;
   std::string out;
-  for (std::size_t i = 0; i < skeleton.names.size(); ++i) {
+  for (std::size_t i = 0; i < skeleton.names.size() && i < kListedJoints; ++i) {
     if (i) out += ", ";
-    out += skeleton.names[i];
+    out += printable_text(skeleton.names[i]);
+  }
+  if (skeleton.names.size() > kListedJoints) {
+    out += " and " + std::to_string(skeleton.names.size() - kListedJoints) + " more";
   }
   return out;
 }
@@ -137,14 +145,14 @@ Result<int> find_bone(const Skeleton& skeleton, std::string_view bone) {
   if (bone.front() != '@') {
     const int index = skeleton.find(bone);
     if (index < 0) {
-      return make_error("bone '" + std::string(bone) + "' not found; the skeleton's joints are: " +
+      return make_error("bone '" + printable_text(bone) + "' not found; the skeleton's joints are: " +
                         list_joints(skeleton));
     }
     return index;
   }
   const std::string_view role_name = bone.substr(1);
   const RoleNames* role = role_named(role_name);
-  if (!role) return make_error("unknown bone role '" + std::string(bone) + "'; known roles: " + known_roles());
+  if (!role) return make_error("unknown bone role '" + printable_text(bone) + "'; known roles: " + known_roles());
   if (role_name == "hips") {
     // The pelvis is where the two legs meet: the deepest common ancestor of
     // the upper legs. This skips static scene roots above it (Bandai's
@@ -164,7 +172,7 @@ Result<int> find_bone(const Skeleton& skeleton, std::string_view bone) {
       if (!names.empty()) names += ", ";
       names += candidate;
     }
-    return make_error("bone '" + std::string(bone) + "' not found: no joint is named like a " +
+    return make_error("bone '" + printable_text(bone) + "' not found: no joint is named like a " +
                       std::string(role->description) + " (" + names +
                       ", compared lower-case without punctuation); the skeleton's joints are: " +
                       list_joints(skeleton));

@@ -14,6 +14,7 @@
 
 #include "import/bvh_lexer.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/input_text.hpp"
 #include "mmvk/bvh.hpp"
 
 namespace mmvk {
@@ -58,16 +59,13 @@ std::optional<BvhChannel> channel_from_name(std::string_view name) {
 }
 
 // A short, printable excerpt of a token for error messages (garbage input can
-// hold control bytes or megabytes without a space).
+// hold control bytes or megabytes without a space): the rule of every
+// message that echoes input (mmvk/input_text.hpp).
 std::string quote(std::string_view token) {
   std::string out = "'";
-  const std::size_t shown = std::min<std::size_t>(token.size(), 40);
-  for (std::size_t i = 0; i < shown; ++i) {
-    const unsigned char c = static_cast<unsigned char>(token[i]);
-    out += (c >= 0x20 && c < 0x7F) ? static_cast<char>(c) : '?';
-  }
-  if (shown < token.size()) out += "...";
-  return out + "'";
+  out += printable_text(token, 40);
+  out += '\'';
+  return out;
 }
 
 template <class Int>

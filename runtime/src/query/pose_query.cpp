@@ -11,6 +11,7 @@
 #include "mmvk/channel_kinds.hpp"
 #include "mmvk/character.hpp"
 #include "mmvk/file_io.hpp"
+#include "mmvk/input_text.hpp"
 
 namespace mmvk {
 
@@ -32,7 +33,7 @@ Result<PoseTarget> read_target(const Json& object, const std::string& where) {
   if (!object.is_object()) return make_error(where + ": expected an object with \"bone\" and \"position\" and/or \"velocity\"");
   for (const auto& item : object.items()) {
     if (item.key() != "bone" && item.key() != "position" && item.key() != "velocity") {
-      return make_error(where + "." + item.key() + ": unknown field (expected bone, position, velocity)");
+      return make_error(where + "." + printable_text(item.key()) + ": unknown field (expected bone, position, velocity)");
     }
   }
   PoseTarget target;
@@ -109,7 +110,9 @@ Result<std::vector<PoseTarget>> parse_pose_targets_json(std::string_view json_te
   MMVK_ASSIGN_OR_RETURN(const Json root, detail::parse_json_text(json_text, name));
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"targets\"");
   for (const auto& item : root.items()) {
-    if (item.key() != "targets") return make_error(name + ": " + item.key() + ": unknown field (expected targets)");
+    if (item.key() != "targets") {
+      return make_error(name + ": " + printable_text(item.key()) + ": unknown field (expected targets)");
+    }
   }
   if (!root.contains("targets") || !root["targets"].is_array()) {
     return make_error(name + ": targets: expected an array of {\"bone\", \"position\", \"velocity\"}");

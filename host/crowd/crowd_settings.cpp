@@ -152,18 +152,29 @@ Status check_cost_overflow(const CrowdSettings& s, const ControllerParams& param
   return {};
 }
 
-}  // namespace
-
-Status apply_query_settings(const CrowdSettings& s, const ControllerParams& params, const Database& database,
-                            SettingNames names, std::span<QueryParams> query_params) {
+// --weights on one query's options; errors name --weights.
+Result<QueryParams> weighted_params(const CrowdSettings& s, const Database& database, SettingNames names) {
   QueryParams weighted;
   for (const auto& [channel, weight] : s.weights) {
     if (Status set = set_channel_weight(database.schema(), weighted, channel, weight); !set) {
       return make_error(setting_name(names, "weights") + ": " + set.message());
     }
   }
-  MMVK_TRY(check_cost_overflow(s, params, weighted, database, names));
+  return weighted;
+}
+
+}  // namespace
+
+Status check_query_settings(const CrowdSettings& s, const ControllerParams& params, const Database& database,
+                            SettingNames names) {
+  MMVK_ASSIGN_OR_RETURN(const QueryParams weighted, weighted_params(s, database, names));
+  return check_cost_overflow(s, params, weighted, database, names);
+}
+
+Status apply_query_settings(const CrowdSettings& s, const Database& database, SettingNames names,
+                            std::span<QueryParams> query_params) {
   if (s.weights.empty()) return {};
+  MMVK_ASSIGN_OR_RETURN(const QueryParams weighted, weighted_params(s, database, names));
   for (QueryParams& p : query_params) p.channel_weights = weighted.channel_weights;
   return {};
 }

@@ -80,8 +80,11 @@ Status check_tick_count(double seconds, double rate_hz, std::uint64_t min_ticks,
 }
 
 Status check_agent_count(double agents, SettingNames names) {
-  if (agents >= 1.0 && agents <= double(kMaxAgents) && agents == std::floor(agents)) return {};
-  return make_error(setting_name(names, "agents") + " " + exact_number_text(agents) + ": expected 1 to " +
+  const bool whole = agents == std::floor(agents) && std::fabs(agents) < 9.0e18;
+  if (whole && agents >= 1.0 && agents <= double(kMaxAgents)) return {};
+  // A count as it was typed: "10000000", not "1e+07".
+  const std::string given = whole ? std::to_string(static_cast<long long>(agents)) : exact_number_text(agents);
+  return make_error(setting_name(names, "agents") + " " + given + ": expected 1 to " +
                     std::to_string(kMaxAgents) + " characters (the search's batch limit)");
 }
 

@@ -85,10 +85,12 @@ Result<std::unique_ptr<CrowdSession>> CrowdSession::create(const Database& datab
   MMVK_TRY(validate(options, options.names));
   MMVK_ASSIGN_OR_RETURN(GaitSpeeds speeds, check_motion(database, options));
   MMVK_ASSIGN_OR_RETURN(const DataSettings data, data_settings(database, data_name(options)));
+  const ControllerParams params = controller_params(options, data);
+  MMVK_TRY(check_query_settings(options, params, database, options.names));
   MMVK_ASSIGN_OR_RETURN(Scenario scenario, plan_scenario(database, options, speeds));
   std::unique_ptr<CrowdSession> s(new CrowdSession(database, std::move(scenario), std::move(speeds), options));
   s->options_.scenario.reset();  // the session keeps its own copy, scenario_
-  MMVK_TRY(s->set_up(controller_params(options, data)));
+  MMVK_TRY(s->set_up(params));
   return s;
 }
 
@@ -101,7 +103,7 @@ Status CrowdSession::set_up(const ControllerParams& params) {
   controller_.emplace(std::move(created.value()));
   CrowdController& c = *controller_;
   MMVK_TRY(apply_plan_tags(scenario_, database_, c.query_params()));
-  MMVK_TRY(apply_query_settings(o, params, database_, o.names, c.query_params()));
+  MMVK_TRY(apply_query_settings(o, database_, o.names, c.query_params()));
   for (std::uint32_t b = 0; b < agents_; ++b) {
     const AgentPlan& plan = scenario_.agents[b];
     const float yaw = std::atan2(plan.goals[0][0] - plan.start[0], plan.goals[0][1] - plan.start[1]);

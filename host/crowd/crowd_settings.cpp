@@ -80,8 +80,11 @@ Status check_tick_count(double seconds, double rate_hz, std::uint64_t min_ticks,
 }
 
 Status check_agent_count(double agents, SettingNames names) {
-  if (agents >= 1.0 && agents <= double(kMaxAgents) && agents == std::floor(agents)) return {};
-  return make_error(setting_name(names, "agents") + " " + exact_number_text(agents) + ": expected 1 to " +
+  const bool whole = agents == std::floor(agents) && std::fabs(agents) < 9.0e18;
+  if (whole && agents >= 1.0 && agents <= double(kMaxAgents)) return {};
+  // A count as it was typed: "10000000", not "1e+07".
+  const std::string given = whole ? std::to_string(static_cast<long long>(agents)) : exact_number_text(agents);
+  return make_error(setting_name(names, "agents") + " " + given + ": expected 1 to " +
                     std::to_string(kMaxAgents) + " characters (the search's batch limit)");
 }
 
@@ -152,18 +155,29 @@ Status check_cost_overflow(const CrowdSettings& s, const ControllerParams& param
   return {};
 }
 
-}  // namespace
-
-Status apply_query_settings(const CrowdSettings& s, const ControllerParams& params, const Database& database,
-                            SettingNames names, std::span<QueryParams> query_params) {
+// --weights on one query's options; errors name --weights.
+Result<QueryParams> weighted_params(const CrowdSettings& s, const Database& database, SettingNames names) {
   QueryParams weighted;
   for (const auto& [channel, weight] : s.weights) {
     if (Status set = set_channel_weight(database.schema(), weighted, channel, weight); !set) {
       return make_error(setting_name(names, "weights") + ": " + set.message());
     }
   }
-  MMVK_TRY(check_cost_overflow(s, params, weighted, database, names));
+  return weighted;
+}
+
+}  // namespace
+
+Status check_query_settings(const CrowdSettings& s, const ControllerParams& params, const Database& database,
+                            SettingNames names) {
+  MMVK_ASSIGN_OR_RETURN(const QueryParams weighted, weighted_params(s, database, names));
+  return check_cost_overflow(s, params, weighted, database, names);
+}
+
+Status apply_query_settings(const CrowdSettings& s, const Database& database, SettingNames names,
+                            std::span<QueryParams> query_params) {
   if (s.weights.empty()) return {};
+  MMVK_ASSIGN_OR_RETURN(const QueryParams weighted, weighted_params(s, database, names));
   for (QueryParams& p : query_params) p.channel_weights = weighted.channel_weights;
   return {};
 }

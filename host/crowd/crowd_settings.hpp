@@ -70,10 +70,13 @@ Status check_tick_count(double seconds, double rate_hz, std::uint64_t min_ticks,
 // The controller's parameters: each setting given, else the data's, else the
 // crowd's default.
 ControllerParams controller_params(const CrowdSettings& settings, const DataSettings& data);
-// --weights on every character's query options, then the costs those
-// options and the controls allow checked against float overflow on
-// `database`: errors name the setting and its value.
-Status apply_query_settings(const CrowdSettings& settings, const ControllerParams& params, const Database& database,
-                            SettingNames names, std::span<QueryParams> query_params);
+// The weights' channels on `database`, and the costs the weights and the
+// controls allow checked against float overflow there; errors name the
+// setting and its value. Before anything is allocated for the characters.
+Status check_query_settings(const CrowdSettings& settings, const ControllerParams& params, const Database& database,
+                            SettingNames names);
+// The weights on every character's query options (after check_query_settings).
+Status apply_query_settings(const CrowdSettings& settings, const Database& database, SettingNames names,
+                            std::span<QueryParams> query_params);
 
 }  // namespace mmvk::crowd

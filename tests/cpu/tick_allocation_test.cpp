@@ -64,7 +64,7 @@ Database shipped_walks() {
   return std::move(db.value());
 }
 
-TEST(TickAllocation, TheCounterSeesAnAllocation) {
+TEST(TickAllocationCounter, TheCounterSeesAnAllocation) {
   // The test can fail: a std::string beyond the small-string buffer is counted.
   const std::size_t counted = allocations_during([] {
     std::string text(100, 'x');
@@ -73,7 +73,7 @@ TEST(TickAllocation, TheCounterSeesAnAllocation) {
   EXPECT_EQ(counted, 1u);
 }
 
-TEST(TickAllocation, ValidatingASearchAllocatesNothing) {
+TEST(TickAllocationCounter, ValidatingASearchAllocatesNothing) {
   const Database db = shipped_walks();
   constexpr std::size_t kQueries = 64;
   std::vector<float> features(kQueries * db.dims());
@@ -91,11 +91,14 @@ TEST(TickAllocation, ValidatingASearchAllocatesNothing) {
   EXPECT_EQ(counted, 0u) << "validate_search allocated on the per-query path";
 }
 
-TEST(TickAllocation, AControllerTickAfterWarmUpAllocatesNothing) {
+// The CPU backends --backend auto picks (crowd_backend.hpp).
+class TickAllocation : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(TickAllocation, AControllerTickAfterWarmUpAllocatesNothing) {
   const Database db = shipped_walks();
   ThreadPool pool(2);  // the workers' hand-over too
   BackendSpec spec;
-  spec.name = "fast-box";
+  spec.name = GetParam();
   spec.pool = &pool;
   Result<std::unique_ptr<SearchBackend>> backend = cpu_backends().make(spec, db);
   ASSERT_TRUE(backend.ok()) << backend.message();
@@ -120,8 +123,10 @@ TEST(TickAllocation, AControllerTickAfterWarmUpAllocatesNothing) {
     }
   });
   EXPECT_GT(searches, 0u) << "the ticks searched";
-  EXPECT_EQ(counted, 0u) << "allocations in 30 controller ticks after warm-up";
+  EXPECT_EQ(counted, 0u) << "allocations in 30 controller ticks after warm-up on " << GetParam();
 }
+
+INSTANTIATE_TEST_SUITE_P(CpuBackends, TickAllocation, ::testing::Values("fast-box", "clusters"));
 
 }  // namespace
 }  // namespace mmvk

@@ -190,3 +190,23 @@ def test_a_failed_write_html_can_be_retried(db, tmp_path):
     assert first > 1000
     assert crowd.write_html(tmp_path / "again.html") == first
     assert (tmp_path / "crowd.html").read_bytes() == (tmp_path / "again.html").read_bytes()
+
+
+# Messages: Animation.parents was a writable copy where the docs promise
+# read-only views.
+def test_parents_are_a_read_only_view(db):
+    parents = db.animation.parents
+    assert parents.dtype == np.int32 and parents[0] == -1
+    with pytest.raises(ValueError):
+        parents[0] = 3
+
+
+# Messages: a float32 dtype with metadata was refused as "expected a
+# float32 array, got float32"; a byte-swapped one stays refused.
+def test_float32_with_metadata_is_float32(db, queries):
+    search = mmvk.Search(db, "fast-box")
+    tagged = queries.view(np.dtype(np.float32, metadata={"units": "normalized"}))
+    frames, _ = search.search(tagged)
+    assert (frames == search.search(queries)[0]).all()
+    with pytest.raises(ValueError, match="expected a float32 array"):
+        search.search(queries.astype(">f4"))

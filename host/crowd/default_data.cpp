@@ -89,6 +89,10 @@ std::vector<std::filesystem::path> shipped_manifest_candidates(const ShippedData
 
 Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,
                                const std::filesystem::path& executable) {
+  // An empty path read as ": no such file or folder", naming nothing.
+  if (data && data->empty()) {
+    return make_error("--data is empty: name a shipped motion set, a folder of BVH, a manifest or a .mmdb");
+  }
   const ShippedData* shipped = data ? find_shipped_data(data->string()) : &shipped_data()[0];
   if (!shipped) return DataChoice{*data, data->string(), data->filename().string(), std::nullopt};
   for (const auto& candidate : shipped_manifest_candidates(*shipped, executable)) {

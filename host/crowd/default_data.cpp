@@ -111,7 +111,7 @@ Result<OpenedDatabase> open_database(const std::filesystem::path& source, const 
                                      const std::function<void(const std::string&)>& say) {
   std::error_code ec;
   if (!std::filesystem::exists(source, ec)) return make_error(source.string() + ": no such file or folder");
-  if (source.extension() == ".mmdb") {
+  if (source.extension() == ".mmdb" || has_database_magic(source)) {
     MMVK_ASSIGN_OR_RETURN(Database database, load_database(source));
     return OpenedDatabase{std::move(database), source, false};
   }

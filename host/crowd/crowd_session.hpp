@@ -38,6 +38,10 @@
 
 namespace mmvk::crowd {
 
+// The fastest desired velocity step() takes, m/s: far beyond any motion
+// capture, and far below what would overflow the search's costs.
+inline constexpr float kMaxDesiredSpeed = 1000.0f;
+
 class ObservedSearch;
 
 struct CrowdSessionOptions {

@@ -210,3 +210,14 @@ def test_float32_with_metadata_is_float32(db, queries):
     assert (frames == search.search(queries)[0]).all()
     with pytest.raises(ValueError, match="expected a float32 array"):
         search.search(queries.astype(">f4"))
+
+
+# Messages: a 1e30 velocity overflowed the search's costs later, as
+# "search: query 0: its costs could overflow float", naming neither.
+def test_a_huge_desired_velocity_names_its_row(db):
+    crowd = mmvk.Crowd(db, agents=3)
+    velocity = np.zeros((3, 2), np.float32)
+    velocity[1] = (1e30, 0.0)
+    with pytest.raises(ValueError, match=r"desired_velocity\[1\]: 1e\+30 m/s is over 1000 m/s"):
+        crowd.step(velocity)
+    crowd.step(np.ones((3, 2), np.float32))

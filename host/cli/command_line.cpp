@@ -105,7 +105,11 @@ std::optional<int> CommandLine::parse(Args args) {
 }
 
 std::optional<int> CommandLine::check_leftovers() {
-  const std::vector<std::string> left = app_.remaining();
+  std::vector<std::string> left = app_.remaining();
+  // "--" ends the options (POSIX): CLI11 reads what follows as positionals
+  // but keeps the "--" itself among the extras, where it was reported as
+  // "unknown option '--'".
+  std::erase(left, std::string("--"));
   for (const std::string& arg : left) {
     if (arg.size() > 1 && arg[0] == '-') {
       return report_error(command_, "unknown option '" + arg + "' (see mmvk " + command_ + " --help)", kUsageExit);

@@ -26,7 +26,8 @@ std::string usage() {
   }
   return text +
          "\n"
-         "Run `mmvk <command> --help` for a command's options.\n"
+         "Run `mmvk <command> --help` for a command's options; `--` ends the options\n"
+         "(`mmvk inspect -- -odd-name.mmdb`).\n"
          "\n"
          "Inputs are regular files (only query --queries may also be a pipe). A regular\n"
          "output is replaced atomically; a device or FIFO is written in place; an output\n"

@@ -2,6 +2,7 @@
 
 #include <system_error>
 
+#include "mmvk/database_io.hpp"
 #include "mmvk/manifest.hpp"
 #include "trace.hpp"
 
@@ -14,7 +15,8 @@ std::vector<NamedPath> crowd_paths(const CrowdOptions& options, const std::files
   // A manifest or a folder: the files its build reads are inputs too. A
   // manifest that does not load is reported by the run itself.
   std::error_code ec;
-  if (data_source.extension() != ".mmdb" && std::filesystem::exists(data_source, ec)) {
+  if (data_source.extension() != ".mmdb" && !has_database_magic(data_source) &&
+      std::filesystem::exists(data_source, ec)) {
     if (Result<Manifest> manifest = load_manifest_or_directory(data_source); manifest) {
       for (const std::filesystem::path& file : manifest_input_files(*manifest)) {
         paths.push_back({"a clip of " + data, file, false});

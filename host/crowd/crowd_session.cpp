@@ -6,7 +6,9 @@
 
 #include "clip_quality.hpp"
 #include "crowd_defaults.hpp"
+#include "crowd_limits.hpp"
 #include "data_settings.hpp"
+#include "mmvk/number_text.hpp"
 #include "gait_plan.hpp"
 #include "observed_search.hpp"
 #include "observed_tick.hpp"
@@ -151,7 +153,16 @@ Status CrowdSession::step(std::span<const glm::vec3> desired_velocity, std::span
     return make_error("desired_facing: " + std::to_string(desired_yaw.size()) + " values for " +
                       std::to_string(agents_) + " agents");
   }
-  for (std::uint32_t b = 0; b < agents_; ++b) desired_[b] = glm::vec3(desired_velocity[b].x, 0.0f, desired_velocity[b].z);
+  for (std::uint32_t b = 0; b < agents_; ++b) {
+    // A speed no motion has (1e30 m/s) overflowed the search's costs later,
+    // in a message that named neither the argument nor the row.
+    const float speed = std::hypot(desired_velocity[b].x, desired_velocity[b].z);
+    if (speed > kMaxDesiredSpeed) {
+      return make_error("desired_velocity[" + std::to_string(b) + "]: " + number_text(speed) + " m/s is over " +
+                        number_text(kMaxDesiredSpeed) + " m/s");
+    }
+    desired_[b] = glm::vec3(desired_velocity[b].x, 0.0f, desired_velocity[b].z);
+  }
   return tick(desired_, desired_yaw, tick_start);
 }
 

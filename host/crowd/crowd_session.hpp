@@ -42,6 +42,10 @@
 
 namespace mmvk::crowd {
 
+// The fastest desired velocity step() takes, m/s: far beyond any motion
+// capture, and far below what would overflow the search's costs.
+inline constexpr float kMaxDesiredSpeed = 1000.0f;
+
 class ObservedSearch;
 
 // The crowd's settings (crowd_settings.hpp: the defaults and bounds every

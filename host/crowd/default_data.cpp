@@ -87,6 +87,10 @@ std::vector<std::filesystem::path> shipped_manifest_candidates(const ShippedData
 
 Result<DataChoice> choose_data(const std::optional<std::filesystem::path>& data,
                                const std::filesystem::path& executable) {
+  // An empty path read as ": no such file or folder", naming nothing.
+  if (data && data->empty()) {
+    return make_error("--data is empty: name a shipped motion set, a folder of BVH, a manifest or a .mmdb");
+  }
   const ShippedData* shipped = data ? find_shipped_data(data->string()) : &shipped_data()[0];
   if (!shipped) return DataChoice{*data, data->string(), data->filename().string()};
   for (const auto& candidate : shipped_manifest_candidates(*shipped, executable)) {
@@ -146,7 +150,7 @@ Result<OpenedDatabase> open_database(const std::filesystem::path& source, const 
                                      const std::function<void(const std::string&)>& say) {
   std::error_code ec;
   if (!std::filesystem::exists(source, ec)) return make_error(missing_data_message(source));
-  if (source.extension() == ".mmdb") {
+  if (source.extension() == ".mmdb" || has_database_magic(source)) {
     MMVK_ASSIGN_OR_RETURN(Database database, load_database(source));
     return OpenedDatabase{std::move(database), source, false};
   }

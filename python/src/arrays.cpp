@@ -20,7 +20,10 @@ py::array float32_array(const py::handle& value, const char* what) {
           std::string(py::str(py::type::of(value).attr("__name__"))));
   }
   auto a = py::reinterpret_borrow<py::array>(value);
-  if (!a.dtype().is(py::dtype::of<float>())) {
+  // Equal, not the same object: a float32 dtype carrying metadata is a
+  // dtype of its own ("expected a float32 array, got float32"); a
+  // byte-swapped one is not equal and is refused.
+  if (!a.dtype().equal(py::dtype::of<float>())) {
     raise(std::string(what) + ": expected a float32 array, got " + std::string(py::str(a.dtype())) +
           " (convert with .astype(numpy.float32))");
   }

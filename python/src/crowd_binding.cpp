@@ -365,7 +365,8 @@ void add_outputs(py::class_<PyCrowd>& crowd) {
           },
           py::arg("path"),
           "Writes the viewer page (one self-contained HTML file) of the steps so far; needs record=True. The "
-          "recording ends there. Returns the bytes written.")
+          "recording ends at the first call and is kept: a failed write can be retried, and a later call writes the same "
+          "page. Returns the bytes written.")
       .def("__repr__", [](const PyCrowd& c) {
         const std::uint64_t ticks = c.session()->ticks();
         return "<mmvk.Crowd: " + std::to_string(c.agents()) + " agents, " + std::to_string(ticks) +

@@ -214,7 +214,11 @@ void bind_animation(py::module_& m) {
       .def_property_readonly("joint_names", [](const AnimationView& a) { return a.data->skeleton.names; },
                              "Joint names, [joints].")
       .def_property_readonly(
-          "parents", [](const AnimationView& a) { return py::array_t<int>(a.data->skeleton.parents.size(), a.data->skeleton.parents.data()); },
+          "parents",
+          [](const AnimationView& a) {
+            // A read-only view like the other arrays (it was a writable copy).
+            return view(a.owner, a.data->skeleton.parents.data(), {py::ssize_t(a.data->skeleton.parents.size())});
+          },
           "Parent of each joint, int32 [joints], -1 for the root; parents[i] < i.")
       .def_property_readonly(
           "rest_offsets",

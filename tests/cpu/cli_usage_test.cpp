@@ -97,6 +97,20 @@ TEST_F(CliUsage, UsageErrorsExitTwoAndNameTheProblem) {
   EXPECT_TRUE(fs::is_empty(dir_)) << "a usage error wrote a file";
 }
 
+// Issue 34: "--" ends the options as POSIX says (it was "unknown option
+// '--'"), and an empty --data names the option (it was ": no such file").
+TEST_F(CliUsage, DoubleDashEndsTheOptionsAndEmptyDataIsNamed) {
+  const std::string missing = (dir_ / "missing.mmdb").string();
+  const auto inspect = run_command(mmvk_ + " inspect -- " + missing);
+  EXPECT_EQ(inspect.exit_code, 1) << inspect.output;
+  EXPECT_NE(inspect.output.find(missing + ": no such file"), std::string::npos) << inspect.output;
+  EXPECT_EQ(inspect.output.find("unknown option"), std::string::npos) << inspect.output;
+  const auto crowd = run_command(mmvk_ + " crowd --data ''");
+  EXPECT_EQ(crowd.exit_code, 1) << crowd.output;
+  EXPECT_NE(crowd.output.find("--data is empty: name a shipped motion set"), std::string::npos) << crowd.output;
+  EXPECT_TRUE(fs::is_empty(dir_)) << "a usage error wrote a file";
+}
+
 // An option given twice takes its last value, as a shell alias expects: the
 // bad first --threads is replaced, so the error is the missing input.
 TEST_F(CliUsage, TheLastOfARepeatedOptionCounts) {

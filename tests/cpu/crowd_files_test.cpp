@@ -263,5 +263,16 @@ TEST_F(CrowdFiles, AFileSizeLimitIsAnErrorNotASignal) {
   }
 }
 
+// Issue 34: a database not named *.mmdb was read as a manifest ("a NUL
+// byte at offset 7"); it is known by its magic.
+TEST_F(CrowdFiles, ADatabaseIsKnownByItsContent) {
+  const fs::path db = dir_ / "walks.bin";
+  const auto built = run_command(mmvk_ + " build " + (data_ / "manifest.json").string() + " -o " + db.string());
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const auto ran = run_command(mmvk_ + " crowd --backend fast-box --data " + db.string() + " --agents 3 --seconds 0.2");
+  EXPECT_EQ(ran.exit_code, 0) << ran.output;
+  EXPECT_FALSE(contains(ran.output, "NUL byte")) << ran.output;
+}
+
 }  // namespace
 }  // namespace mmvk

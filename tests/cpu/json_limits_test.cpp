@@ -95,6 +95,18 @@ TEST(JsonLimits, EchoedKeysAreEscapedAndBounded) {
   EXPECT_EQ(schema.message().find('\x1b'), std::string::npos) << schema.message();
 }
 
+// The OS reads a path only up to a NUL: a clip "131_01.bvh\u0000.junk" built
+// 131_01.bvh with exit 0.
+TEST(JsonLimits, ManifestPathsWithANulAreRefused) {
+  for (const std::string& text : {std::string(R"({"clips": [{"file": "131_01.bvh\u0000.junk"}]})"),
+                                  std::string(R"({"clips": ["131_01.bvh\u0000.junk"]})"),
+                                  std::string(R"({"clips": ["a.bvh"], "schema": "s.json\u0000x"})")}) {
+    const Result<Manifest> manifest = parse_manifest_json(text, "m.json", ".");
+    ASSERT_FALSE(manifest.ok()) << text;
+    EXPECT_TRUE(contains(manifest.message(), "the path holds a NUL byte at offset")) << manifest.message();
+  }
+}
+
 TEST(JsonLimits, PrintableTextEscapesControlBytesAndCuts) {
   EXPECT_EQ(printable_text("walk_01"), "walk_01");
   EXPECT_EQ(printable_text("a\x1b[2J\x7f\n"), "a\\x1b[2J\\x7f\\x0a");

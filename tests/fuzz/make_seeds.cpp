@@ -3,9 +3,11 @@
 //   make_seeds OUT_DIR [MALFORMED_BVH_DIR]
 // OUT_DIR/<target>/ gets: bvh (a generated walk, plus the malformed-BVH test
 // corpus when given), mmdb and mmdb_repair (a database built from the walk),
-// json (a manifest and the default schema, each behind its selector byte),
+// json (a manifest and the default schema, each behind its selector byte;
+// nesting at and past kMaxJsonDepth; a manifest of 3,000 clip objects),
 // cluster_table (a table trained on fixed_database.hpp's), query (query rows),
-// scenario (a crowd scenario using every field) and pose_targets (targets on
+// scenario (a crowd scenario using every field, one of 3,000 agents, one
+// nested too deep) and pose_targets (targets on
 // the walk database's bones).
 #include <cstdio>
 #include <filesystem>
@@ -18,6 +20,7 @@
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/json_check.hpp"
 #include "fixed_database.hpp"
 #include "walk_database.hpp"
 
@@ -66,6 +69,26 @@ int main(int argc, char** argv) {
                    " \"clips\": [{\"file\": \"walk.bvh\", \"name\": \"walk\", \"tags\": [\"walk\"], \"loop\": true,"
                    " \"cost_multiplier\": 1.5, \"cost_bias\": 0.1, \"do_not_use\": [[0.0, 0.2]],"
                    " \"block_transition\": [[1.0, 1.1]]}]}");
+
+  // Issue 34: nesting at and past kMaxJsonDepth (the parsers must refuse
+  // the deeper one before anything recursive walks it) and arrays of many
+  // objects (the strict check was quadratic in them).
+  const auto nested = [](std::size_t depth) { return std::string(depth, '[') + std::string(depth, ']'); };
+  ok = ok && write(out / "json" / "deep_schema.json",
+                   "\1{\"clips\": [\"walk.bvh\"], \"schema\": {\"channels\": " + nested(mmvk::kMaxJsonDepth + 8) + "}}");
+  ok = ok && write(out / "json" / "deepest_allowed.json",
+                   std::string(1, '\0') + "{\"channels\": " + nested(mmvk::kMaxJsonDepth - 1) + "}");
+  std::string clips;
+  for (int c = 0; c < 3000; ++c) {
+    clips += (c ? ", " : "") + std::string("{\"file\": \"walk.bvh\", \"name\": \"w") + std::to_string(c) + "\"}";
+  }
+  ok = ok && write(out / "json" / "many_clips.json", "\1{\"fps\": 30, \"clips\": [" + clips + "]}");
+  std::string agents;
+  for (int a = 0; a < 3000; ++a) {
+    agents += (a ? ", " : "") + std::string("{\"start\": [") + std::to_string(a % 50) + ", 1], \"goals\": [[2, 3]]}";
+  }
+  ok = ok && write(out / "scenario" / "many_agents.json", "{\"agents\": [" + agents + "]}");
+  ok = ok && write(out / "scenario" / "deep.json", "{\"agents\": " + nested(mmvk::kMaxJsonDepth + 8) + "}");
 
   mmvk::KMeansParams params;
   params.clusters = 2;

@@ -190,3 +190,34 @@ def test_a_failed_write_html_can_be_retried(db, tmp_path):
     assert first > 1000
     assert crowd.write_html(tmp_path / "again.html") == first
     assert (tmp_path / "crowd.html").read_bytes() == (tmp_path / "again.html").read_bytes()
+
+
+# Messages: Animation.parents was a writable copy where the docs promise
+# read-only views.
+def test_parents_are_a_read_only_view(db):
+    parents = db.animation.parents
+    assert parents.dtype == np.int32 and parents[0] == -1
+    with pytest.raises(ValueError):
+        parents[0] = 3
+
+
+# Messages: a float32 dtype with metadata was refused as "expected a
+# float32 array, got float32"; a byte-swapped one stays refused.
+def test_float32_with_metadata_is_float32(db, queries):
+    search = mmvk.Search(db, "fast-box")
+    tagged = queries.view(np.dtype(np.float32, metadata={"units": "normalized"}))
+    frames, _ = search.search(tagged)
+    assert (frames == search.search(queries)[0]).all()
+    with pytest.raises(ValueError, match="expected a float32 array"):
+        search.search(queries.astype(">f4"))
+
+
+# Messages: a 1e30 velocity overflowed the search's costs later, as
+# "search: query 0: its costs could overflow float", naming neither.
+def test_a_huge_desired_velocity_names_its_row(db):
+    crowd = mmvk.Crowd(db, agents=3)
+    velocity = np.zeros((3, 2), np.float32)
+    velocity[1] = (1e30, 0.0)
+    with pytest.raises(ValueError, match=r"desired_velocity\[1\]: 1e\+30 m/s is over 1000 m/s"):
+        crowd.step(velocity)
+    crowd.step(np.ones((3, 2), np.float32))

@@ -7,6 +7,7 @@
 // Skipped when no chromium is installed, unless MMVK_REQUIRE_VIEWER=1 (CI
 // sets it), which turns a missing browser into a failure.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
@@ -211,6 +212,34 @@ TEST_F(ViewerChromium, TinyZoomAndThousandsOfGoalsStayResponsive) {
                                                       std::string("?t=4&agent=3&paused=1&zoom=") + zoom));
     EXPECT_NE(status.find("data-state=\"ready\""), std::string::npos) << "zoom=" << zoom << ": " << status;
   }
+}
+
+// Issue 34: one character with 20,000 goals took 3-63 s (and more than
+// 100 s in three runs of six) to open: every frame drew the selected
+// character's whole goal path dashed (hundreds of thousands of dashes), a
+// disc per goal, and everyone's goal paths again. Playing (a frame per
+// animation frame for the 10 s of virtual time), the page must open and
+// report ready. The issue's target is 5 s of wall time; on a shared,
+// loaded machine the same run of a 4-goal page varies from 2 to 20 s, so
+// the bound here is what tells the fixed page (a cached ground layer) from
+// the old one, whose runs went past 100 s.
+TEST_F(ViewerChromium, TwentyThousandGoalsOpenWithoutStalling) {
+  SyntheticRecordingParams params;
+  params.agents = 1;
+  params.seconds = 10.0f;
+  Recording r = make_synthetic_recording(params);
+  r.goals[0].clear();
+  for (int g = 0; g < 20000; ++g) {
+    r.goals[0].push_back({float((g * 7919) % 600) / 10.0f - 30.0f, float((g * 104729) % 600) / 10.0f - 30.0f});
+  }
+  const auto size = write_viewer_html(*dir_ / "goals20k.html", r);
+  ASSERT_TRUE(size.ok()) << size.message();
+  const auto start = std::chrono::steady_clock::now();
+  const std::string status = status_of(run_chromium(*dir_ / "goals20k.html", "--dump-dom", "goals20k", "?agent=0"));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_NE(status.find("data-state=\"ready\""), std::string::npos) << status;
+  std::cout << "[ viewer ] 20,000 goals: opened and played 10 s (virtual) in " << seconds << " s\n";
+  EXPECT_LT(seconds, 60.0);
 }
 
 struct Rgb {

@@ -304,9 +304,12 @@
     ctx.setLineDash([]);
   }
 
+  // One path for all the discs: a fill per disc costs far more with many.
   function dots(ctx, pts, color, radius) {
     ctx.fillStyle = color;
-    for (const p of pts) { ctx.beginPath(); ctx.arc(p[0], p[1], radius, 0, 2 * Math.PI); ctx.fill(); }
+    ctx.beginPath();
+    for (const p of pts) { ctx.moveTo(p[0] + radius, p[1]); ctx.arc(p[0], p[1], radius, 0, 2 * Math.PI); }
+    ctx.fill();
   }
 
   const css = (name) => getComputedStyle(document.documentElement).getPropertyValue(name).trim();
@@ -327,6 +330,8 @@
     state.view = { cx: (x0 + x1) / 2, cz: (z0 + z1) / 2, scale };
   }
   const toScreen = (v, w, h, x, z) => [w / 2 + (x - v.cx) * v.scale, h / 2 + (z - v.cz) * v.scale];
+  // The world rectangle [xa, xb, za, zb] (metres) a w x h canvas shows.
+  const viewRect = (v, w, h) => [v.cx - w / 2 / v.scale, v.cx + w / 2 / v.scale, v.cz - h / 2 / v.scale, v.cz + h / 2 / v.scale];
 
   // One agent's goal path into the current path, only its segments that
   // cross the view [xa, xb] x [za, zb] (world metres), and at most about
@@ -349,6 +354,48 @@
     }
   }
 
+  // The ground, the goal paths of everyone and the selected character's
+  // goals stay the same from frame to frame until the view, the canvas or
+  // the selection changes: they are drawn into a layer of their own then,
+  // and each frame copies the layer. Redrawn every frame, 20,000 goals (a
+  // path of as many long segments, stroked twice) cost most of a second a
+  // frame in a software canvas; a copy costs the same whatever the goals.
+  const groundLayer = { canvas: document.createElement('canvas'), key: '' };
+  function drawGroundLayer(ctx, v, w, h) {
+    const key = [ctx.canvas.width, ctx.canvas.height, w, h, v.cx, v.cz, v.scale, state.selected].join(',');
+    if (groundLayer.key !== key) {
+      const layer = groundLayer.canvas;
+      layer.width = ctx.canvas.width; layer.height = ctx.canvas.height;
+      const g = layer.getContext('2d');
+      g.setTransform(ctx.getTransform());
+      // Ground grid: 1 m lines when zoomed in, else 10 m, coarser by tens
+      // while more than 200 lines would cross the view.
+      const [xa, xb, za, zb] = viewRect(v, w, h);
+      let step = v.scale > 12 ? 1 : 10;
+      while (Math.max(xb - xa, zb - za) / step > 200) step *= 10;
+      g.strokeStyle = '#242a33'; g.lineWidth = 1;
+      g.beginPath();
+      for (let x = Math.ceil(xa / step) * step; x <= xb; x += step) { const sx = toScreen(v, w, h, x, 0)[0]; g.moveTo(sx, 0); g.lineTo(sx, h); }
+      for (let z = Math.ceil(za / step) * step; z <= zb; z += step) { const sy = toScreen(v, w, h, 0, z)[1]; g.moveTo(0, sy); g.lineTo(w, sy); }
+      g.stroke();
+      // Goal paths of everyone, faint, in one path.
+      g.strokeStyle = 'rgba(160,170,190,0.16)'; g.lineWidth = 1;
+      g.beginPath();
+      for (let a = 0; a < D.N; a++) {
+        const b = D.goalBox[a];
+        if (b[2] < xa || b[0] > xb || b[3] < za || b[1] > zb) continue;
+        addVisiblePath(g, D.goals[a], v, w, h, xa, xb, za, zb);
+      }
+      g.stroke();
+      if (state.selected >= 0) drawSelectedGoals(g, D.goals[state.selected], v, w, h);
+      groundLayer.key = key;
+    }
+    ctx.save();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.drawImage(groundLayer.canvas, 0, 0);
+    ctx.restore();
+  }
+
   function drawCrowd() {
     const { ctx, w, h } = prepare(crowdCanvas);
     if (!state.view) {
@@ -364,26 +411,8 @@
       const p = sampleAt(state.selected, state.t);
       v.cx = p.x; v.cz = p.z;
     }
-    // Ground grid: 1 m lines when zoomed in, else 10 m, coarser by tens
-    // while more than 200 lines would cross the view.
     v.scale = clampScale(v.scale);
-    const xa = v.cx - w / 2 / v.scale, xb = v.cx + w / 2 / v.scale, za = v.cz - h / 2 / v.scale, zb = v.cz + h / 2 / v.scale;
-    let step = v.scale > 12 ? 1 : 10;
-    while (Math.max(xb - xa, zb - za) / step > 200) step *= 10;
-    ctx.strokeStyle = '#242a33'; ctx.lineWidth = 1;
-    ctx.beginPath();
-    for (let x = Math.ceil(xa / step) * step; x <= xb; x += step) { const sx = toScreen(v, w, h, x, 0)[0]; ctx.moveTo(sx, 0); ctx.lineTo(sx, h); }
-    for (let z = Math.ceil(za / step) * step; z <= zb; z += step) { const sy = toScreen(v, w, h, 0, z)[1]; ctx.moveTo(0, sy); ctx.lineTo(w, sy); }
-    ctx.stroke();
-    // Goal paths of everyone, faint, in one path.
-    ctx.strokeStyle = 'rgba(160,170,190,0.16)'; ctx.lineWidth = 1;
-    ctx.beginPath();
-    for (let a = 0; a < D.N; a++) {
-      const b = D.goalBox[a];
-      if (b[2] < xa || b[0] > xb || b[3] < za || b[1] > zb) continue;
-      addVisiblePath(ctx, D.goals[a], v, w, h, xa, xb, za, zb);
-    }
-    ctx.stroke();
+    drawGroundLayer(ctx, v, w, h);
     // The characters: a disc (0.3 m, at least 2.5 px) and a facing tick.
     const radius = Math.max(0.3 * v.scale, 2.5);
     let drawn = 0;
@@ -461,14 +490,37 @@
     }
   }
 
+  // The selected character's goals: its path and a dot per goal. Drawn
+  // every frame, so its cost must not grow with the goal count: 20,000
+  // goals, drawn whole with dashes (hundreds of thousands of dashes) and a
+  // disc each, took seconds a frame and minutes to open the page. The path
+  // takes only its segments in view, about one point per pixel
+  // (addVisiblePath); it is dashed only while it is short, and at most one
+  // dot is drawn per 6 x 6 pixel cell (the size of a dot).
+  const kDashedGoalsMax = 256;
+  function drawSelectedGoals(ctx, g, v, w, h) {
+    const [xa, xb, za, zb] = viewRect(v, w, h);
+    ctx.strokeStyle = 'rgba(255,255,255,0.55)'; ctx.lineWidth = 1.5;
+    ctx.setLineDash(g.length / 2 <= kDashedGoalsMax ? [4, 4] : []);
+    ctx.beginPath();
+    addVisiblePath(ctx, g, v, w, h, xa, xb, za, zb);
+    ctx.stroke();
+    ctx.setLineDash([]);
+    const cells = new Set(), shown = [];
+    for (let i = 0; i < g.length; i += 2) {
+      const [x, y] = toScreen(v, w, h, g[i], g[i + 1]);
+      if (x < -4 || y < -4 || x > w + 4 || y > h + 4) continue;
+      const cell = Math.floor(x / 6) * 65536 + Math.floor(y / 6);  // a disc is 6 px across
+      if (cells.has(cell)) continue;
+      cells.add(cell); shown.push([x, y]);
+    }
+    dots(ctx, shown, '#fff', 3);
+  }
+
   function drawSelectionOnCrowd(ctx, v, w, h, radius) {
     const a = state.selected;
     if (a < 0) return;
     drawFootprints(ctx, v, w, h, a);
-    const g = D.goals[a], goalPts = [];
-    for (let i = 0; i < g.length; i += 2) goalPts.push(toScreen(v, w, h, g[i], g[i + 1]));
-    polyline(ctx, goalPts, 'rgba(255,255,255,0.55)', 1.5, [4, 4]);
-    dots(ctx, goalPts.filter(([x, y]) => x >= -4 && y >= -4 && x <= w + 4 && y <= h + 4), '#fff', 3);
     // Achieved path: 2 s behind (grey) and the samples ahead (cyan).
     const p = sampleAt(a, state.t), past = [], ahead = [];
     for (let s = Math.max(0, p.s0 - Math.round(2 * D.rate)); s <= p.s0; s++) past.push(toScreen(v, w, h, D.rootX[a * D.S + s], D.rootZ[a * D.S + s]));

@@ -92,5 +92,10 @@ Result<Database> deserialize_database(std::string_view bytes, std::string_view s
 // leaves any previous file intact.
 Status save_database(const Database& database, const std::filesystem::path& path);
 Result<Database> load_database(const std::filesystem::path& path);
+// True when `path` is a regular file that begins with the magic: hosts that
+// take a database or a manifest tell them apart by content as well as by
+// the .mmdb extension (a database named db.bin was read as JSON: "a NUL
+// byte at offset 7"). Never blocks (a FIFO is no database).
+bool has_database_magic(const std::filesystem::path& path);
 
 }  // namespace mmvk

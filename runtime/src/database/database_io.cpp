@@ -1,5 +1,9 @@
 #include "mmvk/database_io.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -569,6 +573,18 @@ Result<Database> load_database(const std::filesystem::path& path) {
   Result<std::string> bytes = read_file(path);
   if (!bytes.ok()) return bytes.error();
   return deserialize_database(*bytes, path.string());
+}
+
+bool has_database_magic(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat st {};
+  char head[sizeof(kMagic)] = {};
+  const bool match = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
+                     ::read(fd, head, sizeof(head)) == static_cast<ssize_t>(sizeof(head)) &&
+                     std::memcmp(head, kMagic, sizeof(kMagic)) == 0;
+  ::close(fd);
+  return match;
 }
 
 }  // namespace mmvk

@@ -44,6 +44,16 @@ Result<std::string> read_string(const Json& value, const std::string& where) {
   return value.get<std::string>();
 }
 
+// A file name: the OS would read it only up to a NUL ("131_01.bvh\u0000.junk"
+// built 131_01.bvh), so one is refused.
+Result<std::string> read_path(const Json& value, const std::string& where) {
+  MMVK_ASSIGN_OR_RETURN(std::string path, read_string(value, where));
+  if (const std::size_t nul = path.find('\0'); nul != std::string::npos) {
+    return make_error(where + ": the path holds a NUL byte at offset " + std::to_string(nul));
+  }
+  return path;
+}
+
 Result<TimeRange> read_range(const Json& pair, const std::string& at) {
   if (!pair.is_array() || pair.size() != 2) return make_error(at + ": expected [begin, end] in seconds");
   Result<float> begin = json_float(pair[0], at + "[0]");
@@ -128,7 +138,8 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   if (object.is_string()) {
     ManifestClip clip;
     clip.field = where;
-    clip.file = base_dir / object.get<std::string>();
+    MMVK_ASSIGN_OR_RETURN(const std::string file, read_path(object, where));
+    clip.file = base_dir / file;
     clip.name = clip.file.stem().string();
     return clip;
   }
@@ -140,7 +151,7 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
   clip.field = where;
   if (!object.contains("file")) return make_error(where + ".file: missing");
   std::string file;
-  MMVK_READ(file, read_string(object["file"], where + ".file"));
+  MMVK_READ(file, read_path(object["file"], where + ".file"));
   if (file.empty()) return make_error(where + ".file: empty");
   clip.file = base_dir / file;
   clip.name = clip.file.stem().string();
@@ -330,7 +341,8 @@ Status read_schema_field(const Json& root, const std::string& name, const std::s
   if (!root.contains("schema")) return {};
   const Json& schema = root["schema"];
   if (schema.is_string()) {
-    std::filesystem::path path = base_dir / schema.get<std::string>();
+    MMVK_ASSIGN_OR_RETURN(const std::string file, read_path(schema, at + "schema"));
+    std::filesystem::path path = base_dir / file;
     Result<FeatureSchema> loaded = load_schema(path);
     if (!loaded.ok()) return make_error(at + "schema: " + loaded.message());
     manifest.schema = std::move(*loaded);

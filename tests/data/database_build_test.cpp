@@ -299,7 +299,7 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   const auto text = test::run_command(mmvk.string() + " inspect " + db);
   EXPECT_NE(text.output.find("units: 0.01 metres per file unit (centimetres)"), std::string::npos) << text.output;
   EXPECT_NE(text.output.find("speeds: walk "), std::string::npos) << text.output;
-  EXPECT_NE(text.output.find("up axis: +Y, upright (the feet-to-head direction's y is 0."), std::string::npos)
+  EXPECT_NE(text.output.find("up axis: +Y, upright (the feet-to-head direction's y is "), std::string::npos)
       << text.output;
 
   const std::string out = (dir / "out.f32").string();

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 #include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -306,6 +308,86 @@ TEST(SceneImport, WrongUnitsOrUpAxisOnAGltfAreRefused) {
   EXPECT_NE(z_up.message().find("set \"import\": {\"up_axis\": \"y\"}"), std::string::npos) << z_up.message();
   EXPECT_TRUE(build(R"({"up_axis": "z", "accept_implausible": true})").ok());
   EXPECT_TRUE(build(R"({"up_axis": "y"})").ok());
+}
+
+// --- A COLLADA file written from a BVH clip --------------------------------
+
+// Writes `motion` as a Z-up COLLADA file in centimetres (<unit meter="0.01">,
+// <up_axis>Z_UP</up_axis>), so that the import's units and axes come from
+// the file: each joint a node with a matrix, animated by one 4x4 matrix per
+// frame (COLLADA matrices are row-major).
+fs::path write_collada(const Motion& motion, const fs::path& dir, const std::string& stem) {
+  const std::size_t joints = motion.joint_count(), frames = motion.frame_count;
+  // mmvk's Y-up to the file's Z-up: (x, y, z) -> (x, -z, y); assimp undoes it.
+  const glm::mat4 to_file = glm::mat4(glm::mat3(glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)));
+  auto local = [&](std::size_t f, std::size_t j) {
+    const std::size_t i = motion.index(std::uint32_t(f), j);
+    glm::mat4 m = glm::mat4_cast(motion.local_rotations[i]);
+    m[3] = glm::vec4(motion.local_positions[i] * 100.0f, 1.0f);  // centimetres
+    return motion.skeleton.parents[j] < 0 ? to_file * m : m;
+  };
+  auto row_major = [](const glm::mat4& m) {
+    std::string text;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) text += std::to_string(m[c][r]) + " ";
+    }
+    return text;
+  };
+  std::string animations, nodes;
+  std::vector<std::string> open(joints);
+  for (std::size_t j = 0; j < joints; ++j) {
+    const std::string& name = motion.skeleton.names[j];
+    std::string times, values, interpolation;
+    for (std::size_t f = 0; f < frames; ++f) {
+      times += std::to_string(double(f) / motion.fps) + " ";
+      values += row_major(local(f, j));
+      interpolation += "LINEAR ";
+    }
+    const std::string n = std::to_string(frames), n16 = std::to_string(16 * frames);
+    animations += "<animation id=\"a_" + name + "\">"
+      "<source id=\"" + name + "_in\"><float_array id=\"" + name + "_in_a\" count=\"" + n + "\">" + times +
+      "</float_array><technique_common><accessor source=\"#" + name + "_in_a\" count=\"" + n +
+      "\" stride=\"1\"><param name=\"TIME\" type=\"float\"/></accessor></technique_common></source>"
+      "<source id=\"" + name + "_out\"><float_array id=\"" + name + "_out_a\" count=\"" + n16 + "\">" + values +
+      "</float_array><technique_common><accessor source=\"#" + name + "_out_a\" count=\"" + n +
+      "\" stride=\"16\"><param name=\"TRANSFORM\" type=\"float4x4\"/></accessor></technique_common></source>"
+      "<source id=\"" + name + "_ip\"><Name_array id=\"" + name + "_ip_a\" count=\"" + n + "\">" + interpolation +
+      "</Name_array><technique_common><accessor source=\"#" + name + "_ip_a\" count=\"" + n +
+      "\" stride=\"1\"><param name=\"INTERPOLATION\" type=\"name\"/></accessor></technique_common></source>"
+      "<sampler id=\"" + name + "_s\"><input semantic=\"INPUT\" source=\"#" + name + "_in\"/>"
+      "<input semantic=\"OUTPUT\" source=\"#" + name + "_out\"/><input semantic=\"INTERPOLATION\" source=\"#" +
+      name + "_ip\"/></sampler><channel source=\"#" + name + "_s\" target=\"" + name + "/transform\"/></animation>\n";
+  }
+  // Nodes nest: joints are depth-first with parents first.
+  std::function<std::string(std::size_t)> node = [&](std::size_t j) {
+    const std::string& name = motion.skeleton.names[j];
+    std::string text = "<node id=\"" + name + "\" name=\"" + name + "\" sid=\"" + name +
+                       "\" type=\"JOINT\"><matrix sid=\"transform\">" + row_major(local(0, j)) + "</matrix>";
+    for (std::size_t c = 0; c < joints; ++c) {
+      if (motion.skeleton.parents[c] == int(j)) text += node(c);
+    }
+    return text + "</node>";
+  };
+  std::ofstream(dir / (stem + ".dae"))
+      << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" "
+         "version=\"1.4.1\"><asset><unit name=\"centimeter\" meter=\"0.01\"/><up_axis>Z_UP</up_axis></asset>"
+         "<library_animations>" << animations << "</library_animations><library_visual_scenes><visual_scene id=\"scene\">"
+      << node(0) << "</visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#scene\"/></scene></COLLADA>\n";
+  return dir / (stem + ".dae");
+}
+
+TEST(SceneImport, ColladaInCentimetresZUpFromABvhClipGivesItsFeatures) {
+  const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const fs::path dae = write_collada(load_bvh_motion(bvh), dir, "walk");
+  const mmvk::Database from_bvh = build_one(bvh, dir);
+  const mmvk::Database from_dae = build_one(dae, dir);
+  ASSERT_EQ(from_dae.frame_count(), from_bvh.frame_count());
+  const auto a = from_bvh.features(), b = from_dae.features();
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  // Matrices written with 6 decimals (std::to_string) in centimetres.
+  EXPECT_LT(worst, 2e-3f) << "largest feature difference (normalized units)";
 }
 
 TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {

@@ -50,10 +50,10 @@ const fs::path kModels = "/usr/share/assimp/models";
     GTEST_SKIP() << path << " not installed";                                                    \
   }
 
-// The scene's world node positions at `seconds`, evaluated independently of
+// The scene's world node matrices at `seconds`, evaluated independently of
 // the importer: keys interpolated with glm, node matrices multiplied down.
-std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, const aiAnimation& animation,
-                                                        double seconds) {
+std::map<std::string, aiMatrix4x4> assimp_world_matrices(const aiScene& scene, const aiAnimation& animation,
+                                                         double seconds) {
   const double ticks = (animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0) *
                        std::min(seconds, animation.mDuration / (animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0));
   std::map<std::string, const aiNodeAnim*> channels;
@@ -69,7 +69,7 @@ std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, co
   auto quat = [](const aiQuaternion& q) { return glm::quat(q.w, q.x, q.y, q.z); };
   auto mix = [](glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; };
   auto slerp = [](glm::quat a, glm::quat b, float t) { return glm::slerp(a, glm::dot(a, b) < 0 ? -b : b, t); };
-  std::map<std::string, glm::vec3> out;
+  std::map<std::string, aiMatrix4x4> out;
   std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{{scene.mRootNode, aiMatrix4x4()}};
   while (!stack.empty()) {
     auto [node, parent] = stack.back();
@@ -83,10 +83,23 @@ std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, co
       local = aiMatrix4x4(aiVector3D(s.x, s.y, s.z), aiQuaternion(r.w, r.x, r.y, r.z), aiVector3D(p.x, p.y, p.z));
     }
     const aiMatrix4x4 global = parent * local;
-    out.emplace(node->mName.C_Str(), glm::vec3(global.a4, global.b4, global.c4));
+    out.emplace(node->mName.C_Str(), global);
     for (unsigned c = 0; c < node->mNumChildren; ++c) stack.push_back({node->mChildren[c], global});
   }
   return out;
+}
+
+std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, const aiAnimation& animation,
+                                                        double seconds) {
+  std::map<std::string, glm::vec3> out;
+  for (const auto& [name, m] : assimp_world_matrices(scene, animation, seconds)) out[name] = glm::vec3(m.a4, m.b4, m.c4);
+  return out;
+}
+
+// A node frame's axis `column` (0 = x, 1 = y), normalized: scale dropped.
+glm::vec3 axis_of(const aiMatrix4x4& m, int column) {
+  const glm::vec3 axis = column == 0 ? glm::vec3(m.a1, m.b1, m.c1) : glm::vec3(m.a2, m.b2, m.c2);
+  return glm::normalize(axis);
 }
 
 struct ModelCase {
@@ -125,10 +138,17 @@ TEST(SceneImport, ForwardKinematicsAgreesWithAssimp) {
     const std::uint32_t last = motion.frame_count - 1;
     for (const std::uint32_t frame : {0u, last / 3, last / 2, last}) {
       mmvk::forward_kinematics(motion, frame, positions, rotations);
-      const auto expected = assimp_world_positions(*scene, *scene->mAnimations[0], frame / 30.0);
+      const auto expected = assimp_world_matrices(*scene, *scene->mAnimations[0], frame / 30.0);
       for (std::size_t j = 0; j < motion.joint_count(); ++j) {
-        const glm::vec3 want = expected.at(motion.skeleton.names[j]) * imported->metres_per_unit;
+        const aiMatrix4x4& m = expected.at(motion.skeleton.names[j]);
+        const glm::vec3 want = glm::vec3(m.a4, m.b4, m.c4) * imported->metres_per_unit;
         EXPECT_LT(glm::length(positions[j] - want), 1e-4f * std::max(extent, 1.0f))
+            << "frame " << frame << " joint " << motion.skeleton.names[j];
+        // The joint's frame too (these files are Y-up: no axis change), not
+        // only where it is: poses blend and IK turns rotations.
+        EXPECT_GT(glm::dot(rotations[j] * glm::vec3(1, 0, 0), axis_of(m, 0)), 0.9999f)
+            << "frame " << frame << " joint " << motion.skeleton.names[j];
+        EXPECT_GT(glm::dot(rotations[j] * glm::vec3(0, 1, 0), axis_of(m, 1)), 0.9999f)
             << "frame " << frame << " joint " << motion.skeleton.names[j];
       }
     }
@@ -240,6 +260,26 @@ TEST(SceneImport, BuiltDatabasePosesAgreeWithAssimp) {
   }
 }
 
+// The stored poses of two databases of one motion: the least |dot| of their
+// rotations, joint by joint (by name: b may have joints above a's, such as
+// the scene node that assimp gives a COLLADA skeleton) and frame by frame
+// (1 = the same up to sign).
+float least_rotation_agreement(const mmvk::Database& a, const mmvk::Database& b) {
+  const mmvk::AnimationData *pa = a.animation(), *pb = b.animation();
+  if (pa == nullptr || pb == nullptr || pa->frame_count != pb->frame_count) return 0.0f;
+  float least = 1.0f;
+  for (std::size_t j = 0; j < pa->joint_count(); ++j) {
+    const int k = pb->skeleton.find(pa->skeleton.names[j]);
+    if (k < 0) return 0.0f;
+    for (std::size_t f = 0; f < pa->frame_count; ++f) {
+      const glm::quat qa = pa->local_rotations[f * pa->joint_count() + j];
+      const glm::quat qb = pb->local_rotations[f * pb->joint_count() + std::size_t(k)];
+      least = std::min(least, std::abs(glm::dot(qa, qb)));
+    }
+  }
+  return least;
+}
+
 TEST(SceneImport, GltfFromABvhClipGivesItsFeatures) {
   const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
   const fs::path dir = mmvk::test::make_temp_dir();
@@ -253,6 +293,7 @@ TEST(SceneImport, GltfFromABvhClipGivesItsFeatures) {
   for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
   EXPECT_LT(worst, 1e-3f) << "largest feature difference (normalized units)";
   EXPECT_EQ(from_gltf.clips()[0].metres_per_unit, 1.0f);  // glTF is metres
+  EXPECT_GT(least_rotation_agreement(from_bvh, from_gltf), 0.99999f) << "least |dot| of the stored rotations";
 }
 
 TEST(SceneImport, SeveralAnimationsAreSeveralClipsNamedAfterThem) {
@@ -388,6 +429,7 @@ TEST(SceneImport, ColladaInCentimetresZUpFromABvhClipGivesItsFeatures) {
   for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
   // Matrices written with 6 decimals (std::to_string) in centimetres.
   EXPECT_LT(worst, 2e-3f) << "largest feature difference (normalized units)";
+  EXPECT_GT(least_rotation_agreement(from_bvh, from_dae), 0.9999f) << "least |dot| of the stored rotations";
 }
 
 TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {

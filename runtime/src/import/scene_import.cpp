@@ -98,10 +98,10 @@ void choose_units_and_axes(const aiScene& scene, const std::string& ext, const I
   } else if (ext == ".fbx") {
     const bool read = fbx_axes(scene, to_mmvk);
     if (!read) to_mmvk = glm::mat3(1.0f);
-    out.axes_from = read ? "FBX UpAxis " + std::to_string(int(metadata_number(scene, "UpAxis", 1))) +
-                               " (0 = X, 1 = Y, 2 = Z), sign " +
-                               std::to_string(int(metadata_number(scene, "UpAxisSign", 1)))
-                         : "FBX without a valid axis set (Y-up assumed)";
+    char text[120];
+    std::snprintf(text, sizeof(text), "FBX UpAxis %g (0 = X, 1 = Y, 2 = Z), UpAxisSign %g",
+                  metadata_number(scene, "UpAxis", 1), metadata_number(scene, "UpAxisSign", 1));
+    out.axes_from = read ? std::string(text) : "FBX without a valid axis set (Y-up assumed)";
   } else {
     out.axes_from = ext == ".dae" ? "COLLADA <up_axis> (applied by assimp)" : "glTF (Y-up by the format)";
   }

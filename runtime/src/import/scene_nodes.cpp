@@ -92,7 +92,9 @@ aiMatrix4x4 sample_channel(const aiNode& node, const aiNodeAnim& channel, double
     } else {
       const auto& before = next[-1];
       const double span = next->mTime - before.mTime;
-      const float factor = span > 0.0 ? static_cast<float>((ticks - before.mTime) / span) : 0.0f;
+      // Clamped: keys a hostile file wrote out of order put `ticks` outside
+      // the pair, and a double beyond float's range does not convert.
+      const float factor = span > 0.0 ? static_cast<float>(std::clamp((ticks - before.mTime) / span, 0.0, 1.0)) : 0.0f;
       blend(value, before.mValue, next->mValue, factor);
     }
   };

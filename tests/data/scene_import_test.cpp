@@ -16,6 +16,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <sys/stat.h>
 #include <vector>
 
 #include <assimp/Importer.hpp>
@@ -457,6 +458,63 @@ TEST(SceneImport, ErrorsNameTheFile) {
   const auto box = mmvk::import_scene(still, {});
   ASSERT_FALSE(box.ok());
   EXPECT_NE(box.message().find("BoxTextured.gltf: no animation in the file"), std::string::npos) << box.message();
+}
+
+// A one-joint glTF whose rotation keys are at `times` (seconds, any order).
+fs::path write_keys_gltf(const fs::path& dir, const std::string& stem, const std::vector<float>& times) {
+  using nlohmann::json;
+  std::string bin;
+  append_floats(bin, times);
+  std::vector<float> rotations;
+  for (std::size_t k = 0; k < times.size(); ++k) rotations.insert(rotations.end(), {0.0f, 0.0f, 0.0f, 1.0f});
+  append_floats(bin, rotations);
+  const auto [low, high] = std::minmax_element(times.begin(), times.end());
+  const json gltf = {
+      {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"name", "Hips"}}}},
+      {"buffers", {{{"byteLength", bin.size()}, {"uri", stem + ".bin"}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 4 * times.size()}},
+                       {{"buffer", 0}, {"byteOffset", 4 * times.size()}, {"byteLength", 16 * times.size()}}}},
+      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", times.size()}, {"type", "SCALAR"},
+                      {"min", {*low}}, {"max", {*high}}},
+                     {{"bufferView", 1}, {"componentType", 5126}, {"count", times.size()}, {"type", "VEC4"}}}},
+      {"animations", {{{"name", "a"}, {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "rotation"}}}}}},
+                       {"samplers", {{{"input", 0}, {"output", 1}}}}}}}};
+  std::ofstream(dir / (stem + ".bin"), std::ios::binary) << bin;
+  std::ofstream(dir / (stem + ".gltf")) << gltf.dump();
+  return dir / (stem + ".gltf");
+}
+
+TEST(SceneImport, HostileFilesEndInErrors) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  mmvk::SceneImportOptions options;
+  options.fps = 30.0f;
+  // A FIFO under a scene name: refused before assimp would block on it.
+  ASSERT_EQ(::mkfifo((dir / "pipe.fbx").c_str(), 0600), 0);
+  const auto pipe = mmvk::import_scene(dir / "pipe.fbx", options);
+  ASSERT_FALSE(pipe.ok());
+  EXPECT_NE(pipe.message().find("pipe.fbx: not a regular file"), std::string::npos) << pipe.message();
+  // A claimed ten-million-second animation: an error, not 300 million frames.
+  const auto huge = mmvk::import_scene(write_keys_gltf(dir, "huge", {0.0f, 1e7f}), options);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_NE(huge.message().find("huge.gltf: animation 'a': 1e+07 s at 30 fps is 3e+08 frames of 1 joints, over the "
+                                "limit of 33554432 samples"),
+            std::string::npos)
+      << huge.message();
+  // Keys out of order: whatever assimp makes of them, an answer.
+  const auto shuffled = mmvk::import_scene(write_keys_gltf(dir, "shuffled", {1.0f, 0.0f, 0.5f}), options);
+  if (shuffled.ok()) {
+    EXPECT_EQ(shuffled->animations.size(), 1u);
+  }
+  // A truncated FBX.
+  const fs::path fbx = kModels / "FBX/animation_with_skeleton.fbx";
+  MMVK_REQUIRE_TEST_MODEL(fbx);
+  std::ifstream in(fbx, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  std::ofstream(dir / "cut.fbx", std::ios::binary) << head;
+  const auto cut = mmvk::import_scene(dir / "cut.fbx", options);
+  ASSERT_FALSE(cut.ok());
+  EXPECT_NE(cut.message().find("cut.fbx: assimp could not read it"), std::string::npos) << cut.message();
 }
 
 }  // namespace

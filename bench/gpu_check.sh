@@ -19,7 +19,7 @@
 #   bench/gpu_check.sh --prepare        # here: builds build-gpu/, fills build-gpu/stage/
 #
 # The stage holds programs/programs.tar.xz (the programs and the shared
-# libraries they need beyond glibc and libstdc++: Google Benchmark, the
+# libraries they need beyond glibc and libstdc++: Google Benchmark, assimp, the
 # Vulkan loader) and the data in two parts, data-1/ and data-2/ (the volume
 # archives and locomotion-normal are about 85 MB, more than one transfer of
 # 64 MiB to the GPU machine may carry). The printed plan carries the

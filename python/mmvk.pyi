@@ -16,8 +16,9 @@ def backends() -> list[str]:
 
 def build(source: Union[PathLike, Mapping[str, Any]], schema: Union[None, PathLike, Mapping[str, Any]] = None,
           **manifest_fields: Any) -> Database:
-    """Builds a database from a manifest file, a folder of BVH or a manifest dict; manifest_fields
-    (fps=30, mirror=True, edge_rule='extrapolate', ...) are set over the source's fields."""
+    """Builds a database from a manifest file, a folder of motion files (BVH, FBX, glTF, COLLADA), one such
+    file or a manifest dict; manifest_fields (fps=30, mirror=True, edge_rule='extrapolate', ...) are set over
+    the source's fields."""
 
 class Animation:
     """The skeleton and per-frame poses, root and contacts of a Database (read-only views)."""

@@ -9,6 +9,7 @@
 
 #include "cli_args.hpp"
 #include "gait_speeds.hpp"
+#include "mmvk/character.hpp"
 #include "mmvk/pose_batch.hpp"
 
 namespace mmvk::cli {
@@ -47,20 +48,29 @@ std::vector<UnitCount> unit_counts(const Database& database) {
   return counts;
 }
 
-// The skeleton's standing height, metres: over the database's frames (at most
-// kHeightFrames of them, evenly spread), the highest joint above the lowest,
-// taken at the 90th percentile, so that crouches and bent knees do not count
-// and a stray frame does not either. Measured on the animation rather than
-// the rest pose, which is not upright on every skeleton (Bandai's bones lie
-// along local X). Joints only: the End Sites' tips are not stored, so the
-// highest joint is the head joint, below the top of the head. None without
-// animation.
-std::optional<double> standing_height(const Database& database) {
-  constexpr std::uint32_t kHeightFrames = 4096;
+// What the database's poses say about the import, over its frames (at most
+// kFrames of them, evenly spread).
+//  - height: the skeleton's standing height, metres: the highest joint above
+//    the lowest, taken at the 90th percentile, so that crouches and bent
+//    knees do not count and a stray frame does not either. Measured on the
+//    animation rather than the rest pose, which is not upright on every
+//    skeleton (Bandai's bones lie along local X). Joints only: the End
+//    Sites' tips are not stored, so the highest joint is the head joint,
+//    below the top of the head.
+//  - body_up: the mean y of the unit feet-to-head vector, the axis the
+//    import stood the character along (1 = +Y, as the build's import check
+//    wants: import_check.hpp); none when the roles do not resolve.
+struct PoseFigures {
+  double height = 0.0;
+  std::optional<double> body_up;
+};
+
+std::optional<PoseFigures> pose_figures(const Database& database) {
+  constexpr std::uint32_t kFrames = 4096;
   const AnimationData* a = database.animation();
   if (a == nullptr || a->joint_count() == 0 || a->frame_count == 0) return std::nullopt;
   const std::size_t joints = a->joint_count();
-  const std::uint32_t count = std::min(a->frame_count, kHeightFrames);
+  const std::uint32_t count = std::min(a->frame_count, kFrames);
   std::vector<glm::quat> rotations(count * joints);
   std::vector<glm::vec3> translations(count * joints), world(count * joints), roots(count, glm::vec3(0.0f));
   const std::vector<float> yaws(count, 0.0f);
@@ -70,16 +80,26 @@ std::optional<double> standing_height(const Database& database) {
                 std::span(translations).subspan(i * joints, joints));
   }
   forward_kinematics_batch(a->skeleton, rotations, translations, roots, yaws, world);
+  const Result<int> head = find_bone(a->skeleton, "@head"), left = find_bone(a->skeleton, "@left_foot"),
+                    right = find_bone(a->skeleton, "@right_foot");
+  const bool human = head.ok() && left.ok() && right.ok();
   std::vector<double> heights(count);
+  double up = 0.0;
   for (std::uint32_t i = 0; i < count; ++i) {
     const auto pose = std::span(world).subspan(i * joints, joints);
     const auto [low, high] = std::minmax_element(pose.begin(), pose.end(),
                                                  [](const glm::vec3& p, const glm::vec3& q) { return p.y < q.y; });
     heights[i] = double(high->y - low->y);
+    if (!human) continue;
+    const glm::vec3 body = pose[std::size_t(*head)] - 0.5f * (pose[std::size_t(*left)] + pose[std::size_t(*right)]);
+    up += glm::length(body) > 0.0f ? double(body.y / glm::length(body)) : 0.0;
   }
   const auto at = heights.begin() + std::ptrdiff_t(0.9 * double(count - 1));
   std::nth_element(heights.begin(), at, heights.end());
-  return *at;
+  PoseFigures out;
+  out.height = *at;
+  if (human) out.body_up = up / count;
+  return out;
 }
 
 }  // namespace
@@ -101,12 +121,20 @@ void print_units(const Database& database) {
     }
   }
   std::printf("units: %s\n", units.c_str());
-  if (const std::optional<double> height = standing_height(database)) {
+  const std::optional<PoseFigures> figures = pose_figures(database);
+  if (figures) {
     std::printf("standing height: %.2f m (highest joint above the lowest, 90th percentile of the frames; the "
                 "top of the head is higher than its joint)\n",
-                *height);
+                figures->height);
   } else {
     std::printf("standing height: unknown (no animation section)\n");
+  }
+  if (figures && figures->body_up) {
+    // The axis the import stood the character along, measured: a wrong
+    // up_axis shows here as a body lying down.
+    std::printf("up axis: %s (the feet-to-head direction's y is %.2f on average; 1 = upright along +Y)\n",
+                *figures->body_up >= 0.5 ? "+Y, upright" : "not +Y: the body is not upright (check import.up_axis)",
+                *figures->body_up);
   }
   Result<crowd::GaitSpeeds> speeds = crowd::measure_gait_speeds(database);
   if (!speeds.ok()) {
@@ -128,8 +156,9 @@ nlohmann::json units_json(const Database& database) {
                                       {"clips", count.clips},
                                       {"name", name ? nlohmann::json(name) : nlohmann::json()}});
   }
-  const std::optional<double> height = standing_height(database);
-  out["standing_height_m"] = height ? nlohmann::json(*height) : nlohmann::json();
+  const std::optional<PoseFigures> figures = pose_figures(database);
+  out["standing_height_m"] = figures ? nlohmann::json(figures->height) : nlohmann::json();
+  out["body_up"] = figures && figures->body_up ? nlohmann::json(*figures->body_up) : nlohmann::json();
   Result<crowd::GaitSpeeds> speeds = crowd::measure_gait_speeds(database);
   out["walk_mps"] = speeds.ok() ? nlohmann::json(speeds->walk_mps) : nlohmann::json();
   out["run_mps"] = speeds.ok() && speeds->has_run ? nlohmann::json(speeds->run_mps) : nlohmann::json();

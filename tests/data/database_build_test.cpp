@@ -291,6 +291,7 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   EXPECT_EQ(units["metres_per_unit"][0]["name"], "centimetres");
   EXPECT_GT(units["standing_height_m"].get<double>(), 1.2) << units.dump();
   EXPECT_LT(units["standing_height_m"].get<double>(), 2.0) << units.dump();
+  EXPECT_GT(units["body_up"].get<double>(), 0.9) << units.dump();  // upright along +Y
   EXPECT_GT(units["walk_mps"].get<double>(), 0.8) << units.dump();
   EXPECT_LT(units["walk_mps"].get<double>(), 2.0) << units.dump();
   EXPECT_TRUE(units["run_mps"].is_null()) << units.dump();
@@ -298,6 +299,8 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   const auto text = test::run_command(mmvk.string() + " inspect " + db);
   EXPECT_NE(text.output.find("units: 0.01 metres per file unit (centimetres)"), std::string::npos) << text.output;
   EXPECT_NE(text.output.find("speeds: walk "), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("up axis: +Y, upright (the feet-to-head direction's y is "), std::string::npos)
+      << text.output;
 
   const std::string out = (dir / "out.f32").string();
   ASSERT_EQ(run(mmvk.string() + " export " + db + " --features " + out), 0);

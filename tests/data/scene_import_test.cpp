@@ -13,13 +13,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <string>
+#include <sys/stat.h>
 #include <vector>
 
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 #include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -48,10 +51,10 @@ const fs::path kModels = "/usr/share/assimp/models";
     GTEST_SKIP() << path << " not installed";                                                    \
   }
 
-// The scene's world node positions at `seconds`, evaluated independently of
+// The scene's world node matrices at `seconds`, evaluated independently of
 // the importer: keys interpolated with glm, node matrices multiplied down.
-std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, const aiAnimation& animation,
-                                                        double seconds) {
+std::map<std::string, aiMatrix4x4> assimp_world_matrices(const aiScene& scene, const aiAnimation& animation,
+                                                         double seconds) {
   const double ticks = (animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0) *
                        std::min(seconds, animation.mDuration / (animation.mTicksPerSecond > 0.0 ? animation.mTicksPerSecond : 25.0));
   std::map<std::string, const aiNodeAnim*> channels;
@@ -67,7 +70,7 @@ std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, co
   auto quat = [](const aiQuaternion& q) { return glm::quat(q.w, q.x, q.y, q.z); };
   auto mix = [](glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; };
   auto slerp = [](glm::quat a, glm::quat b, float t) { return glm::slerp(a, glm::dot(a, b) < 0 ? -b : b, t); };
-  std::map<std::string, glm::vec3> out;
+  std::map<std::string, aiMatrix4x4> out;
   std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{{scene.mRootNode, aiMatrix4x4()}};
   while (!stack.empty()) {
     auto [node, parent] = stack.back();
@@ -81,10 +84,23 @@ std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, co
       local = aiMatrix4x4(aiVector3D(s.x, s.y, s.z), aiQuaternion(r.w, r.x, r.y, r.z), aiVector3D(p.x, p.y, p.z));
     }
     const aiMatrix4x4 global = parent * local;
-    out.emplace(node->mName.C_Str(), glm::vec3(global.a4, global.b4, global.c4));
+    out.emplace(node->mName.C_Str(), global);
     for (unsigned c = 0; c < node->mNumChildren; ++c) stack.push_back({node->mChildren[c], global});
   }
   return out;
+}
+
+std::map<std::string, glm::vec3> assimp_world_positions(const aiScene& scene, const aiAnimation& animation,
+                                                        double seconds) {
+  std::map<std::string, glm::vec3> out;
+  for (const auto& [name, m] : assimp_world_matrices(scene, animation, seconds)) out[name] = glm::vec3(m.a4, m.b4, m.c4);
+  return out;
+}
+
+// A node frame's axis `column` (0 = x, 1 = y), normalized: scale dropped.
+glm::vec3 axis_of(const aiMatrix4x4& m, int column) {
+  const glm::vec3 axis = column == 0 ? glm::vec3(m.a1, m.b1, m.c1) : glm::vec3(m.a2, m.b2, m.c2);
+  return glm::normalize(axis);
 }
 
 struct ModelCase {
@@ -123,10 +139,17 @@ TEST(SceneImport, ForwardKinematicsAgreesWithAssimp) {
     const std::uint32_t last = motion.frame_count - 1;
     for (const std::uint32_t frame : {0u, last / 3, last / 2, last}) {
       mmvk::forward_kinematics(motion, frame, positions, rotations);
-      const auto expected = assimp_world_positions(*scene, *scene->mAnimations[0], frame / 30.0);
+      const auto expected = assimp_world_matrices(*scene, *scene->mAnimations[0], frame / 30.0);
       for (std::size_t j = 0; j < motion.joint_count(); ++j) {
-        const glm::vec3 want = expected.at(motion.skeleton.names[j]) * imported->metres_per_unit;
+        const aiMatrix4x4& m = expected.at(motion.skeleton.names[j]);
+        const glm::vec3 want = glm::vec3(m.a4, m.b4, m.c4) * imported->metres_per_unit;
         EXPECT_LT(glm::length(positions[j] - want), 1e-4f * std::max(extent, 1.0f))
+            << "frame " << frame << " joint " << motion.skeleton.names[j];
+        // The joint's frame too (these files are Y-up: no axis change), not
+        // only where it is: poses blend and IK turns rotations.
+        EXPECT_GT(glm::dot(rotations[j] * glm::vec3(1, 0, 0), axis_of(m, 0)), 0.9999f)
+            << "frame " << frame << " joint " << motion.skeleton.names[j];
+        EXPECT_GT(glm::dot(rotations[j] * glm::vec3(0, 1, 0), axis_of(m, 1)), 0.9999f)
             << "frame " << frame << " joint " << motion.skeleton.names[j];
       }
     }
@@ -238,6 +261,26 @@ TEST(SceneImport, BuiltDatabasePosesAgreeWithAssimp) {
   }
 }
 
+// The stored poses of two databases of one motion: the least |dot| of their
+// rotations, joint by joint (by name: b may have joints above a's, such as
+// the scene node that assimp gives a COLLADA skeleton) and frame by frame
+// (1 = the same up to sign).
+float least_rotation_agreement(const mmvk::Database& a, const mmvk::Database& b) {
+  const mmvk::AnimationData *pa = a.animation(), *pb = b.animation();
+  if (pa == nullptr || pb == nullptr || pa->frame_count != pb->frame_count) return 0.0f;
+  float least = 1.0f;
+  for (std::size_t j = 0; j < pa->joint_count(); ++j) {
+    const int k = pb->skeleton.find(pa->skeleton.names[j]);
+    if (k < 0) return 0.0f;
+    for (std::size_t f = 0; f < pa->frame_count; ++f) {
+      const glm::quat qa = pa->local_rotations[f * pa->joint_count() + j];
+      const glm::quat qb = pb->local_rotations[f * pb->joint_count() + std::size_t(k)];
+      least = std::min(least, std::abs(glm::dot(qa, qb)));
+    }
+  }
+  return least;
+}
+
 TEST(SceneImport, GltfFromABvhClipGivesItsFeatures) {
   const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
   const fs::path dir = mmvk::test::make_temp_dir();
@@ -251,6 +294,7 @@ TEST(SceneImport, GltfFromABvhClipGivesItsFeatures) {
   for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
   EXPECT_LT(worst, 1e-3f) << "largest feature difference (normalized units)";
   EXPECT_EQ(from_gltf.clips()[0].metres_per_unit, 1.0f);  // glTF is metres
+  EXPECT_GT(least_rotation_agreement(from_bvh, from_gltf), 0.99999f) << "least |dot| of the stored rotations";
 }
 
 TEST(SceneImport, SeveralAnimationsAreSeveralClipsNamedAfterThem) {
@@ -308,6 +352,87 @@ TEST(SceneImport, WrongUnitsOrUpAxisOnAGltfAreRefused) {
   EXPECT_TRUE(build(R"({"up_axis": "y"})").ok());
 }
 
+// --- A COLLADA file written from a BVH clip --------------------------------
+
+// Writes `motion` as a Z-up COLLADA file in centimetres (<unit meter="0.01">,
+// <up_axis>Z_UP</up_axis>), so that the import's units and axes come from
+// the file: each joint a node with a matrix, animated by one 4x4 matrix per
+// frame (COLLADA matrices are row-major).
+fs::path write_collada(const Motion& motion, const fs::path& dir, const std::string& stem) {
+  const std::size_t joints = motion.joint_count(), frames = motion.frame_count;
+  // mmvk's Y-up to the file's Z-up: (x, y, z) -> (x, -z, y); assimp undoes it.
+  const glm::mat4 to_file = glm::mat4(glm::mat3(glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)));
+  auto local = [&](std::size_t f, std::size_t j) {
+    const std::size_t i = motion.index(std::uint32_t(f), j);
+    glm::mat4 m = glm::mat4_cast(motion.local_rotations[i]);
+    m[3] = glm::vec4(motion.local_positions[i] * 100.0f, 1.0f);  // centimetres
+    return motion.skeleton.parents[j] < 0 ? to_file * m : m;
+  };
+  auto row_major = [](const glm::mat4& m) {
+    std::string text;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) text += std::to_string(m[c][r]) + " ";
+    }
+    return text;
+  };
+  std::string animations, nodes;
+  std::vector<std::string> open(joints);
+  for (std::size_t j = 0; j < joints; ++j) {
+    const std::string& name = motion.skeleton.names[j];
+    std::string times, values, interpolation;
+    for (std::size_t f = 0; f < frames; ++f) {
+      times += std::to_string(double(f) / motion.fps) + " ";
+      values += row_major(local(f, j));
+      interpolation += "LINEAR ";
+    }
+    const std::string n = std::to_string(frames), n16 = std::to_string(16 * frames);
+    animations += "<animation id=\"a_" + name + "\">"
+      "<source id=\"" + name + "_in\"><float_array id=\"" + name + "_in_a\" count=\"" + n + "\">" + times +
+      "</float_array><technique_common><accessor source=\"#" + name + "_in_a\" count=\"" + n +
+      "\" stride=\"1\"><param name=\"TIME\" type=\"float\"/></accessor></technique_common></source>"
+      "<source id=\"" + name + "_out\"><float_array id=\"" + name + "_out_a\" count=\"" + n16 + "\">" + values +
+      "</float_array><technique_common><accessor source=\"#" + name + "_out_a\" count=\"" + n +
+      "\" stride=\"16\"><param name=\"TRANSFORM\" type=\"float4x4\"/></accessor></technique_common></source>"
+      "<source id=\"" + name + "_ip\"><Name_array id=\"" + name + "_ip_a\" count=\"" + n + "\">" + interpolation +
+      "</Name_array><technique_common><accessor source=\"#" + name + "_ip_a\" count=\"" + n +
+      "\" stride=\"1\"><param name=\"INTERPOLATION\" type=\"name\"/></accessor></technique_common></source>"
+      "<sampler id=\"" + name + "_s\"><input semantic=\"INPUT\" source=\"#" + name + "_in\"/>"
+      "<input semantic=\"OUTPUT\" source=\"#" + name + "_out\"/><input semantic=\"INTERPOLATION\" source=\"#" +
+      name + "_ip\"/></sampler><channel source=\"#" + name + "_s\" target=\"" + name + "/transform\"/></animation>\n";
+  }
+  // Nodes nest: joints are depth-first with parents first.
+  std::function<std::string(std::size_t)> node = [&](std::size_t j) {
+    const std::string& name = motion.skeleton.names[j];
+    std::string text = "<node id=\"" + name + "\" name=\"" + name + "\" sid=\"" + name +
+                       "\" type=\"JOINT\"><matrix sid=\"transform\">" + row_major(local(0, j)) + "</matrix>";
+    for (std::size_t c = 0; c < joints; ++c) {
+      if (motion.skeleton.parents[c] == int(j)) text += node(c);
+    }
+    return text + "</node>";
+  };
+  std::ofstream(dir / (stem + ".dae"))
+      << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" "
+         "version=\"1.4.1\"><asset><unit name=\"centimeter\" meter=\"0.01\"/><up_axis>Z_UP</up_axis></asset>"
+         "<library_animations>" << animations << "</library_animations><library_visual_scenes><visual_scene id=\"scene\">"
+      << node(0) << "</visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#scene\"/></scene></COLLADA>\n";
+  return dir / (stem + ".dae");
+}
+
+TEST(SceneImport, ColladaInCentimetresZUpFromABvhClipGivesItsFeatures) {
+  const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const fs::path dae = write_collada(load_bvh_motion(bvh), dir, "walk");
+  const mmvk::Database from_bvh = build_one(bvh, dir);
+  const mmvk::Database from_dae = build_one(dae, dir);
+  ASSERT_EQ(from_dae.frame_count(), from_bvh.frame_count());
+  const auto a = from_bvh.features(), b = from_dae.features();
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  // Matrices written with 6 decimals (std::to_string) in centimetres.
+  EXPECT_LT(worst, 2e-3f) << "largest feature difference (normalized units)";
+  EXPECT_GT(least_rotation_agreement(from_bvh, from_dae), 0.9999f) << "least |dot| of the stored rotations";
+}
+
 TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {
   const auto cli = mmvk::test::cli_binary();
   if (!cli) GTEST_SKIP() << "no mmvk command line in this build";
@@ -333,6 +458,63 @@ TEST(SceneImport, ErrorsNameTheFile) {
   const auto box = mmvk::import_scene(still, {});
   ASSERT_FALSE(box.ok());
   EXPECT_NE(box.message().find("BoxTextured.gltf: no animation in the file"), std::string::npos) << box.message();
+}
+
+// A one-joint glTF whose rotation keys are at `times` (seconds, any order).
+fs::path write_keys_gltf(const fs::path& dir, const std::string& stem, const std::vector<float>& times) {
+  using nlohmann::json;
+  std::string bin;
+  append_floats(bin, times);
+  std::vector<float> rotations;
+  for (std::size_t k = 0; k < times.size(); ++k) rotations.insert(rotations.end(), {0.0f, 0.0f, 0.0f, 1.0f});
+  append_floats(bin, rotations);
+  const auto [low, high] = std::minmax_element(times.begin(), times.end());
+  const json gltf = {
+      {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"name", "Hips"}}}},
+      {"buffers", {{{"byteLength", bin.size()}, {"uri", stem + ".bin"}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 4 * times.size()}},
+                       {{"buffer", 0}, {"byteOffset", 4 * times.size()}, {"byteLength", 16 * times.size()}}}},
+      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", times.size()}, {"type", "SCALAR"},
+                      {"min", {*low}}, {"max", {*high}}},
+                     {{"bufferView", 1}, {"componentType", 5126}, {"count", times.size()}, {"type", "VEC4"}}}},
+      {"animations", {{{"name", "a"}, {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "rotation"}}}}}},
+                       {"samplers", {{{"input", 0}, {"output", 1}}}}}}}};
+  std::ofstream(dir / (stem + ".bin"), std::ios::binary) << bin;
+  std::ofstream(dir / (stem + ".gltf")) << gltf.dump();
+  return dir / (stem + ".gltf");
+}
+
+TEST(SceneImport, HostileFilesEndInErrors) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  mmvk::SceneImportOptions options;
+  options.fps = 30.0f;
+  // A FIFO under a scene name: refused before assimp would block on it.
+  ASSERT_EQ(::mkfifo((dir / "pipe.fbx").c_str(), 0600), 0);
+  const auto pipe = mmvk::import_scene(dir / "pipe.fbx", options);
+  ASSERT_FALSE(pipe.ok());
+  EXPECT_NE(pipe.message().find("pipe.fbx: not a regular file"), std::string::npos) << pipe.message();
+  // A claimed ten-million-second animation: an error, not 300 million frames.
+  const auto huge = mmvk::import_scene(write_keys_gltf(dir, "huge", {0.0f, 1e7f}), options);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_NE(huge.message().find("huge.gltf: animation 'a': 1e+07 s at 30 fps is 3e+08 frames of 1 joints, over the "
+                                "limit of 33554432 samples"),
+            std::string::npos)
+      << huge.message();
+  // Keys out of order: whatever assimp makes of them, an answer.
+  const auto shuffled = mmvk::import_scene(write_keys_gltf(dir, "shuffled", {1.0f, 0.0f, 0.5f}), options);
+  if (shuffled.ok()) {
+    EXPECT_EQ(shuffled->animations.size(), 1u);
+  }
+  // A truncated FBX.
+  const fs::path fbx = kModels / "FBX/animation_with_skeleton.fbx";
+  MMVK_REQUIRE_TEST_MODEL(fbx);
+  std::ifstream in(fbx, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  std::ofstream(dir / "cut.fbx", std::ios::binary) << head;
+  const auto cut = mmvk::import_scene(dir / "cut.fbx", options);
+  ASSERT_FALSE(cut.ok());
+  EXPECT_NE(cut.message().find("cut.fbx: assimp could not read it"), std::string::npos) << cut.message();
 }
 
 }  // namespace

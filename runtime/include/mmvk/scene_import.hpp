@@ -37,6 +37,8 @@
 #include "mmvk/motion.hpp"
 #include "mmvk/status.hpp"
 
+struct aiScene;
+
 namespace mmvk {
 
 // Whether `path` names a file import_scene() reads, by its extension (any
@@ -83,7 +85,15 @@ struct SceneImport {
 // samples.
 Result<SceneImport> import_scene(const std::filesystem::path& path, const SceneImportOptions& options);
 
-// The same from bytes in memory (the fuzz target's entry): `extension` (".fbx",
+// A scene the caller has read with assimp itself (an application that
+// already uses it): `format` (".fbx", ".gltf", ".glb", ".dae") says which
+// metadata rules apply (scene_import.hpp's units and axes); `source` names
+// it in messages. The scene is only read. tests/fuzz/fuzz_scene_import.cpp
+// feeds it scenes built from fuzz bytes.
+Result<SceneImport> import_assimp_scene(const aiScene& scene, std::string_view format, std::string_view source,
+                                        const SceneImportOptions& options);
+
+// The same from bytes in memory: `extension` (".fbx",
 // ".glb", ...) picks the format as the file name would; `source` names it in
 // messages. A .gltf whose buffers are separate files cannot be read this way.
 Result<SceneImport> import_scene_from_memory(std::span<const std::uint8_t> bytes, std::string_view extension,

@@ -96,7 +96,12 @@ ImportMeasures measure_import(const Motion& motion) {
 }
 
 Status check_import(const ImportMeasures& m, const ImportContext& context) {
-  if (!m.human) return {};
+  // Not a person, or a motion so corrupt that its figures overflow: the
+  // build's feature limits then name the frame (database_build.hpp).
+  if (!m.human || !std::isfinite(m.standing_height) || !std::isfinite(m.body_up) || !std::isfinite(m.floor) ||
+      !std::isfinite(m.root_speed)) {
+    return {};
+  }
   const std::string head = context.source + ": implausible import: ";
   const std::string accept =
       " If the figures are right (not a person standing up, a giant, a crawl), set \"import\": "

@@ -34,7 +34,7 @@ std::string lower_extension(const std::filesystem::path& path) {
 // or a double, the axes as ints), or `fallback`.
 double metadata_number(const aiScene& scene, const char* key, double fallback) {
   const aiMetadata* meta = scene.mMetaData;
-  if (meta == nullptr) return fallback;
+  if (meta == nullptr || meta->mKeys == nullptr || meta->mValues == nullptr) return fallback;
   for (unsigned i = 0; i < meta->mNumProperties; ++i) {
     if (std::string_view(meta->mKeys[i].C_Str()) != key || meta->mValues[i].mData == nullptr) continue;
     const aiMetadataEntry& entry = meta->mValues[i];
@@ -98,10 +98,10 @@ void choose_units_and_axes(const aiScene& scene, const std::string& ext, const I
   } else if (ext == ".fbx") {
     const bool read = fbx_axes(scene, to_mmvk);
     if (!read) to_mmvk = glm::mat3(1.0f);
-    out.axes_from = read ? "FBX UpAxis " + std::to_string(int(metadata_number(scene, "UpAxis", 1))) +
-                               " (0 = X, 1 = Y, 2 = Z), sign " +
-                               std::to_string(int(metadata_number(scene, "UpAxisSign", 1)))
-                         : "FBX without a valid axis set (Y-up assumed)";
+    char text[120];
+    std::snprintf(text, sizeof(text), "FBX UpAxis %g (0 = X, 1 = Y, 2 = Z), UpAxisSign %g",
+                  metadata_number(scene, "UpAxis", 1), metadata_number(scene, "UpAxisSign", 1));
+    out.axes_from = read ? std::string(text) : "FBX without a valid axis set (Y-up assumed)";
   } else {
     out.axes_from = ext == ".dae" ? "COLLADA <up_axis> (applied by assimp)" : "glTF (Y-up by the format)";
   }
@@ -115,10 +115,15 @@ float key_rate(const aiAnimation& animation) {
     const double step = (b - a) / ticks;
     if (step >= 1.0 / kMaxFps && std::isfinite(step) && (smallest == 0.0 || step < smallest)) smallest = step;
   };
-  for (unsigned c = 0; c < animation.mNumChannels; ++c) {
+  for (unsigned c = 0; animation.mChannels != nullptr && c < animation.mNumChannels; ++c) {
+    if (animation.mChannels[c] == nullptr) continue;
     const aiNodeAnim& channel = *animation.mChannels[c];
-    for (unsigned k = 1; k < channel.mNumPositionKeys; ++k) visit(channel.mPositionKeys[k - 1].mTime, channel.mPositionKeys[k].mTime);
-    for (unsigned k = 1; k < channel.mNumRotationKeys; ++k) visit(channel.mRotationKeys[k - 1].mTime, channel.mRotationKeys[k].mTime);
+    for (unsigned k = 1; channel.mPositionKeys != nullptr && k < channel.mNumPositionKeys; ++k) {
+      visit(channel.mPositionKeys[k - 1].mTime, channel.mPositionKeys[k].mTime);
+    }
+    for (unsigned k = 1; channel.mRotationKeys != nullptr && k < channel.mNumRotationKeys; ++k) {
+      visit(channel.mRotationKeys[k - 1].mTime, channel.mRotationKeys[k].mTime);
+    }
   }
   if (smallest == 0.0) return 30.0f;
   double fps = 1.0 / smallest;
@@ -165,7 +170,9 @@ Result<SceneImport> import_loaded(const aiScene* scene, const std::string& ext, 
   if (scene == nullptr || scene->mRootNode == nullptr) {
     return make_error(source + ": assimp could not read it: " + std::string(assimp_error));
   }
-  if (scene->mNumAnimations == 0) return make_error(source + ": no animation in the file (a model without motion?)");
+  if (scene->mNumAnimations == 0 || scene->mAnimations == nullptr) {
+    return make_error(source + ": no animation in the file (a model without motion?)");
+  }
   if (!(options.fps == 0.0f || (options.fps >= kMinFps && options.fps <= kMaxFps))) {
     return make_error(source + ": fps " + std::to_string(options.fps) + " is outside the supported range");
   }
@@ -174,6 +181,7 @@ Result<SceneImport> import_loaded(const aiScene* scene, const std::string& ext, 
   choose_units_and_axes(*scene, ext, options.import, out, to_mmvk);
   std::vector<std::string> names;
   for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
+    if (scene->mAnimations[a] == nullptr) continue;
     const aiAnimation& animation = *scene->mAnimations[a];
     names.push_back("'" + std::string(animation.mName.C_Str()) + "'");
     if (!options.animation.empty() && options.animation != animation.mName.C_Str()) continue;
@@ -230,6 +238,13 @@ Result<SceneImport> import_scene(const std::filesystem::path& path, const SceneI
   configure(importer);
   const aiScene* scene = importer.ReadFile(source, kPostProcess);
   return import_loaded(scene, lower_extension(path), source, options, importer.GetErrorString());
+}
+
+Result<SceneImport> import_assimp_scene(const aiScene& scene, std::string_view format, std::string_view source,
+                                        const SceneImportOptions& options) {
+  std::string ext(format);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return import_loaded(&scene, ext, std::string(source), options, "no root node");
 }
 
 Result<SceneImport> import_scene_from_memory(std::span<const std::uint8_t> bytes, std::string_view extension,

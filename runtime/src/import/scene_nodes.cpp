@@ -27,7 +27,7 @@ Status flatten(const aiNode* root, NodeTree& tree, const std::string& where) {
     const int index = static_cast<int>(tree.nodes.size());
     tree.nodes.push_back(node);
     tree.node_parent.push_back(parent);
-    for (unsigned c = node->mNumChildren; c-- > 0;) {
+    for (unsigned c = node->mChildren != nullptr ? node->mNumChildren : 0; c-- > 0;) {
       if (node->mChildren[c] != nullptr) stack.push_back({node->mChildren[c], index});
     }
   }
@@ -55,14 +55,17 @@ std::vector<bool> joint_marks(const aiScene& scene, const aiAnimation* animation
     const auto it = names.find(std::string_view(name.C_Str()));
     if (it != names.end()) any = marked[std::size_t(it->second)] = true;
   };
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+  // Counts are checked against null arrays: a scene an application built
+  // (import_assimp_scene) has not been through assimp's validation.
+  for (unsigned m = 0; scene.mMeshes != nullptr && m < scene.mNumMeshes; ++m) {
     const aiMesh* mesh = scene.mMeshes[m];
-    for (unsigned b = 0; mesh != nullptr && b < mesh->mNumBones; ++b) {
+    for (unsigned b = 0; mesh != nullptr && mesh->mBones != nullptr && b < mesh->mNumBones; ++b) {
       if (mesh->mBones[b] != nullptr) mark(mesh->mBones[b]->mName);
     }
   }
   const bool skinned = any;
-  for (unsigned c = 0; !skinned && animation != nullptr && c < animation->mNumChannels; ++c) {
+  for (unsigned c = 0; !skinned && animation != nullptr && animation->mChannels != nullptr && c < animation->mNumChannels;
+       ++c) {
     if (animation->mChannels[c] != nullptr) mark(animation->mChannels[c]->mNodeName);
   }
   // Children come after parents, so one backward pass closes over ancestors.
@@ -82,7 +85,7 @@ aiMatrix4x4 sample_channel(const aiNode& node, const aiNodeAnim& channel, double
   aiQuaternion rotation;
   node.mTransformation.Decompose(scaling, rotation, position);
   auto find = [ticks](const auto* keys, unsigned count, auto& value, auto&& blend) {
-    if (count == 0) return;
+    if (count == 0 || keys == nullptr) return;
     const auto* end = keys + count;
     const auto* next = std::upper_bound(keys, end, ticks, [](double t, const auto& key) { return t < key.mTime; });
     if (next == keys) {
@@ -92,7 +95,9 @@ aiMatrix4x4 sample_channel(const aiNode& node, const aiNodeAnim& channel, double
     } else {
       const auto& before = next[-1];
       const double span = next->mTime - before.mTime;
-      const float factor = span > 0.0 ? static_cast<float>((ticks - before.mTime) / span) : 0.0f;
+      // Clamped: keys a hostile file wrote out of order put `ticks` outside
+      // the pair, and a double beyond float's range does not convert.
+      const float factor = span > 0.0 ? static_cast<float>(std::clamp((ticks - before.mTime) / span, 0.0, 1.0)) : 0.0f;
       blend(value, before.mValue, next->mValue, factor);
     }
   };
@@ -172,7 +177,7 @@ Result<NodeTree> build_node_tree(const aiScene& scene, const aiAnimation* animat
 std::vector<const aiNodeAnim*> channels_by_node(const NodeTree& tree, const aiAnimation& animation) {
   const std::map<std::string_view, int> names = nodes_by_name(tree);
   std::vector<const aiNodeAnim*> channels(tree.nodes.size(), nullptr);
-  for (unsigned c = 0; c < animation.mNumChannels; ++c) {
+  for (unsigned c = 0; animation.mChannels != nullptr && c < animation.mNumChannels; ++c) {
     const aiNodeAnim* channel = animation.mChannels[c];
     if (channel == nullptr) continue;
     const auto it = names.find(std::string_view(channel->mNodeName.C_Str()));

@@ -25,6 +25,8 @@
 #include "mmvk/database_io.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
+#include "mmvk/vulkan/vulkan_brute_force.hpp"
+#include "mmvk/vulkan/vulkan_cluster_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 
 namespace {
@@ -101,7 +103,6 @@ int main(int argc, char** argv) {
   options.max_k = k;
   options.warm_up = false;  // timed apart below
   if (mode == "clusters") {
-    options.mode = mmvk::vulkan::SearchMode::ClustersExact;
     mmvk::Result<mmvk::ClusterTable> loaded =
         clusters_path.empty() ? mmvk::train_cluster_table(*db, mmvk::KMeansParams{}) : mmvk::load_cluster_table(clusters_path);
     if (!loaded) return fail(loaded.message());
@@ -128,14 +129,21 @@ int main(int argc, char** argv) {
   const double load_ms = ms_since(start);
 
   start = Clock::now();
-  mmvk::Result<std::unique_ptr<mmvk::vulkan::VulkanSearch>> search =
-      mmvk::vulkan::VulkanSearch::create(**context, *db, options, mode == "clusters" ? &table : nullptr);
-  if (!search) return fail(search.message());
+  std::unique_ptr<mmvk::vulkan::VulkanSearch> search;
+  if (mode == "clusters") {
+    auto created = mmvk::vulkan::VulkanClusterSearch::create(**context, *db, table, options);
+    if (!created) return fail(created.message());
+    search = std::move(created).value();
+  } else {
+    auto created = mmvk::vulkan::VulkanBruteForce::create(**context, *db, options);
+    if (!created) return fail(created.message());
+    search = std::move(created).value();
+  }
   const double create_ms = ms_since(start);
   double warm_up_ms = 0.0;
   if (warm_up) {
     start = Clock::now();
-    if (mmvk::Status warmed = (*search)->warm_up(); !warmed) return fail(warmed.message());
+    if (mmvk::Status warmed = search->warm_up(); !warmed) return fail(warmed.message());
     warm_up_ms = ms_since(start);
   }
   std::vector<double> times;
@@ -143,7 +151,7 @@ int main(int argc, char** argv) {
   for (std::uint32_t r = 0; r <= repeat; ++r) {
     start = Clock::now();
     const double cpu_start = process_cpu_ms();
-    if (mmvk::Status searched = (*search)->search(query_batch, k, out); !searched) return fail(searched.message());
+    if (mmvk::Status searched = search->search(query_batch, k, out); !searched) return fail(searched.message());
     cpu_times.push_back(process_cpu_ms() - cpu_start);
     times.push_back(ms_since(start));
   }

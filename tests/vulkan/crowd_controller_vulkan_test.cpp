@@ -56,7 +56,7 @@ TEST(CrowdControllerVulkan, SameFramesAsTheReferenceEveryTick) {
   vulkan::VulkanSearchOptions options;
   options.max_k = 1;
   options.max_batch = 16;  // the first tick's 50 forced searches: 4 pages on 2 slots
-  Result<std::unique_ptr<vulkan::VulkanSearch>> gpu = vulkan::VulkanSearch::create(*context, *db, options);
+  Result<std::unique_ptr<vulkan::VulkanBruteForce>> gpu = vulkan::VulkanBruteForce::create(*context, *db, options);
   ASSERT_TRUE(gpu.ok()) << gpu.message();
 
   const test::CrowdRun expected = run_sync(*db, reference);

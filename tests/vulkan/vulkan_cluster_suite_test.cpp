@@ -6,11 +6,14 @@
 // table, a run under the validation layer, and the creation errors.
 #include <map>
 #include <memory>
+#include <string_view>
 
 #include "mmvk/backends.hpp"
 #include "mmvk/cluster_search.hpp"
 #include "mmvk/thread_pool.hpp"
 #include "mmvk/vulkan/backends.hpp"
+#include "mmvk/vulkan/vulkan_brute_force.hpp"
+#include "mmvk/vulkan/vulkan_cluster_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/backend_data_suite.hpp"
 #include "support/backend_suite.hpp"
@@ -42,6 +45,23 @@ using VulkanClusterBackends = ::testing::Types<VulkanClustersExact, VulkanProbeA
 INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendSuite, VulkanClusterBackends);
 INSTANTIATE_TYPED_TEST_SUITE_P(VulkanClusters, BackendDataSuite, VulkanClusterBackends);
 
+// The three Vulkan searches by their registry names, made directly.
+constexpr std::string_view kVulkanSearches[] = {"vulkan-brute", "vulkan-clusters", "vulkan-nprobe"};
+
+std::unique_ptr<vulkan::VulkanSearch> make_named(vulkan::Context& context, const Database& db, std::string_view name,
+                                                 const vulkan::VulkanSearchOptions& options, const ClusterTable& table,
+                                                 vulkan::VulkanClusterOptions cluster_options = {}) {
+  if (name == "vulkan-brute") {
+    auto made = vulkan::VulkanBruteForce::create(context, db, options);
+    EXPECT_TRUE(made.ok()) << made.message();
+    return made.ok() ? std::move(made).value() : nullptr;
+  }
+  if (name == "vulkan-nprobe") cluster_options.nprobe = 8;
+  auto made = vulkan::VulkanClusterSearch::create(context, db, table, options, cluster_options);
+  EXPECT_TRUE(made.ok()) << made.message();
+  return made.ok() ? std::move(made).value() : nullptr;
+}
+
 // Approximate mode: the same clusters as the CPU nprobe (nearest centroids
 // by channel-weighted squared distance, ties by cluster id), searched
 // exactly, so the same answers; also with constraints and k > 1.
@@ -57,9 +77,9 @@ TEST(VulkanClusterSearch, NProbeEqualsCpuNProbe) {
     SCOPED_TRACE("nprobe " + std::to_string(nprobe));
     vulkan::VulkanSearchOptions options;
     options.warm_up = false;
-    options.mode = vulkan::SearchMode::NProbe;
-    options.nprobe = nprobe;
-    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
+    vulkan::VulkanClusterOptions probe;
+    probe.nprobe = nprobe;
+    auto gpu = vulkan::VulkanClusterSearch::create(*context, db, **table, options, probe);
     ASSERT_TRUE(gpu.ok()) << gpu.message();
     ClusterSearchOptions cpu_options;
     cpu_options.nprobe = nprobe;
@@ -89,12 +109,12 @@ TEST(VulkanClusterSearch, PrunesAndChunksUnderValidation) {
   Result<const ClusterTable*> table = tables.table_for(db);
   ASSERT_TRUE(table.ok()) << table.message();
   vulkan::VulkanSearchOptions options;
-  options.mode = vulkan::SearchMode::ClustersExact;
   options.max_batch = 100;
   options.max_k = 4;
   options.scratch_bytes = 16 << 10;  // a few queries per chunk
-  options.cluster_scratch_bytes = 16 << 10;
-  auto created = vulkan::VulkanSearch::create(*context, db, options, *table);
+  vulkan::VulkanClusterOptions cluster_options;
+  cluster_options.scratch_bytes = 16 << 10;
+  auto created = vulkan::VulkanClusterSearch::create(*context, db, **table, options, cluster_options);
   ASSERT_TRUE(created.ok()) << created.message();
   std::unique_ptr<vulkan::VulkanSearch> gpu = std::move(created).value();
   const std::vector<float> queries = synthetic_queries(db, 100, 56, 0.05f);
@@ -134,10 +154,9 @@ TEST(VulkanClusterSearch, LargeDatabaseStaysExact) {
     SCOPED_TRACE("k " + std::to_string(k));
     vulkan::VulkanSearchOptions options;
     options.warm_up = false;
-    options.mode = vulkan::SearchMode::ClustersExact;
     options.max_batch = 64;
     options.max_k = k;
-    auto gpu = vulkan::VulkanSearch::create(*context, db, options, &*table);
+    auto gpu = vulkan::VulkanClusterSearch::create(*context, db, *table, options);
     ASSERT_TRUE(gpu.ok()) << gpu.message();
     const std::vector<Match> expected = reference_results(db, queries, {}, 64, k);
     expect_identical(expected, run_search(**gpu, queries, {}, 64, k), k, {}, (*gpu)->name());
@@ -171,11 +190,11 @@ TEST(VulkanClusterSearch, TiledScanOverSharedBlocksStaysExact) {
   for (const std::uint64_t cluster_scratch : {std::uint64_t{512} << 20, std::uint64_t{64} << 10}) {
     vulkan::VulkanSearchOptions options;
     options.warm_up = false;
-    options.mode = vulkan::SearchMode::ClustersExact;
     options.max_batch = kBatch;
     options.max_k = 16;
-    options.cluster_scratch_bytes = cluster_scratch;
-    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
+    vulkan::VulkanClusterOptions cluster_options;
+    cluster_options.scratch_bytes = cluster_scratch;
+    auto gpu = vulkan::VulkanClusterSearch::create(*context, db, **table, options, cluster_options);
     ASSERT_TRUE(gpu.ok()) << gpu.message();
     for (const std::uint32_t k : {1u, 4u, 16u}) {
       SCOPED_TRACE("k " + std::to_string(k) + ", cluster scratch " + std::to_string(cluster_scratch));
@@ -212,10 +231,9 @@ TEST(VulkanClusterSearch, BlocksOfOneClusterAreCulledExactly) {
   const std::vector<QueryParams> params = random_params(db, kBatch, 133);
   vulkan::VulkanSearchOptions options;
   options.warm_up = false;
-  options.mode = vulkan::SearchMode::ClustersExact;
   options.max_batch = kBatch;
   options.max_k = 4;
-  auto gpu = vulkan::VulkanSearch::create(*context, db, options, &*table);
+  auto gpu = vulkan::VulkanClusterSearch::create(*context, db, *table, options);
   ASSERT_TRUE(gpu.ok()) << gpu.message();
   for (const std::uint32_t k : {1u, 4u}) {
     SCOPED_TRACE("k " + std::to_string(k));
@@ -244,24 +262,23 @@ TEST(VulkanClusterSearch, BuildsOnlyItsModesKernels) {
     }
     return false;
   };
-  for (const vulkan::SearchMode mode :
-       {vulkan::SearchMode::BruteForce, vulkan::SearchMode::ClustersExact, vulkan::SearchMode::NProbe}) {
+  for (const std::string_view name : kVulkanSearches) {
     vulkan::VulkanSearchOptions options;
     options.warm_up = false;
-    options.mode = mode;
     options.max_k = 4;
-    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
-    ASSERT_TRUE(gpu.ok()) << gpu.message();
-    const std::vector<std::string_view> kernels = (*gpu)->kernels();
-    const bool brute = mode == vulkan::SearchMode::BruteForce;
-    EXPECT_EQ(has(kernels, "brute_force_scan") || has(kernels, "topk_merge"), brute) << (*gpu)->name();
-    EXPECT_EQ(has(kernels, "cluster_"), !brute) << (*gpu)->name();
+    std::unique_ptr<vulkan::VulkanSearch> gpu = make_named(*context, db, name, options, **table);
+    ASSERT_NE(gpu, nullptr) << name;
+    EXPECT_EQ(gpu->name(), name);
+    const std::vector<std::string_view> kernels = gpu->kernels();
+    const bool brute = name == "vulkan-brute";
+    EXPECT_EQ(has(kernels, "brute_force_scan") || has(kernels, "topk_merge"), brute) << gpu->name();
+    EXPECT_EQ(has(kernels, "cluster_"), !brute) << gpu->name();
     // K classes 1 and 4: a scan per round (their tiles differ) and a merge
     // each, plus bounds, select and the block sort's three steps.
     if (!brute) {
       EXPECT_EQ(kernels.size(), 11u);
     }
-    EXPECT_TRUE((*gpu)->warm_up().ok());
+    EXPECT_TRUE(gpu->warm_up().ok());
   }
 }
 
@@ -277,24 +294,23 @@ TEST(VulkanClusterSearch, DeviceBytesCountTheDatabaseTablesAndSlots) {
   Result<const ClusterTable*> table = tables.table_for(db);
   ASSERT_TRUE(table.ok()) << table.message();
   const std::uint64_t feature_bytes = std::uint64_t{db.frame_count()} * ((db.dims() + 3) / 4) * 16;
-  const auto bytes_of = [&](vulkan::SearchMode mode, std::uint32_t slots, std::uint64_t cluster_scratch) {
+  const auto bytes_of = [&](std::string_view name, std::uint32_t slots, std::uint64_t cluster_scratch) {
     vulkan::VulkanSearchOptions options;
     options.warm_up = false;
-    options.mode = mode;
     options.slots = slots;
     options.max_batch = 64;
-    options.cluster_scratch_bytes = cluster_scratch;
-    auto gpu = vulkan::VulkanSearch::create(*context, db, options, *table);
-    EXPECT_TRUE(gpu.ok()) << gpu.message();
-    return gpu.ok() ? (*gpu)->device_bytes() : 0;
+    vulkan::VulkanClusterOptions cluster_options;
+    cluster_options.scratch_bytes = cluster_scratch;
+    const std::unique_ptr<vulkan::VulkanSearch> gpu = make_named(*context, db, name, options, **table, cluster_options);
+    return gpu != nullptr ? gpu->device_bytes() : 0;
   };
   // A budget below max_batch queries' scratch (small with 256-row blocks),
   // so that a roomier one holds more queries per chunk.
   constexpr std::uint64_t kSmallScratch = 16u << 10;
-  const std::uint64_t brute = bytes_of(vulkan::SearchMode::BruteForce, 1, kSmallScratch);
-  const std::uint64_t clusters[] = {bytes_of(vulkan::SearchMode::ClustersExact, 1, kSmallScratch),
-                                    bytes_of(vulkan::SearchMode::ClustersExact, 2, kSmallScratch),
-                                    bytes_of(vulkan::SearchMode::ClustersExact, 3, kSmallScratch)};
+  const std::uint64_t brute = bytes_of("vulkan-brute", 1, kSmallScratch);
+  const std::uint64_t clusters[] = {bytes_of("vulkan-clusters", 1, kSmallScratch),
+                                    bytes_of("vulkan-clusters", 2, kSmallScratch),
+                                    bytes_of("vulkan-clusters", 3, kSmallScratch)};
   // Metadata 16 and cost terms 8 bytes a frame; every frame is scanned here
   // (no flags), with 4 + 16 bytes for scan_frames and scan_terms.
   EXPECT_GE(brute, feature_bytes + std::uint64_t{db.frame_count()} * (16 + 8 + 4 + 16));
@@ -303,7 +319,7 @@ TEST(VulkanClusterSearch, DeviceBytesCountTheDatabaseTablesAndSlots) {
   EXPECT_GT(per_slot, 0u);
   EXPECT_EQ(clusters[2] - clusters[1], per_slot);
   // A larger scratch budget holds more queries per chunk: more per slot.
-  const std::uint64_t roomy = bytes_of(vulkan::SearchMode::ClustersExact, 1, 64u << 20);
+  const std::uint64_t roomy = bytes_of("vulkan-clusters", 1, 64u << 20);
   EXPECT_GT(roomy, clusters[0]);
 }
 
@@ -316,18 +332,15 @@ TEST(VulkanClusterSearch, CreationErrors) {
   ASSERT_TRUE(table.ok()) << table.message();
   vulkan::VulkanSearchOptions options;
   options.warm_up = false;
-  options.mode = vulkan::SearchMode::ClustersExact;
-  auto no_table = vulkan::VulkanSearch::create(*context, db, options);
-  ASSERT_FALSE(no_table.ok());
-  EXPECT_NE(no_table.message().find("ClusterTable"), std::string::npos) << no_table.message();
-  auto mismatched = vulkan::VulkanSearch::create(*context, other, options, *table);
+  // A search without a table does not compile (create() takes one by
+  // reference); nprobe 0 is the exact search, as in ClusterSearchOptions,
+  // and the registry's vulkan-nprobe refuses it (VulkanBackendRegistry).
+  auto mismatched = vulkan::VulkanClusterSearch::create(*context, other, **table, options);
   ASSERT_FALSE(mismatched.ok());
   EXPECT_NE(mismatched.message().find("cluster table"), std::string::npos) << mismatched.message();
-  options.mode = vulkan::SearchMode::NProbe;
-  options.nprobe = 0;
-  auto zero = vulkan::VulkanSearch::create(*context, db, options, *table);
-  ASSERT_FALSE(zero.ok());
-  EXPECT_NE(zero.message().find("nprobe"), std::string::npos) << zero.message();
+  auto zero = vulkan::VulkanClusterSearch::create(*context, db, **table, options);
+  ASSERT_TRUE(zero.ok()) << zero.message();
+  EXPECT_EQ((*zero)->name(), "vulkan-clusters");
 }
 
 }  // namespace

@@ -45,14 +45,14 @@ TEST(VulkanLimits, BatchOverMaxStorageBufferRangeNamesTheLimit) {
   // 27 dims = 7 vec4s = 112 bytes per query: 1024 queries need 114688 bytes.
   MMVK_VULKAN_CONTEXT(context, capped(65536, 0, 0));
   const Database db = synthetic_database({.frames = 500, .clips = 2});
-  const Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options(1024));
+  const Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(*context, db, small_options(1024));
   ASSERT_FALSE(search.ok());
   EXPECT_TRUE(contains(search.message(), "the query buffer for max_batch = 1024 queries needs 114688 bytes"))
       << search.message();
   EXPECT_TRUE(contains(search.message(), "maxStorageBufferRange of 65536 bytes")) << search.message();
   EXPECT_TRUE(contains(search.message(), "lower max_batch to at most 585")) << search.message();
   // The advice is right: 585 queries fit.
-  const Result<std::unique_ptr<VulkanSearch>> fits = VulkanSearch::create(*context, db, small_options(585));
+  const Result<std::unique_ptr<VulkanBruteForce>> fits = VulkanBruteForce::create(*context, db, small_options(585));
   ASSERT_TRUE(fits.ok()) << fits.message();
   // ... and search right, in scratch chunks under the lowered range.
   const std::vector<float> queries = synthetic_queries(db, 585, 3);
@@ -71,8 +71,8 @@ TEST(VulkanLimits, BatchOverLavapipesOwnStorageRangeNamesTheLimit) {
   const Database db = synthetic_database({.frames = 300, .clips = 2, .channel_dims = {64, 64}});
   const std::uint64_t needed = std::uint64_t{kMaxBatch} * 32 * 16;
   if (needed <= context->properties().limits.maxStorageBufferRange) GTEST_SKIP() << "the device's range is larger";
-  const Result<std::unique_ptr<VulkanSearch>> search =
-      VulkanSearch::create(*context, db, small_options(static_cast<std::uint32_t>(kMaxBatch)));
+  const Result<std::unique_ptr<VulkanBruteForce>> search =
+      VulkanBruteForce::create(*context, db, small_options(static_cast<std::uint32_t>(kMaxBatch)));
   ASSERT_FALSE(search.ok());
   EXPECT_TRUE(contains(search.message(), std::to_string(needed) + " bytes, over the device's maxStorageBufferRange"))
       << search.message();
@@ -81,7 +81,7 @@ TEST(VulkanLimits, BatchOverLavapipesOwnStorageRangeNamesTheLimit) {
 TEST(VulkanLimits, DatabaseOverMaxTexelBufferElementsNamesTheLimit) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 1000, 0));
   const Database db = synthetic_database({.frames = 500, .clips = 2});  // 504 (groups of 8) x 7 = 3528 texels
-  const Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options());
+  const Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(*context, db, small_options());
   ASSERT_FALSE(search.ok());
   EXPECT_TRUE(contains(search.message(), "500 frames, 504 in groups of 8, x 7 texels) needs 3528 texels")) << search.message();
   EXPECT_TRUE(contains(search.message(), "maxTexelBufferElements of 1000")) << search.message();
@@ -92,7 +92,7 @@ TEST(VulkanLimits, DatabaseOverTheDeviceHeapNamesTheHeap) {
   // scanned frames and their terms) = 78448 bytes.
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 65536));
   const Database db = synthetic_database({.frames = 500, .clips = 2});
-  const Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options());
+  const Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(*context, db, small_options());
   ASSERT_FALSE(search.ok());
   EXPECT_TRUE(contains(search.message(), "the database (500 frames x 27 dims) needs 78448 bytes of device memory"))
       << search.message();
@@ -104,7 +104,7 @@ TEST(VulkanLimits, SlotsOverTheHostVisibleHeapNameTheSlots) {
   const Database db = synthetic_database({.frames = 500, .clips = 2});
   VulkanSearchOptions options = small_options(1024);
   options.scratch_bytes = 1 << 20;
-  const Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, options);
+  const Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(*context, db, options);
   ASSERT_FALSE(search.ok());
   EXPECT_TRUE(contains(search.message(), "2 submission slots of max_batch = 1024 queries needs")) << search.message();
 }
@@ -112,8 +112,8 @@ TEST(VulkanLimits, SlotsOverTheHostVisibleHeapNameTheSlots) {
 TEST(VulkanLimits, MaxBatchOverKMaxBatchIsAnError) {
   MMVK_VULKAN_CONTEXT(context, ContextOptions{});
   const Database db = synthetic_database({.frames = 100, .clips = 2});
-  const Result<std::unique_ptr<VulkanSearch>> search =
-      VulkanSearch::create(*context, db, small_options(0xFFFFFFFFu));
+  const Result<std::unique_ptr<VulkanBruteForce>> search =
+      VulkanBruteForce::create(*context, db, small_options(0xFFFFFFFFu));
   ASSERT_FALSE(search.ok());
   EXPECT_TRUE(contains(search.message(), "max_batch = 4294967295 is out of range [1, 1048576]")) << search.message();
 }
@@ -129,7 +129,7 @@ struct Fixture {
   std::unique_ptr<VulkanSearch> search;
 
   explicit Fixture(Context& context) {
-    Result<std::unique_ptr<VulkanSearch>> made = VulkanSearch::create(context, db, small_options());
+    Result<std::unique_ptr<VulkanBruteForce>> made = VulkanBruteForce::create(context, db, small_options());
     EXPECT_TRUE(made.ok()) << made.message();
     if (made.ok()) search = std::move(made).value();
   }
@@ -158,37 +158,37 @@ TEST(VulkanDeviceLoss, LostAtSubmitIsAnErrorAndTheSearchStaysSafe) {
     ASSERT_FALSE(again.ok());
     expect_lost(again.message(), "vkQueueSubmit");
   }
-  const Result<std::unique_ptr<VulkanSearch>> another = VulkanSearch::create(*context, f.db, small_options());
+  const Result<std::unique_ptr<VulkanBruteForce>> another = VulkanBruteForce::create(*context, f.db, small_options());
   ASSERT_FALSE(another.ok());
   expect_lost(another.message(), "vkQueueSubmit");
   f.search.reset();  // destroys cleanly
   EXPECT_EQ(context->validation_message_count(), 0u);
 }
 
-TEST(VulkanDeviceLoss, LostWhileWaitingFreesTheSlotAndReportsOtherTickets) {
+// Two pages in flight on the two slots (8 queries, pages of 4): the wait
+// of the first reports the loss; the second ran on the lost device, so it
+// is waited out without results; both slots are free again, and every
+// later use says lost (not "all slots in flight").
+TEST(VulkanDeviceLoss, LostWhileWaitingFreesEverySlotOfTheBatch) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 0));
   Fixture f(*context);
   ASSERT_TRUE(f.search);
-  VulkanSearch& s = *f.search;
-  // Two tickets in flight; the first wait reports the loss.
-  const Result<vulkan::Ticket> first = s.submit(f.batch(), 4);
-  const Result<vulkan::Ticket> second = s.submit(f.batch(), 4);
-  ASSERT_TRUE(first.ok() && second.ok());
+  Result<std::unique_ptr<VulkanBruteForce>> paged = VulkanBruteForce::create(*context, f.db, small_options(4));
+  ASSERT_TRUE(paged.ok()) << paged.message();
+  vulkan::VulkanAsyncSearch async(**paged, 8);
+  std::vector<Match> out(8);
+  ASSERT_TRUE(async.submit(f.batch()).ok());
   context->inject_fault("vkWaitForFences", VK_ERROR_DEVICE_LOST);
-  const Status waited = s.wait(*first, f.out);
+  const Status waited = async.collect(out);
   ASSERT_FALSE(waited.ok());
   expect_lost(waited.message(), "vkWaitForFences");
-  // The other ticket ran on the lost device: an error too, not results.
-  const Result<bool> polled = s.poll(*second);
-  ASSERT_FALSE(polled.ok());
-  expect_lost(polled.message(), "vkWaitForFences");
-  const Status other = s.wait(*second, f.out);
-  ASSERT_FALSE(other.ok());
-  expect_lost(other.message(), "vkWaitForFences");
-  // Both slots are free again (no "all slots in flight"), and say lost.
-  const Result<vulkan::Ticket> next = s.submit(f.batch(), 4);
+  const Status next = async.submit(f.batch());
   ASSERT_FALSE(next.ok());
   expect_lost(next.message(), "vkWaitForFences");
+  // Another search on the same device fails the same way.
+  const Status other = f.search->search(f.batch(), 4, f.out);
+  ASSERT_FALSE(other.ok());
+  expect_lost(other.message(), "vkWaitForFences");
   EXPECT_EQ(context->validation_message_count(), 0u);
 }
 
@@ -217,7 +217,7 @@ TEST(VulkanDeviceLoss, AsyncSearchFreesItsSlotsAfterAFailedChunk) {
   MMVK_VULKAN_CONTEXT(context, capped(0, 0, 0));
   const Database db = synthetic_database({.frames = 600, .clips = 3, .seed = 6});
   VulkanSearchOptions options = small_options(8);  // 32 queries = 4 chunks on 2 slots
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, options);
+  Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(*context, db, options);
   ASSERT_TRUE(search.ok()) << search.message();
   vulkan::VulkanAsyncSearch async(**search, 32);
   const std::vector<float> queries = synthetic_queries(db, 32, 4);

@@ -36,7 +36,7 @@ const Database& test_database() {
 // reference on a few batches.
 void expect_search_matches(Context& context, bool call_warm_up) {
   const Database& db = test_database();
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(context, db, small_options(!call_warm_up));
+  Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(context, db, small_options(!call_warm_up));
   ASSERT_TRUE(search.ok()) << search.message();
   if (call_warm_up) {
     ASSERT_TRUE((*search)->warm_up().ok());
@@ -63,7 +63,7 @@ std::unique_ptr<Context> another_context(const ContextOptions& options) {
 }
 
 std::vector<std::byte> blob_after_search(Context& context) {
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(context, test_database(), small_options(true));
+  Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(context, test_database(), small_options(true));
   EXPECT_TRUE(search.ok()) << search.message();
   Result<std::vector<std::byte>> blob = context.pipeline_cache_data();
   EXPECT_TRUE(blob.ok()) << blob.message();
@@ -147,7 +147,7 @@ TEST(PipelineCache, WarmUpThenSearchMatchesReference) {
 TEST(PipelineCache, WarmUpKeepsTheCallersStatistics) {
   MMVK_VULKAN_CONTEXT(context, ContextOptions{});
   const Database& db = test_database();
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(*context, db, small_options(false));
+  Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(*context, db, small_options(false));
   ASSERT_TRUE(search.ok()) << search.message();
   const std::vector<float> queries = synthetic_queries(db, 3, 9);
   std::vector<Match> out(3);

@@ -1,6 +1,6 @@
 // VulkanSearch against ReferenceSearch on cases the shared backend suite
 // does not cover: the large-N loop-limit pitfall, every kernel variant
-// (K 1/4/16 x tile 1/4/16), chunked batches, async submit/poll/wait,
+// (K 1/4/16 x tile 1/4/16), chunked batches, async submit/collect,
 // timestamps and the validation layer with zero messages.
 #include <bit>
 #include <chrono>
@@ -9,6 +9,8 @@
 #include <thread>
 
 #include "mmvk/reference_search.hpp"
+#include "mmvk/vulkan/vulkan_async_search.hpp"
+#include "mmvk/vulkan/vulkan_cluster_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/search_test_data.hpp"
 #include "support/test_data.hpp"
@@ -30,7 +32,7 @@ ContextOptions index_options(std::uint32_t index) {
 }
 
 std::unique_ptr<VulkanSearch> make_search(Context& context, const Database& db, const VulkanSearchOptions& options = {}) {
-  Result<std::unique_ptr<VulkanSearch>> search = VulkanSearch::create(context, db, options);
+  Result<std::unique_ptr<VulkanBruteForce>> search = VulkanBruteForce::create(context, db, options);
   EXPECT_TRUE(search.ok()) << search.message();
   return search.ok() ? std::move(search).value() : nullptr;
 }
@@ -181,59 +183,48 @@ TEST(VulkanSearch, LargestTileMatchesReference) {
   compare(*search, db, queries, {}, 600, 1);
 }
 
-TEST(VulkanSearch, AsyncSubmitPollWait) {
+// The one asynchronous interface (AsyncSearch): submit() returns while the
+// pages run, a second submit() before collect() is an error, not a block,
+// and a blocking search() meanwhile runs on the slots the batch leaves free.
+TEST(VulkanSearch, AsyncSubmitCollect) {
   MMVK_VULKAN_CONTEXT(context, ContextOptions{});
   const Database db = synthetic_database({.frames = 4000, .seed = 109, .constraints = true});
   VulkanSearchOptions options;
   options.max_batch = 32;
-  options.slots = 2;
+  options.slots = 3;
   options.max_tile = 4;
   std::unique_ptr<VulkanSearch> search = make_search(*context, db, options);
   ASSERT_NE(search, nullptr);
   ReferenceSearch reference(db);
-  const std::vector<float> a = synthetic_queries(db, 32, 110);
+  const std::vector<float> a = synthetic_queries(db, 64, 110);
   const std::vector<float> b = synthetic_queries(db, 5, 111);
-  const std::vector<QueryParams> params = random_params(db, 32, 112);
+  const std::vector<QueryParams> params = random_params(db, 64, 112);
+  vulkan::VulkanAsyncSearch async(*search, 64);
 
-  Result<vulkan::Ticket> first = search->submit(QueryBatch{a, params, 32}, 3);
-  ASSERT_TRUE(first.ok()) << first.message();
-  Result<vulkan::Ticket> second = search->submit(QueryBatch{b, {}, 5}, 1);
-  ASSERT_TRUE(second.ok()) << second.message();
-  // Every slot is in flight: a third submit is an error, not a block.
-  Result<vulkan::Ticket> third = search->submit(QueryBatch{b, {}, 5}, 1);
-  ASSERT_FALSE(third.ok());
-  EXPECT_NE(third.message().find("in flight"), std::string::npos) << third.message();
-
-  // poll() turns true without wait(); then wait() out of submission order.
-  for (int i = 0; i < 2000; ++i) {
-    Result<bool> done = search->poll(*second);
-    ASSERT_TRUE(done.ok()) << done.message();
-    if (*done) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  std::vector<Match> out_b(5);
-  ASSERT_TRUE(search->wait(*second, out_b).ok());
-  expect_identical(run_search(reference, b, {}, 5, 1), out_b, 1, {}, "vulkan async");
-  std::vector<Match> out_a(32 * 3);
-  ASSERT_TRUE(search->wait(*first, out_a).ok());
-  expect_identical(run_search(reference, a, params, 32, 3), out_a, 3, params, "vulkan async");
-
-  // A ticket is consumed by wait(); its slot is reused by the next submit.
-  EXPECT_FALSE(search->wait(*first, out_a).ok());
-  EXPECT_FALSE(search->poll(*second).ok());
-  Result<vulkan::Ticket> again = search->submit(QueryBatch{b, {}, 5}, 1);
-  ASSERT_TRUE(again.ok()) << again.message();
-  std::vector<Match> wrong_size(4);
-  EXPECT_FALSE(search->wait(*again, wrong_size).ok());
-  ASSERT_TRUE(search->wait(*again, out_b).ok());
-  expect_identical(run_search(reference, b, {}, 5, 1), out_b, 1, {}, "vulkan async");
+  // Two pages on two of the three slots.
+  ASSERT_TRUE(async.submit(QueryBatch{a, params, 64}).ok());
+  const Status twice = async.submit(QueryBatch{a, params, 64});
+  ASSERT_FALSE(twice.ok());
+  EXPECT_NE(twice.message().find("in flight"), std::string::npos) << twice.message();
+  // The blocking search of k = 3 on the third slot, while the batch runs.
+  const std::vector<Match> blocking = run_search(*search, b, {}, 5, 3);
+  expect_identical(run_search(reference, b, {}, 5, 3), blocking, 3, {}, "vulkan search beside an async batch");
+  std::vector<Match> out_a(64);
+  std::vector<Match> wrong_size(63);
+  EXPECT_FALSE(async.collect(wrong_size).ok());  // waits the pages out: the slots are free again
+  EXPECT_FALSE(async.collect(out_a).ok());       // nothing submitted
+  ASSERT_TRUE(async.submit(QueryBatch{a, params, 64}).ok());
+  ASSERT_TRUE(async.collect(out_a).ok());
+  expect_identical(run_search(reference, a, params, 64, 1), out_a, 1, params, "vulkan async");
+  // Over its capacity.
+  EXPECT_FALSE(vulkan::VulkanAsyncSearch(*search, 4).submit(QueryBatch{b, {}, 5}).ok());
 
   // lavapipe's queue has timestamps: the kernel time is measured.
   if (context->timestamp_valid_bits() != 0) {
     ASSERT_TRUE(search->last_kernel_seconds().has_value());
     EXPECT_GT(*search->last_kernel_seconds(), 0.0);
   }
-  EXPECT_EQ(search->stats().queries, 42u);
+  EXPECT_EQ(search->stats().queries, 64u + 5u + 64u);
 }
 
 TEST(VulkanSearch, ErrorsAreReturned) {
@@ -244,11 +235,8 @@ TEST(VulkanSearch, ErrorsAreReturned) {
   ASSERT_NE(search, nullptr);
   const std::vector<float> queries = synthetic_queries(db, 9, 114);
   std::vector<Match> out(9 * 4);
-  // A page (submit) over max_batch, k over max_k.
-  Status status = search->submit(QueryBatch{queries, {}, 9}, 1).status();
-  ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("max_batch"), std::string::npos) << status.message();
-  status = search->search(QueryBatch{std::span<const float>(queries).first(8 * db.dims()), {}, 8}, 5,
+  // k over max_k.
+  Status status = search->search(QueryBatch{std::span<const float>(queries).first(8 * db.dims()), {}, 8}, 5,
                           std::span<Match>(out).first(8 * 5));
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("max_k"), std::string::npos) << status.message();
@@ -258,12 +246,12 @@ TEST(VulkanSearch, ErrorsAreReturned) {
                   .ok());
 
   // Options out of range.
-  EXPECT_FALSE(VulkanSearch::create(*context, db, search_options(0, 1)).ok());
-  EXPECT_FALSE(VulkanSearch::create(*context, db, search_options(8, 17)).ok());
-  EXPECT_FALSE(VulkanSearch::create(*context, db, search_options(8, 1, 8)).ok());
+  EXPECT_FALSE(VulkanBruteForce::create(*context, db, search_options(0, 1)).ok());
+  EXPECT_FALSE(VulkanBruteForce::create(*context, db, search_options(8, 17)).ok());
+  EXPECT_FALSE(VulkanBruteForce::create(*context, db, search_options(8, 1, 8)).ok());
   VulkanSearchOptions too_many_rows;
   too_many_rows.rows_per_invocation = 40000;
-  EXPECT_FALSE(VulkanSearch::create(*context, db, too_many_rows).ok());
+  EXPECT_FALSE(VulkanBruteForce::create(*context, db, too_many_rows).ok());
 
   // A cluster table from another database.
   const Database other = synthetic_database({.frames = 1000, .seed = 115});
@@ -273,15 +261,13 @@ TEST(VulkanSearch, ErrorsAreReturned) {
   table.cluster_count = 1;
   table.offsets = {0, other.frame_count()};
   table.members.resize(other.frame_count());
-  VulkanSearchOptions cluster_options;
-  cluster_options.mode = vulkan::SearchMode::ClustersExact;
-  Result<std::unique_ptr<VulkanSearch>> mismatched = VulkanSearch::create(*context, db, cluster_options, &table);
+  Result<std::unique_ptr<vulkan::VulkanClusterSearch>> mismatched = vulkan::VulkanClusterSearch::create(*context, db, table);
   ASSERT_FALSE(mismatched.ok());
   EXPECT_NE(mismatched.message().find("does not belong"), std::string::npos) << mismatched.message();
 
   // More dims than the kernels support.
   const Database wide = synthetic_database({.frames = 50, .clips = 1, .seed = 116, .channel_dims = {100, 40}});
-  Result<std::unique_ptr<VulkanSearch>> too_wide = VulkanSearch::create(*context, wide);
+  Result<std::unique_ptr<VulkanBruteForce>> too_wide = VulkanBruteForce::create(*context, wide);
   ASSERT_FALSE(too_wide.ok());
   EXPECT_NE(too_wide.message().find("128"), std::string::npos) << too_wide.message();
 }

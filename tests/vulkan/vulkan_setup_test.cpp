@@ -1,8 +1,8 @@
 // The Vulkan backend's setup helpers (runtime/vulkan/src: descriptors.hpp,
 // pipeline.hpp, scan_rows.hpp; white-box, through the private headers): what
 // they refuse before anything reaches the driver, and the brute force's
-// frame-to-row maps. And VulkanSearch::create validating a cluster table
-// once, whatever the mode.
+// frame-to-row maps. And VulkanClusterSearch::create validating its cluster
+// table, exact or nprobe.
 #include <array>
 #include <cstdint>
 #include <utility>
@@ -11,6 +11,7 @@
 #include "memory.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/thread_pool.hpp"
+#include "mmvk/vulkan/vulkan_cluster_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "pipeline.hpp"
 #include "scan_rows.hpp"
@@ -141,9 +142,9 @@ TEST(VulkanSetup, SkippedFramesBecomeScanRows) {
   EXPECT_EQ(skipped_scan_rows({}, p), (Ranges{0, 2, 5, 1}));
 }
 
-// The table is checked in full (validate_cluster_table) even in BruteForce
-// mode, where it goes unused: one check, whatever the mode.
-TEST(VulkanSetup, CreateValidatesTheClusterTableInEveryMode) {
+// The cluster search checks its table in full (validate_cluster_table).
+// (The brute force takes no table.)
+TEST(VulkanSetup, CreateValidatesTheClusterTable) {
   MMVK_VULKAN_CONTEXT(context, vulkan::ContextOptions{});
   const Database db = synthetic_database({.frames = 1000, .seed = 71});
   ThreadPool pool{2};
@@ -155,16 +156,18 @@ TEST(VulkanSetup, CreateValidatesTheClusterTableInEveryMode) {
   vulkan::VulkanSearchOptions options;
   options.warm_up = false;
   options.max_batch = 4;
-  ASSERT_TRUE(vulkan::VulkanSearch::create(*context, db, options, &table).ok());
+  ASSERT_TRUE(vulkan::VulkanClusterSearch::create(*context, db, table, options).ok());
 
   // Same database, malformed: two members of one cluster swapped (members
   // must ascend within a cluster).
   std::uint32_t c = 0;
   while (table.offsets[c + 1] - table.offsets[c] < 2) ++c;
   std::swap(table.members[table.offsets[c]], table.members[table.offsets[c] + 1]);
-  for (const vulkan::SearchMode mode : {vulkan::SearchMode::BruteForce, vulkan::SearchMode::ClustersExact}) {
-    options.mode = mode;
-    Result<std::unique_ptr<vulkan::VulkanSearch>> created = vulkan::VulkanSearch::create(*context, db, options, &table);
+  for (const std::uint32_t nprobe : {0u, 8u}) {
+    vulkan::VulkanClusterOptions cluster_options;
+    cluster_options.nprobe = nprobe;
+    Result<std::unique_ptr<vulkan::VulkanClusterSearch>> created =
+        vulkan::VulkanClusterSearch::create(*context, db, table, options, cluster_options);
     ASSERT_FALSE(created.ok());
     EXPECT_NE(created.message().find("members are not in ascending order"), std::string::npos) << created.message();
   }

@@ -13,6 +13,7 @@
 #include "mmvk/backends.hpp"
 #include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/context.hpp"
+#include "mmvk/vulkan/vulkan_brute_force.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 
 namespace mmvk::test {
@@ -20,6 +21,7 @@ namespace mmvk::test {
 // The Vulkan types every Vulkan test names.
 using vulkan::Context;
 using vulkan::ContextOptions;
+using vulkan::VulkanBruteForce;
 using vulkan::VulkanSearch;
 using vulkan::VulkanSearchOptions;
 

@@ -4,28 +4,47 @@
 #include <optional>
 #include <utility>
 
+#include "mmvk/vulkan/vulkan_brute_force.hpp"
+#include "mmvk/vulkan/vulkan_cluster_search.hpp"
+
 namespace mmvk::vulkan {
 
 namespace {
 
-BackendFactory factory(const ContextSource& context, const VulkanSearchOptions& base, SearchMode mode) {
-  return [context, base, mode](const BackendSpec& spec, const Database& database)
-             -> Result<std::unique_ptr<SearchBackend>> {
+// The options a BackendSpec sets; `base` the rest.
+VulkanSearchOptions spec_options(const BackendSpec& spec, const VulkanSearchOptions& base) {
+  VulkanSearchOptions options = base;
+  options.max_batch = spec.max_batch;
+  options.max_k = spec.max_k;
+  options.max_tile = spec.max_tile;
+  options.warm_up = spec.warm_up;
+  return options;
+}
+
+BackendFactory brute_force_factory(const ContextSource& context, const VulkanSearchOptions& base) {
+  return [context, base](const BackendSpec& spec, const Database& database) -> Result<std::unique_ptr<SearchBackend>> {
     if (!context) return make_error("backend '" + spec.name + "': no Vulkan context source");
     MMVK_ASSIGN_OR_RETURN(Context* device, context());
-    VulkanSearchOptions options = base;
-    options.mode = mode;
-    options.nprobe = spec.nprobe;
-    options.max_batch = spec.max_batch;
-    options.max_k = spec.max_k;
-    options.max_tile = spec.max_tile;
-    options.warm_up = spec.warm_up;
+    MMVK_ASSIGN_OR_RETURN(std::unique_ptr<VulkanBruteForce> search,
+                          VulkanBruteForce::create(*device, database, spec_options(spec, base)));
+    return std::unique_ptr<SearchBackend>(std::move(search));
+  };
+}
+
+// `probe`: vulkan-nprobe (spec.nprobe clusters per query), else exact.
+BackendFactory cluster_factory(const ContextSource& context, const VulkanSearchOptions& base, bool probe) {
+  return [context, base, probe](const BackendSpec& spec,
+                                const Database& database) -> Result<std::unique_ptr<SearchBackend>> {
+    if (!context) return make_error("backend '" + spec.name + "': no Vulkan context source");
+    if (probe && spec.nprobe == 0) return make_error("backend '" + spec.name + "': nprobe must be at least 1");
+    MMVK_ASSIGN_OR_RETURN(Context* device, context());
     std::optional<ClusterTable> trained;
-    const ClusterTable* table = nullptr;
-    if (mode != SearchMode::BruteForce) {
-      MMVK_ASSIGN_OR_RETURN(table, spec_cluster_table(spec, database, trained));
-    }
-    MMVK_ASSIGN_OR_RETURN(std::unique_ptr<VulkanSearch> search, VulkanSearch::create(*device, database, options, table));
+    MMVK_ASSIGN_OR_RETURN(const ClusterTable* table, spec_cluster_table(spec, database, trained));
+    VulkanClusterOptions cluster_options;
+    cluster_options.nprobe = probe ? spec.nprobe : 0;
+    MMVK_ASSIGN_OR_RETURN(std::unique_ptr<VulkanClusterSearch> search,
+                          VulkanClusterSearch::create(*device, database, *table, spec_options(spec, base),
+                                                      cluster_options));
     return std::unique_ptr<SearchBackend>(std::move(search));
   };
 }
@@ -37,11 +56,11 @@ Status add_backends(BackendRegistry& registry, Context& context, const VulkanSea
 }
 
 Status add_backends(BackendRegistry& registry, ContextSource context, const VulkanSearchOptions& base) {
-  MMVK_TRY(registry.add({"vulkan-brute", "GPU, exact, every row", factory(context, base, SearchMode::BruteForce)}));
+  MMVK_TRY(registry.add({"vulkan-brute", "GPU, exact, every row", brute_force_factory(context, base)}));
   MMVK_TRY(registry.add({"vulkan-clusters", "GPU, exact, rows pruned by k-means cluster bounds",
-                         factory(context, base, SearchMode::ClustersExact), true}));
+                         cluster_factory(context, base, false), true}));
   MMVK_TRY(registry.add({"vulkan-nprobe", "GPU, approximate: the nprobe clusters with the nearest centroids",
-                         factory(context, base, SearchMode::NProbe), true, true}));
+                         cluster_factory(context, base, true), true, true}));
   return {};
 }
 

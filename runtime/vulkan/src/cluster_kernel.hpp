@@ -1,5 +1,5 @@
-// The cluster-pruned kernels (shaders/cluster_*.comp) of VulkanSearch's
-// ClustersExact and NProbe modes: the ClusterTable uploaded once (set 1 of
+// The cluster-pruned kernels (shaders/cluster_*.comp) of
+// VulkanClusterSearch, exact and nprobe: the ClusterTable uploaded once (set 1 of
 // the cluster pipelines), per-slot scratch, and the recording of a batch.
 //
 // Per chunk of queries, twelve dispatches (eight indirect):
@@ -53,7 +53,7 @@ struct ClusterKernelOptions {
   std::uint32_t max_k = 1;
   std::uint32_t slots = 1;
   std::uint32_t nprobe = 0;               // 0 = exact; >= cluster_count is exact too
-  std::uint64_t scratch_bytes = std::uint64_t{512} << 20;  // per slot: VulkanSearchOptions::cluster_scratch_bytes
+  std::uint64_t scratch_bytes = std::uint64_t{512} << 20;  // per slot: VulkanClusterOptions::scratch_bytes
   bool force_staging = false;
   std::vector<SlotQueryBuffers> slot_queries;  // one per slot
 };
@@ -61,7 +61,7 @@ struct ClusterKernelOptions {
 class ClusterKernel {
  public:
   // `table` must have been validated against the database of `shape`
-  // (validate_cluster_table; VulkanSearch::create does it once).
+  // (validate_cluster_table; VulkanClusterSearch::create does it once).
   static Result<ClusterKernel> create(const Context& context, VkCommandPool pool, VkDescriptorSetLayout search_layout,
                                       const KernelShape& shape, const Database& database, const ClusterTable& table,
                                       const ClusterKernelOptions& options);

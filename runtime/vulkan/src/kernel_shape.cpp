@@ -64,11 +64,11 @@ bool unit_cost_terms(const Database& database) {
 }  // namespace
 
 Result<KernelShape> make_kernel_shape(const Context& context, const Database& database,
-                                      const VulkanSearchOptions& options) {
+                                      const VulkanSearchOptions& options, bool brute_force) {
   KernelShape shape;
   shape.frame_count = database.frame_count();
-  // Only the brute force scans scan_frames; the cluster modes upload none.
-  shape.scan_rows = options.mode == SearchMode::BruteForce ? scan_row_count(database) : 0;
+  // Only the brute force scans scan_frames; the cluster search uploads none.
+  shape.scan_rows = brute_force ? scan_row_count(database) : 0;
   shape.dims = database.dims();
   shape.dim_vec4s = (shape.dims + 3) / 4;
   // Channel ends as a bit mask over dims.

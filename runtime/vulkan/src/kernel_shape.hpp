@@ -37,7 +37,7 @@ inline constexpr std::uint32_t kMaxScanBlocks = 16384;         // topk_merge loo
 
 struct KernelShape {
   std::uint32_t frame_count = 0;
-  std::uint32_t scan_rows = 0;       // frames the brute-force scan visits (device_database.hpp); 0 in cluster modes
+  std::uint32_t scan_rows = 0;       // frames the brute-force scan visits (device_database.hpp); 0 for the cluster search
   std::uint32_t dims = 0;
   std::uint32_t dim_vec4s = 0;
   std::uint32_t channels = 0;        // non-empty schema channels
@@ -57,9 +57,10 @@ std::uint32_t k_class(std::uint32_t k);
 std::vector<std::uint32_t> weighted_channels(const FeatureSchema& schema);
 
 // The shape of `database`'s kernels on this device with these options
-// (options already checked by VulkanSearch::create).
+// (options already checked by the search's create()); `brute_force`: the
+// search scans scan_frames (VulkanBruteForce), else it scans none.
 Result<KernelShape> make_kernel_shape(const Context& context, const Database& database,
-                                      const VulkanSearchOptions& options);
+                                      const VulkanSearchOptions& options, bool brute_force);
 
 // The specialization constants every kernel declares (kernel_shape.glsl)
 // for kept-pairs class `k`; kernels with more append theirs.

@@ -5,10 +5,12 @@
 #include <memory>
 #include <string>
 
+#include "vulkan_search_impl.hpp"
+
 namespace mmvk::vulkan {
 
 // Here rather than in vulkan_search.cpp: the search does not depend on its
-// deferred wrapper's definition.
+// asynchronous interface's definition.
 std::unique_ptr<AsyncSearch> VulkanSearch::make_async(std::uint32_t capacity) {
   return std::make_unique<VulkanAsyncSearch>(*this, capacity);
 }
@@ -22,8 +24,11 @@ Status VulkanAsyncSearch::submit(const QueryBatch& batch) {
     return make_error("vulkan async search: batch of " + std::to_string(batch.size) + " queries, capacity " +
                       std::to_string(capacity_));
   }
-  // The pages beyond the free slots go out in collect() as slots free up.
-  MMVK_TRY(search_.submit_batch(batch, 1));
+  VulkanSearch::Impl& impl = *search_.impl_;
+  if (impl.async.active()) {
+    return make_error("vulkan async search: another asynchronous search of this VulkanSearch is in flight");
+  }
+  MMVK_TRY(impl.begin_batch(impl.async, batch, 1));
   in_flight_ = true;
   return {};
 }
@@ -31,7 +36,8 @@ Status VulkanAsyncSearch::submit(const QueryBatch& batch) {
 Status VulkanAsyncSearch::collect(std::span<Match> out) {
   if (!in_flight_) return make_error("vulkan async search: collect without a submitted search");
   in_flight_ = false;
-  return search_.wait_batch(out);
+  VulkanSearch::Impl& impl = *search_.impl_;
+  return impl.async.finish(impl, out);
 }
 
 }  // namespace mmvk::vulkan

@@ -1,8 +1,10 @@
-// The crowd controller's deferred search on a VulkanSearch: submit() records
-// the tick's batch on the GPU and returns at once, collect() (next tick)
-// waits and copies the matches out, so the search overlaps the caller's
-// simulation step. A batch larger than the search's max_batch is paged by
-// the search itself (VulkanSearch::submit_batch).
+// VulkanAsyncSearch: the AsyncSearch (mmvk/async_search.hpp) of a
+// VulkanSearch, its one asynchronous interface. submit() checks the
+// batch, stages its first pages and starts them on the GPU, returning at
+// once; collect() (the crowd's next tick) waits for them oldest first,
+// submitting the rest as slots free up, and copies the matches out, so the
+// search overlaps the caller's simulation step. Paged by the search's own
+// pager (as search() is), so a batch may be larger than max_batch.
 #pragma once
 
 #include <cstdint>
@@ -16,11 +18,17 @@ namespace mmvk::vulkan {
 class VulkanAsyncSearch final : public AsyncSearch {
  public:
   // `search` must outlive this; `capacity` = the largest batch submitted
-  // (the controller's character count), at most kMaxBatch.
+  // (the controller's character count), at most kMaxBatch. One
+  // asynchronous batch per search at a time; a blocking search() meanwhile
+  // runs on the slots it leaves free.
   VulkanAsyncSearch(VulkanSearch& search, std::uint32_t capacity);
 
   const Database& database() const override { return search_.database(); }
+  // Errors: a batch in flight (collect it first), over capacity,
+  // validate_queries, a failed submit (nothing is left in flight).
   Status submit(const QueryBatch& batch) override;
+  // Errors: nothing submitted, `out` not batch.size matches, a failed wait
+  // or submit of a later page (every page is waited out first).
   Status collect(std::span<Match> out) override;
 
  private:

@@ -109,6 +109,22 @@ TEST(Normalization, ZeroSpreadIsAnErrorNamingTheChannel) {
   EXPECT_NE(n.message().find("channel 'group' has zero spread"), std::string::npos) << n.message();
 }
 
+// A schema weight of 1e38 or more (the scale spread / weight underflows to a
+// denormal) made the normalized features infinite; the build then named a
+// frame's feature, not the weight.
+TEST(Normalization, AWeightThatOverflowsTheFeaturesIsNamed) {
+  FeatureSchema schema;
+  schema.channels = {channel("hips", Normalization::PerDimStd, 3e38f)};
+  const std::vector<float> values = random_features(50, 3, 3);
+  Result<std::vector<DimNormalization>> n = compute_normalization(schema, values);
+  ASSERT_FALSE(n.ok());
+  EXPECT_NE(n.message().find("channel 'hips': weight 3e+38 scales its features beyond float's range"),
+            std::string::npos)
+      << n.message();
+  schema.channels[0].weight = 1e30f;  // large, but its features stay finite
+  EXPECT_TRUE(compute_normalization(schema, values).ok());
+}
+
 TEST(Normalization, RejectsAMatrixOfTheWrongShape) {
   const FeatureSchema schema = four_mode_schema();
   std::vector<float> values(13, 1.0f);

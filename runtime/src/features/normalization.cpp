@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "common/name_table.hpp"
+#include "mmvk/number_text.hpp"
 
 namespace mmvk {
 
@@ -128,6 +130,15 @@ Result<std::vector<DimNormalization>> compute_normalization(const FeatureSchema&
       if (!(result[d].scale > 0.0f) || !std::isfinite(result[d].scale) || !std::isfinite(result[d].offset)) {
         return make_error("normalization: channel '" + channel.name + "', dimension " + schema.dim_name(d) +
                           " has an unusable scale " + std::to_string(result[d].scale));
+      }
+      // scale = spread / weight: a huge weight makes the normalized features
+      // themselves overflow, which the build found later as "feature ... is
+      // not finite", naming a frame instead of the weight.
+      const double reach = std::max(std::abs(stats[d].max - double(result[d].offset)),
+                                    std::abs(stats[d].min - double(result[d].offset)));
+      if (!(reach / double(result[d].scale) <= double(std::numeric_limits<float>::max()))) {
+        return make_error("normalization: channel '" + channel.name + "': weight " + number_text(channel.weight) +
+                          " scales its features beyond float's range (dimension " + schema.dim_name(d) + "); lower it");
       }
     }
     first += n;

@@ -10,6 +10,7 @@
 #include "mmvk/hash.hpp"
 #include "mmvk/database_build.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/feature_schema.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/manifest.hpp"
 
@@ -32,9 +33,13 @@ Result<std::uint64_t> source_digest(const std::filesystem::path& source, const M
     MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(source, ReadOptions{kMaxJsonBytes, false}));
     hash.add_text(bytes);
   }
-  for (const ManifestClip& clip : manifest.clips) {
-    MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(clip.file));
-    hash.add_text(clip.file.filename().string());
+  // The schema as parsed, inline or from its own file, and every file the
+  // build reads (clips and sidecars): editing a schema file the manifest
+  // names used to reuse the entry built with the old one.
+  hash.add_text(schema_to_json(manifest.schema));
+  for (const std::filesystem::path& file : manifest_input_files(manifest)) {
+    MMVK_ASSIGN_OR_RETURN(const std::string bytes, read_file(file));
+    hash.add_text(file.filename().string());
     hash.add_text(bytes);
   }
   return hash.digest();

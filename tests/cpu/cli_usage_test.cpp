@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "mmvk/database_io.hpp"
 #include "support/command.hpp"
 #include "support/test_data.hpp"
 
@@ -119,6 +120,25 @@ TEST_F(CliUsage, TheLastOfARepeatedOptionCounts) {
   EXPECT_EQ(ran.exit_code, 1) << ran.output;
   EXPECT_FALSE(contains(ran.output, "--threads")) << ran.output;
   EXPECT_TRUE(contains(ran.output, "absent")) << ran.output;
+}
+
+TEST_F(CliUsage, VersionPrintsTheFormatItWrites) {
+  const auto ran = run_command(mmvk_ + " --version");
+  EXPECT_EQ(ran.exit_code, 0) << ran.output;
+  EXPECT_TRUE(contains(ran.output, "mmvk 0.")) << ran.output;
+  EXPECT_TRUE(contains(ran.output, "writes .mmdb version " + std::to_string(kDatabaseFormatVersion))) << ran.output;
+}
+
+TEST_F(CliUsage, MistypedDataSuggestsTheNearestShippedSet) {
+  const auto ran = run_command(mmvk_ + " crowd --data cmu-walk --agents 2 --seconds 0.1");
+  EXPECT_NE(ran.exit_code, 0) << ran.output;
+  EXPECT_TRUE(contains(ran.output, "cmu-walk: no such file or folder, nor a shipped motion set: did you mean "
+                                   "'cmu-walks'? (shipped: cmu-walk-run, cmu-walks)"))
+      << ran.output;
+  // A path gets no guess: it was not a name.
+  const auto path = run_command(mmvk_ + " crowd --data " + (dir_ / "nowhere").string() + " --agents 2");
+  EXPECT_TRUE(contains(path.output, "nowhere: no such file or folder")) << path.output;
+  EXPECT_FALSE(contains(path.output, "did you mean")) << path.output;
 }
 
 }  // namespace

@@ -2,8 +2,6 @@
 // right (an unknown tag lists the database's tags, a mistyped --data the
 // nearest shipped set, `mmvk --version` the format it writes, a database
 // without animation its possible causes rather than one the user never chose).
-#include <filesystem>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,12 +12,10 @@
 #include "mmvk/database_io.hpp"
 #include "support/command.hpp"
 #include "support/motion_fixtures.hpp"
-#include "support/test_data.hpp"
 
 namespace mmvk {
 namespace {
 
-namespace fs = std::filesystem;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
@@ -51,37 +47,6 @@ TEST(Messages, MissingAnimationNamesEveryCause) {
   EXPECT_TRUE(contains(message, "skeletons differ")) << message;
   EXPECT_TRUE(contains(message, "--no-animation")) << message;
   EXPECT_TRUE(contains(message, "format 1")) << message;
-}
-
-class MessagesCli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const std::optional<fs::path> binary = test::cli_binary();
-    if (!binary) GTEST_SKIP() << "mmvk not built (MMVK_BUILD_HOST=OFF)";
-    dir_ = test::make_temp_dir();
-    mmvk_ = "XDG_CACHE_HOME=" + (dir_ / "cache").string() + " " + binary->string();
-  }
-  fs::path dir_;
-  std::string mmvk_;
-};
-
-TEST_F(MessagesCli, VersionPrintsTheFormatItWrites) {
-  const auto ran = test::run_command(mmvk_ + " --version");
-  EXPECT_EQ(ran.exit_code, 0) << ran.output;
-  EXPECT_TRUE(contains(ran.output, "mmvk 0.")) << ran.output;
-  EXPECT_TRUE(contains(ran.output, "writes .mmdb version " + std::to_string(kDatabaseFormatVersion))) << ran.output;
-}
-
-TEST_F(MessagesCli, MistypedDataSuggestsTheNearestShippedSet) {
-  const auto ran = test::run_command(mmvk_ + " crowd --data cmu-walk --agents 2 --seconds 0.1");
-  EXPECT_NE(ran.exit_code, 0) << ran.output;
-  EXPECT_TRUE(contains(ran.output, "cmu-walk: no such file or folder, nor a shipped motion set: did you mean "
-                                   "'cmu-walks'? (shipped: cmu-walk-run, cmu-walks)"))
-      << ran.output;
-  // A path gets no guess: it was not a name.
-  const auto path = test::run_command(mmvk_ + " crowd --data " + (dir_ / "nowhere").string() + " --agents 2");
-  EXPECT_TRUE(contains(path.output, "nowhere: no such file or folder")) << path.output;
-  EXPECT_FALSE(contains(path.output, "did you mean")) << path.output;
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ std::string data_name(const CrowdSessionOptions& o) {
 // The motion checked for a crowd: it has animation and walks.
 Result<GaitSpeeds> check_motion(const Database& database, const CrowdSessionOptions& o) {
   const std::string caller = o.names == SettingNames::Flags ? "mmvk crowd" : "mmvk.Crowd";
-  if (!database.animation()) return make_error(data_name(o) + ": " + missing_animation_error(caller).message);
+  if (!database.animation()) return make_error(data_name(o) + ": " + missing_animation_error(caller, database.no_animation_reason()).message);
   Result<GaitSpeeds> speeds = measure_gait_speeds(database);
   if (!speeds) return make_error(data_name(o) + ": " + speeds.message());
   return speeds;

@@ -255,6 +255,9 @@ TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {
   auto built = run_command(mmvk_ + " build " + manifest + " --no-animation -o " + no_animation);
   ASSERT_EQ(built.exit_code, 0) << built.output;
   expect_failure("--backend fast-box --agents 5 --data " + no_animation, "mmvk build");
+  // The database records why it has no animation, so the crowd says it.
+  expect_failure("--backend fast-box --agents 5 --data " + no_animation,
+                 "the database has no animation section: built with --no-animation");
 
   const fs::path schema = dir_ / "feet-only.json";
   std::ofstream(schema) << R"({"channels": [{"name": "left_foot", "kind": "bone_position", "bone": "@left_foot"},

@@ -40,7 +40,7 @@ void for_characters(ThreadPool& pool, std::size_t count, const Body& body) {
 
 // The checks of CrowdController::create on its arguments, before anything is built.
 Status check_controller_params(const Database& database, std::uint32_t characters, const ControllerParams& params) {
-  if (database.animation() == nullptr) return missing_animation_error("crowd controller");
+  if (database.animation() == nullptr) return missing_animation_error("crowd controller", database.no_animation_reason());
   if (characters == 0) return make_error("crowd controller: characters must be at least 1");
   // A tick searches every due character in one call (search.hpp's kMaxBatch).
   if (characters > kMaxBatch) {

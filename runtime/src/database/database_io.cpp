@@ -306,6 +306,22 @@ std::string read_animation(Reader& in, std::uint32_t version, AnimationData& a) 
   return {};
 }
 
+// Format 7's record of the import: where each clip's units and up axis
+// came from, and why the animation section is absent.
+bool has_import_record(const DatabaseParts& parts) {
+  return !parts.no_animation_reason.empty() ||
+         std::any_of(parts.clips.begin(), parts.clips.end(),
+                     [](const Clip& clip) { return !clip.units_from.empty() || !clip.axes_from.empty(); });
+}
+
+void write_import_record(Writer& file, const DatabaseParts& parts) {
+  for (const Clip& clip : parts.clips) {
+    file.str(clip.units_from);
+    file.str(clip.axes_from);
+  }
+  file.str(parts.no_animation_reason);
+}
+
 }  // namespace
 
 std::string serialize_database(const Database& database) {
@@ -315,13 +331,13 @@ std::string serialize_database(const Database& database) {
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
   // The oldest version that holds the database, so that older builds read
-  // what they can: 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
+  // what they can: 7 with a record of the import, 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
   // with import units, else 3 with per-frame modifiers, else 2.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
   const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
                                  [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
   const std::uint32_t version =
-      !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
+      has_import_record(parts) ? 7u : !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
   file.u32(version);
   file.u32(0);
   file.u64(0);
@@ -362,6 +378,7 @@ std::string serialize_database(const Database& database) {
     for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
   if (version >= 6) file.str(parts.crowd_settings);
+  if (version >= 7) write_import_record(file, parts);
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
 
@@ -524,6 +541,12 @@ class PayloadReader {
       }
     }
     if (version_ >= 6 && !in_.str(parts.crowd_settings)) return corrupt("crowd settings");
+    if (version_ >= 7) {
+      for (Clip& clip : parts.clips) {
+        if (!in_.str(clip.units_from) || !in_.str(clip.axes_from)) return corrupt("import record of clip '" + clip.name + "'");
+      }
+      if (!in_.str(parts.no_animation_reason)) return corrupt("import record's animation note");
+    }
     if (version_ >= 2) {
       std::uint8_t has_animation = 0;
       if (!in_.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");

@@ -150,7 +150,8 @@ void declare_export(CommandLine& cli, crowd::CrowdOptions& options) {
            "write the same characters into one glTF 2.0 binary: each a skin over its joint nodes, animated at the "
            "tick rate; the poses of both are held in memory until the run ends, at most 512 MiB");
   cli.integer("--export-agents", options.export_agents, "M",
-              "characters in --bvh and --gltf (default " + std::to_string(options.export_agents) + ")", 1);
+              "characters in --bvh and --gltf, the first of the crowd (default " +
+                  std::to_string(crowd::kDefaultExportAgents) + ", or the crowd when smaller)", 1);
 }
 
 // Returns the exit code when the crowd must not run (help, bad options).

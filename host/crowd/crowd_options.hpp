@@ -11,7 +11,8 @@
 
 namespace mmvk::crowd {
 
-// --export-agents' default: the characters --bvh and --gltf write.
+// --export-agents' default: the characters --bvh and --gltf write (or the
+// whole crowd, when it is smaller).
 inline constexpr std::uint32_t kDefaultExportAgents = 10;
 
 struct CrowdOptions : CrowdSettings {
@@ -27,7 +28,7 @@ struct CrowdOptions : CrowdSettings {
   // one BVH per character in `bvh`, one glTF binary `gltf` (pose_export.hpp).
   std::optional<std::filesystem::path> bvh;
   std::optional<std::filesystem::path> gltf;
-  std::uint32_t export_agents = kDefaultExportAgents;
+  std::uint32_t export_agents = 0;  // 0: kDefaultExportAgents, or the crowd when smaller
   // Set by the command line, not by flags.
   std::filesystem::path executable;           // for the shipped data beside an installed binary
   std::filesystem::path cache_dir;            // empty: never cache

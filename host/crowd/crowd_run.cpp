@@ -37,7 +37,8 @@ Result<CrowdSessionOptions> session_options(const CrowdOptions& options, const D
   }
   session.outputs.html = options.html.has_value();
   session.outputs.trace_agents = options.trace ? options.trace_agents : 0;
-  session.outputs.export_agents = options.bvh || options.gltf ? options.export_agents : 0;
+  session.outputs.export_agents =
+      options.bvh || options.gltf ? (options.export_agents > 0 ? options.export_agents : kDefaultExportAgents) : 0;
   session.record = options.html.has_value();
   session.data_label = data.short_label;
   session.data_source = data.label;

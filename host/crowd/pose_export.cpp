@@ -1,5 +1,6 @@
 #include "pose_export.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "bvh_export.hpp"
@@ -7,8 +8,14 @@
 
 namespace mmvk::crowd {
 
+std::uint32_t export_count(const CrowdOptions& options, std::uint32_t crowd_agents) {
+  return options.export_agents > 0 ? options.export_agents : std::min(kDefaultExportAgents, crowd_agents);
+}
+
 Status check_pose_export_paths(const CrowdOptions& options) {
-  if (options.bvh) MMVK_TRY(prepare_bvh_folder(*options.bvh, options.export_agents, "--bvh"));
+  // The files of the largest count the run may take (the crowd is not known yet).
+  const std::uint32_t count = options.export_agents > 0 ? options.export_agents : kDefaultExportAgents;
+  if (options.bvh) MMVK_TRY(prepare_bvh_folder(*options.bvh, count, "--bvh"));
   if (options.gltf) MMVK_TRY(check_gltf_path(*options.gltf, "--gltf"));
   return {};
 }
@@ -20,7 +27,7 @@ Result<std::optional<PoseExport>> PoseExport::open(const CrowdOptions& options, 
                                                    std::uint32_t crowd_agents, std::uint64_t ticks) {
   if (!options.bvh && !options.gltf) return std::optional<PoseExport>();
   const std::string outputs = options.bvh && options.gltf ? "--bvh and --gltf" : options.bvh ? "--bvh" : "--gltf";
-  MMVK_ASSIGN_OR_RETURN(PoseRecorder recorder, PoseRecorder::create(animation, options.export_agents, crowd_agents,
+  MMVK_ASSIGN_OR_RETURN(PoseRecorder recorder, PoseRecorder::create(animation, export_count(options, crowd_agents), crowd_agents,
                                                                     options.rate_hz, ticks, "--export-agents", outputs));
   return std::optional<PoseExport>(PoseExport(options, std::move(recorder)));
 }

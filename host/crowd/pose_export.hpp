@@ -20,6 +20,10 @@ namespace mmvk::crowd {
 // of them. Errors name the option.
 Status check_pose_export_paths(const CrowdOptions& options);
 
+// The characters exported from a crowd of `crowd_agents`: --export-agents,
+// else kDefaultExportAgents or the crowd when smaller.
+std::uint32_t export_count(const CrowdOptions& options, std::uint32_t crowd_agents);
+
 class PoseExport {
  public:
   // Nothing when neither --bvh nor --gltf is given. Errors name

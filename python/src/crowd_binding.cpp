@@ -1,5 +1,6 @@
 // mmvk.Crowd: the crowd host's CrowdSession (host/crowd/crowd_session.hpp)
 // stepped from Python, by its own steering or by another simulator's.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -210,6 +212,17 @@ py::array vec3_array(std::span<const glm::vec3> values, std::vector<py::ssize_t>
   return out;
 }
 
+// A copy of per-joint values of `agents` characters ([agents x joints] vec3
+// or quaternions, x, y, z, w) as float32 [agents x joints x 3|4].
+template <class T>
+py::array per_joint_array(std::span<const T> values, std::uint32_t agents) {
+  constexpr auto width = py::ssize_t(sizeof(T) / sizeof(float));
+  const auto joints = py::ssize_t(values.size() / std::max<std::size_t>(agents, 1));
+  py::array_t<float> out({py::ssize_t(agents), joints, width});
+  std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+  return out;
+}
+
 template <class T>
 py::array copy_array(std::span<const T> values, std::vector<py::ssize_t> shape) {
   py::array_t<T> out(shape);
@@ -362,12 +375,7 @@ void add_state_arrays(py::class_<PyCrowd>& crowd) {
           "1 while a foot (left, right) is held where it was planted, uint8 [agents x 2].")
       .def_property_readonly(
           "joint_positions",
-          [](const PyCrowd& c) {
-            const auto session = c.session();
-            const auto world = session->world_positions();
-            const auto joints = py::ssize_t(world.size() / std::max<std::size_t>(c.agents(), 1));
-            return vec3_array(world, {py::ssize_t(c.agents()), joints, 3});
-          },
+          [](const PyCrowd& c) { return per_joint_array(c.session()->world_positions(), c.agents()); },
           "The displayed global joint positions after the last step (foot IK included), float32 [agents x joints "
           "x 3], metres.");
 }
@@ -393,43 +401,43 @@ void add_pose_arrays(py::class_<PyCrowd>& crowd) {
           "metres, in the parent's frame) and translated_joints (the joints whose translation varies: the hips).")
       .def_property_readonly(
           "local_rotations",
-          [](const PyCrowd& c) {
-            const auto session = c.session();
-            const auto rotations = session->controller().local_rotations();
-            const auto joints = py::ssize_t(rotations.size() / std::max<std::size_t>(c.agents(), 1));
-            py::array_t<float> out({py::ssize_t(c.agents()), joints, py::ssize_t(4)});
-            std::memcpy(out.mutable_data(), rotations.data(), rotations.size() * sizeof(glm::quat));
-            return out;
-          },
+          [](const PyCrowd& c) { return per_joint_array(c.session()->controller().local_rotations(), c.agents()); },
           "The displayed pose's local joint rotations (after foot IK), float32 [agents x joints x 4], unit "
           "quaternions (x, y, z, w) in the parent's frame; a root's (and so the hips') in character space, placed "
           "by root_positions and root_rotations.")
       .def_property_readonly(
           "local_translations",
           [](const PyCrowd& c) {
-            const auto session = c.session();
-            const auto world = session->controller().local_translations();
-            const auto joints = py::ssize_t(world.size() / std::max<std::size_t>(c.agents(), 1));
-            return vec3_array(world, {py::ssize_t(c.agents()), joints, 3});
+            return per_joint_array(c.session()->controller().local_translations(), c.agents());
           },
           "The displayed pose's local joint translations, float32 [agents x joints x 3], metres: the rest offsets, "
           "and the translated joints' own (the hips, lowered by foot IK where it drops them).")
       .def_property_readonly(
           "root_rotations",
           [](const PyCrowd& c) {
-            const auto session = c.session();
-            const auto yaws = session->controller().root_yaws();
-            py::array_t<float> out({py::ssize_t(c.agents()), py::ssize_t(4)});
-            float* o = out.mutable_data();
-            for (std::size_t b = 0; b < yaws.size(); ++b) {
-              o[4 * b] = 0.0f, o[4 * b + 1] = std::sin(0.5f * yaws[b]), o[4 * b + 2] = 0.0f,
-              o[4 * b + 3] = std::cos(0.5f * yaws[b]);
-            }
-            return out;
+            const auto yaws = c.session()->controller().root_yaws();
+            std::vector<glm::quat> rotations(yaws.size());
+            std::transform(yaws.begin(), yaws.end(), rotations.begin(),
+                           [](float yaw) { return glm::angleAxis(yaw, glm::vec3(0.0f, 1.0f, 0.0f)); });
+            // [agents x 1 x 4] as [agents x 4].
+            return per_joint_array(std::span<const glm::quat>(rotations), c.agents()).attr("reshape")(c.agents(), 4);
           },
           "Each character's root rotation R_y(root_yaws), float32 [agents x 4] (x, y, z, w). A joint's world "
           "transform is T(root_positions) * R(root_rotations) * the chain of T(local_translations) * "
           "R(local_rotations) from its root.");
+}
+
+// `write` (a Status of the recording) with the GIL released; its error
+// raised as OSError once the GIL is back. Errors: no poses recorded, naming `what`.
+template <class Write>
+void write_poses(const PyCrowd& c, const char* what, const Write& write) {
+  const auto poses = c.poses(what);
+  Status written;
+  {
+    py::gil_scoped_release released;
+    written = write(*poses.operator->());
+  }
+  check(written, ErrorKind::OS);
 }
 
 // The recorded poses (record_poses=M) written as BVH and glTF.
@@ -439,14 +447,10 @@ void add_exports(py::class_<PyCrowd>& crowd) {
           "write_bvh",
           [](const PyCrowd& c, const py::object& folder) {
             const std::filesystem::path dir = to_path(folder, "folder");
-            const auto poses = c.poses("write_bvh");
-            Status written;
-            {
-              py::gil_scoped_release released;  // raised only once the GIL is back
-              written = crowd::prepare_bvh_folder(dir, poses->agents, "folder");
-              if (written.ok()) written = crowd::write_bvh_files(*poses.operator->(), dir);
-            }
-            check(written, ErrorKind::OS);
+            write_poses(c, "write_bvh", [&dir](const crowd::PoseRecording& poses) -> Status {
+              MMVK_TRY(crowd::prepare_bvh_folder(dir, poses.agents, "folder"));
+              return crowd::write_bvh_files(poses, dir);
+            });
           },
           py::arg("folder"),
           "Writes one BVH per recorded character (record_poses=M), folder/agent_0000.bvh ...: the displayed pose "
@@ -456,14 +460,10 @@ void add_exports(py::class_<PyCrowd>& crowd) {
           "write_gltf",
           [](const PyCrowd& c, const py::object& path) {
             const std::filesystem::path p = to_path(path, "path");
-            const auto poses = c.poses("write_gltf");
-            Status written;
-            {
-              py::gil_scoped_release released;  // raised only once the GIL is back
-              written = crowd::check_gltf_path(p, "path");
-              if (written.ok()) written = crowd::write_gltf(*poses.operator->(), p);
-            }
-            check(written, ErrorKind::OS);
+            write_poses(c, "write_gltf", [&p](const crowd::PoseRecording& poses) -> Status {
+              MMVK_TRY(crowd::check_gltf_path(p, "path"));
+              return crowd::write_gltf(poses, p);
+            });
           },
           py::arg("path"),
           "Writes the recorded characters (record_poses=M) into one glTF 2.0 binary (.glb): each a skin over its "

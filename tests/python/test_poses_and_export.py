@@ -243,7 +243,7 @@ def test_gltf_export_of_20_characters_passes_the_khronos_validator(cli, tmp_path
     errors = [m for m in issues["messages"] if m["severity"] == 0]
     assert issues["numErrors"] == 0, errors[:5]
     assert report["info"]["animationCount"] == 1
-    assert len(json.loads(read_glb(path)[0] and json.dumps(read_glb(path)[0]))["skins"]) == 20
+    assert len(read_glb(path)[0]["skins"]) == 20
 
 
 @pytest.mark.parametrize("args, message", [
@@ -254,7 +254,7 @@ def test_gltf_export_of_20_characters_passes_the_khronos_validator(cli, tmp_path
     (["--gltf", "{tmp}/missing/crowd.glb"], "--gltf"),
     (["--export-agents", "2"], "--export-agents needs --bvh DIR or --gltf FILE.glb"),
     (["--gltf", "{tmp}/crowd.glb", "--export-agents", "1", "--seconds", "100000", "--rate", "10"],
-     "--gltf: 1000000 ticks x 1 characters x 31 joints would take"),
+     "--gltf: 1000000 ticks x 1 characters x 31 joints would take * MiB of poses, over the 512 MiB"),
 ])
 def test_bad_export_options_are_refused_before_the_run(cli, tmp_path, args, message):
     (tmp_path / "file").write_text("a file, not a folder")
@@ -264,8 +264,7 @@ def test_bad_export_options_are_refused_before_the_run(cli, tmp_path, args, mess
                              "--summary", str(tmp_path / "s.json"), *args],
                             capture_output=True, text=True, env=env)
     assert result.returncode != 0
-    assert message in result.stderr
-    assert "over the 512 MiB" in result.stderr or "ticks x" not in message
+    assert all(part in result.stderr for part in message.split(" * ")), result.stderr
     assert not (tmp_path / "s.json").exists(), "the run went ahead"
 
 

@@ -54,8 +54,9 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
     return glm::length((now[i] - now[b * joints]) - (before[i] - before[b * joints]));
   };
   auto observe = [&](const CrowdController& c, int tick) {
-    c.animated_world_positions(current, pool);
-    c.world_positions(shown, pool);
+    const auto animated = c.animated_world_positions(), displayed = c.world_positions();
+    current.assign(animated.begin(), animated.end());
+    shown.assign(displayed.begin(), displayed.end());
     if (tick > 0) {
       for (std::uint32_t b = 0; b < c.size(); ++b) {
         for (std::size_t j = 0; j < joints; ++j) {
@@ -84,15 +85,15 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   // searched() tells the kinds apart: every first search is forced (2), and
   // per tick its 1s and 2s add up to the tick's regular and forced counts.
   const std::uint32_t n = test::kCrowdCharacters;
-  for (std::uint32_t b = 0; b < n; ++b) EXPECT_EQ(run->searched[b], 2) << "character " << b;
+  for (std::uint32_t b = 0; b < n; ++b) EXPECT_EQ(run->searched[b], SearchKind::Forced) << "character " << b;
   std::uint32_t regular_seen = 0;
   for (std::size_t t = 0; t < run->ticks.size(); ++t) {
     std::uint32_t regular = 0, forced = 0;
     for (std::uint32_t b = 0; b < n; ++b) {
-      const std::uint8_t kind = run->searched[t * n + b];
-      ASSERT_LE(kind, 2) << "tick " << t << ", character " << b;
-      regular += kind == 1 ? 1u : 0u;
-      forced += kind == 2 ? 1u : 0u;
+      const SearchKind kind = run->searched[t * n + b];
+      ASSERT_LE(std::uint8_t(kind), 2) << "tick " << t << ", character " << b;
+      regular += kind == SearchKind::Regular ? 1u : 0u;
+      forced += kind == SearchKind::Forced ? 1u : 0u;
     }
     EXPECT_EQ(forced, run->ticks[t].forced) << "tick " << t;
     EXPECT_EQ(regular + forced, run->ticks[t].searches) << "tick " << t;

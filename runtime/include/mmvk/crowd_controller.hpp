@@ -10,10 +10,11 @@
 //      velocity and facing (critically damped springs, trajectory.hpp); each
 //      character's continuous time in its clip advances by dt * fps frames
 //      (playback.hpp: a looping clip wraps to its first frame; a non-looping
-//      clip holds its last frame), and its animated root moves along the
-//      clip's root path plus the inertialization's root offset;
+//      clip holds its last frame);
 //   2. blend: its pose is interpolated between the two neighbouring frames,
-//      plus the decaying inertialization offsets (pose_batch.hpp);
+//      plus the decaying inertialization offsets (pose_batch.hpp), and its
+//      animated root moves along the clip's root path plus the
+//      inertialization's root offset;
 //   3. correct: the animated root is pulled toward the simulated root with a
 //      bounded correction (ControllerParams); its path is recorded
 //      (RootHistory), and the animated pose is measured: one forward

@@ -1,11 +1,13 @@
 // The crowd controller on Bandai locomotion with the reference backend:
 // every search finds a candidate, the load is staggered, roots stay within
-// the correction bound, jumps are blended, the deferred path and batch
-// splitting behave, and a database without animation is refused clearly.
+// the correction bound, jumps are blended, the display follows the jumps, the
+// deferred path and batch splitting behave, and a database without animation
+// is refused clearly.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
+#include "mmvk/pose_batch.hpp"
 #include "mmvk/reference_search.hpp"
 #include "support/crowd_scenario.hpp"
 #include "support/test_data.hpp"
@@ -141,6 +143,56 @@ TEST_F(CrowdControllerData, DeferredAppliesTheSameSearchOneTickLater) {
   const test::CrowdRun deferred = run_with(true);
   EXPECT_EQ(deferred.totals.no_candidate, 0u);
   EXPECT_NE(deferred.frames, sync.frames);  // one tick of latency changes the choices
+}
+
+// The ticks' own order: the display comes after the jumps (step 8 after
+// step 7), so on the synchronous tick the pose shown, and the world positions
+// kept of the animated pose, are those of the pose after a jump, bit for bit;
+// and the applied pairs are the tick's own searches (the deferred tick's: the
+// previous tick's).
+TEST_F(CrowdControllerData, TheDisplayFollowsTheJumpsAndTheAppliedPairsTheSearches) {
+  ReferenceSearch reference(*database_);
+  ThreadPool pool(2);
+  for (const bool deferred : {false, true}) {
+    SCOPED_TRACE(deferred ? "deferred tick" : "synchronous tick");
+    ControllerParams params;
+    params.foot_ik.enabled = false;  // displayed = animated: world_positions() is the FK of local_rotations()
+    Result<CrowdController> controller = CrowdController::create(*database_, test::kCrowdCharacters, params);
+    ASSERT_TRUE(controller.ok()) << controller.message();
+    DeferredSearch later(reference, test::kCrowdCharacters);
+    const std::size_t joints = controller->animation().joint_count();
+    std::vector<glm::vec3> fk(test::kCrowdCharacters * joints), shown_fk(fk.size());
+    std::vector<std::uint32_t> searched_before;
+    std::uint32_t jumps = 0;
+    auto observe = [&](const CrowdController& c, int) {
+      forward_kinematics_batch(c.animation().skeleton, c.animated_rotations(), c.animated_translations(),
+                               c.root_positions(), c.root_yaws(), fk);
+      forward_kinematics_batch(c.animation().skeleton, c.local_rotations(), c.local_translations(),
+                               c.root_positions(), c.root_yaws(), shown_fk);
+      const auto animated = c.animated_world_positions(), shown = c.world_positions();
+      ASSERT_TRUE(std::equal(fk.begin(), fk.end(), animated.begin()));
+      ASSERT_TRUE(std::equal(shown_fk.begin(), shown_fk.end(), shown.begin()));
+      // Without foot IK the pose shown is the animated one, jumps included.
+      ASSERT_TRUE(std::equal(c.local_rotations().begin(), c.local_rotations().end(), c.animated_rotations().begin()));
+      std::vector<std::uint32_t> searched_now;
+      for (std::uint32_t b = 0; b < c.size(); ++b) {
+        if (c.searched()[b] != SearchKind::None) searched_now.push_back(b);
+      }
+      const std::vector<std::uint32_t> applied(c.applied_characters().begin(), c.applied_characters().end());
+      EXPECT_EQ(applied, deferred ? searched_before : searched_now);
+      EXPECT_EQ(c.applied_matches().size(), c.last_tick().applied);
+      searched_before = searched_now;
+      jumps += c.last_tick().jumps;
+    };
+    Result<test::CrowdRun> run = test::run_crowd(
+        *controller,
+        [&](CrowdController& c, const CrowdInput& in) {
+          return deferred ? c.tick(test::kCrowdDt, in, later, pool) : c.tick(test::kCrowdDt, in, reference, pool);
+        },
+        observe);
+    ASSERT_TRUE(run.ok()) << run.message();
+    EXPECT_GT(jumps, 50u);
+  }
 }
 
 TEST_F(CrowdControllerData, DatabaseWithoutAnimationIsRefusedWithTheFix) {

@@ -485,7 +485,7 @@ TEST(FootLocker, ResetForgetsTheLocksAndOffLeavesThePose) {
     update_locker(*locker, a, 1, dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
     // Off: the pose is untouched, the world positions are its FK.
     Pose untouched = walk_pose(a, t);
-    disabled->update(1, dt, untouched.contacts, root, yaw, untouched.rotations, untouched.translations, world);
+    update_locker(*disabled, a, 1, dt, untouched.contacts, root, yaw, untouched.rotations, untouched.translations, world);
     const Pose animated = walk_pose(a, t);
     EXPECT_EQ(untouched.rotations, animated.rotations);
     EXPECT_EQ(untouched.translations, animated.translations);

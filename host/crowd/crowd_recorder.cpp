@@ -71,7 +71,7 @@ CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& 
 
 void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> collected,
                                 std::span<const std::uint32_t> searched_before,
-                                std::span<const std::uint8_t> kinds_before,
+                                std::span<const SearchKind> kinds_before,
                                 std::span<const std::uint32_t> frames_before, std::span<const glm::vec3> world) {
   const auto jumped = controller_.jumped();
   // The searches ran at the end of the previous tick.
@@ -81,7 +81,7 @@ void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> colle
     SearchEvent event;
     event.time_s = searched_at;
     event.jumped = jumped[b] != 0;
-    event.forced = kinds_before[b] == 2;
+    event.forced = kinds_before[b] == SearchKind::Forced;
     event.from_frame = std::int32_t(frames_before[b]);
     event.to_frame = collected[i].frame == kNoFrame ? -1 : std::int32_t(collected[i].frame);
     event.cost = std::isfinite(collected[i].cost) ? collected[i].cost : 0.0f;

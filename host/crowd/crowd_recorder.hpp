@@ -23,12 +23,12 @@ class CrowdRecorder {
   // After each tick `tick` (0-based, its end at (tick + 1) * dt):
   // `collected` are the matches the tick applied, for the characters that
   // searched in the tick before (`searched_before`, ascending), with that
-  // tick's CrowdController::searched() (`kinds_before`, [characters]: 2
-  // marks a forced search), `frames_before` the frames they played when
+  // tick's CrowdController::searched() (`kinds_before`, [characters]:
+  // SearchKind::Forced marks a forced search), `frames_before` the frames they played when
   // they searched, and `world` the displayed world joint positions
   // [characters x joints] after the tick (CrowdController::world_positions).
   void record_tick(std::uint64_t tick, std::span<const Match> collected,
-                   std::span<const std::uint32_t> searched_before, std::span<const std::uint8_t> kinds_before,
+                   std::span<const std::uint32_t> searched_before, std::span<const SearchKind> kinds_before,
                    std::span<const std::uint32_t> frames_before, std::span<const glm::vec3> world);
 
   // Adds the poses of the frames seen and returns the recording.

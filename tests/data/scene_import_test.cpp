@@ -556,6 +556,74 @@ TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {
   EXPECT_NE(inspected.output.find("walk"), std::string::npos) << inspected.output;
 }
 
+// --- assimp in a child process ---------------------------------------------
+
+TEST(SceneImport, TheChildProcessGivesTheSameImportAsThisProcess) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  const fs::path gltf = write_gltf(walk, dir, "walk", "walk");
+  mmvk::SceneImportOptions here;
+  here.isolate = false;
+  const auto child = mmvk::import_scene(gltf, {});
+  const auto local = mmvk::import_scene(gltf, here);
+  ASSERT_TRUE(child.ok()) << child.message();
+  ASSERT_TRUE(local.ok()) << local.message();
+  EXPECT_EQ(child->metres_per_unit, local->metres_per_unit);
+  EXPECT_EQ(child->units_from, local->units_from);
+  EXPECT_EQ(child->axes_from, local->axes_from);
+  ASSERT_EQ(child->animations.size(), local->animations.size());
+  for (std::size_t a = 0; a < local->animations.size(); ++a) {
+    const Motion &x = child->animations[a].motion, &y = local->animations[a].motion;
+    EXPECT_EQ(child->animations[a].name, local->animations[a].name);
+    EXPECT_EQ(x.fps, y.fps);
+    EXPECT_EQ(x.frame_count, y.frame_count);
+    EXPECT_EQ(x.skeleton.names, y.skeleton.names);
+    EXPECT_EQ(x.skeleton.parents, y.skeleton.parents);
+    EXPECT_EQ(x.skeleton.rest_offsets, y.skeleton.rest_offsets);
+    EXPECT_EQ(x.local_positions, y.local_positions);
+    EXPECT_EQ(x.local_rotations, y.local_rotations);
+  }
+  // A failed read's message comes back from the child unchanged.
+  std::ofstream(dir / "fake.fbx") << "not an fbx at all";
+  const auto fake_child = mmvk::import_scene(dir / "fake.fbx", {});
+  const auto fake_local = mmvk::import_scene(dir / "fake.fbx", here);
+  ASSERT_FALSE(fake_child.ok());
+  EXPECT_EQ(fake_child.message(), fake_local.message());
+}
+
+// A COLLADA triangle list with a stray letter in its indices ("2x"): assimp
+// 5.2.5 reads it allocating without bound (over 1 GB in 5 s). In the child
+// process that is an error naming the file, within the limits given.
+TEST(SceneImport, AFileOnWhichAssimpRunsAwayIsAnErrorNamingIt) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const fs::path dae = dir / "runaway.dae";
+  std::ofstream(dae) << R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+<asset><unit meter="1"/><up_axis>Y_UP</up_axis></asset>
+<library_geometries><geometry id="g"><mesh>
+<source id="p"><float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array><technique_common>
+<accessor source="#pa" count="3" stride="3"><param name="X" type="float"/><param name="Y" type="float"/>
+<param name="Z" type="float"/></accessor></technique_common></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2x 1</p></triangles>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node></visual_scene>
+</library_visual_scenes><scene><instance_visual_scene url="#s"/></scene></COLLADA>
+)";
+  mmvk::SceneImportOptions options;
+  options.timeout_seconds = 3.0;
+  options.memory_budget_bytes = std::uint64_t{256} << 20;
+  const auto imported = mmvk::import_scene(dae, options);
+  ASSERT_FALSE(imported.ok());
+  EXPECT_EQ(imported.message().rfind(dae.string() + ": ", 0), 0u) << imported.message();
+  EXPECT_NE(imported.message().find("assimp"), std::string::npos) << imported.message();
+  options.timeout_seconds = 0.0;
+  const auto no_time = mmvk::import_scene(dae, options);
+  ASSERT_FALSE(no_time.ok());
+  EXPECT_NE(no_time.message().find("timeout_seconds and memory_budget_bytes must be positive"), std::string::npos)
+      << no_time.message();
+}
+
 TEST(SceneImport, ErrorsNameTheFile) {
   const fs::path dir = mmvk::test::make_temp_dir();
   std::ofstream(dir / "fake.fbx") << "not an fbx at all";

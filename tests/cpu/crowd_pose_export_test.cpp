@@ -50,20 +50,20 @@ TEST_P(DisplayedPose, ForwardKinematicsOfTheExposedPoseIsTheWorldPositions) {
       PoseRecorder::create(controller.animation(), 2, kCharacters, rate, 0, "--export-agents", "--gltf");
   ASSERT_TRUE(recorder.ok()) << recorder.message();
 
-  std::vector<glm::vec3> velocities(kCharacters), shown(kCharacters * joints), fk(kCharacters * joints);
+  std::vector<glm::vec3> velocities(kCharacters), fk(kCharacters * joints);
   float worst = 0.0f, moved_by_ik = 0.0f;
   std::uint32_t locked = 0;
   for (int t = 0; t < int(2 * rate); ++t) {
     for (std::uint32_t b = 0; b < kCharacters; ++b) velocities[b] = {0.2f * float(b), 0.0f, 0.8f};
     ASSERT_TRUE(controller.tick(1.0f / rate, CrowdInput{velocities, {}}, search, pool).ok());
     ASSERT_TRUE(recorder->record(controller).ok());
-    controller.world_positions(shown, pool);
+    const auto shown = controller.world_positions();
     forward_kinematics_batch(controller.animation().skeleton, controller.local_rotations(),
                              controller.local_translations(), controller.root_positions(), controller.root_yaws(),
                              fk, &pool);
     for (std::size_t i = 0; i < shown.size(); ++i) {
       worst = std::max(worst, glm::length(fk[i] - shown[i]));
-      moved_by_ik = std::max(moved_by_ik, glm::length(controller.displayed_animated_world()[i] - shown[i]));
+      moved_by_ik = std::max(moved_by_ik, glm::length(controller.animated_world_positions()[i] - shown[i]));
     }
     for (const std::uint8_t l : controller.foot_locked()) locked += l;
   }

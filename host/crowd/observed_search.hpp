@@ -1,7 +1,8 @@
 // An AsyncSearch that forwards to another and observes it: how long the
 // host is blocked in submit() and collect() (the search time a tick pays),
-// and the matches of each collected batch, in order (the chosen frames the
-// run hashes and the viewer's search events come from).
+// the matches of each collected batch, in order (the chosen frames the run
+// hashes and the viewer's search events come from), and the batch each tick
+// submitted (the queries the viewer's "why this frame" explains).
 #pragma once
 
 #include <chrono>
@@ -22,6 +23,7 @@ class ObservedSearch final : public AsyncSearch {
     Status status = inner_.submit(batch);
     blocked_s_ += std::chrono::duration<double>(Clock::now() - start).count();
     submitted_ = batch.size;
+    batch_ = batch;
     return status;
   }
   Status collect(std::span<Match> out) override {
@@ -38,10 +40,14 @@ class ObservedSearch final : public AsyncSearch {
     blocked_s_ = 0.0;
     collected_ = false;
     matches_.clear();
+    batch_ = {};
   }
   double blocked_seconds() const { return blocked_s_; }
   bool collected() const { return collected_; }
   std::span<const Match> collected_matches() const { return matches_; }
+  // The batch submitted this tick (empty: none), a view of the submitter's
+  // buffers, valid until its next tick.
+  const QueryBatch& submitted_batch() const { return batch_; }
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -50,6 +56,7 @@ class ObservedSearch final : public AsyncSearch {
   std::size_t submitted_ = 0;
   bool collected_ = false;
   std::vector<Match> matches_;
+  QueryBatch batch_;
 };
 
 }  // namespace mmvk::crowd

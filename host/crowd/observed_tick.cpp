@@ -14,7 +14,7 @@ Result<double> observed_tick(CrowdController& controller, ObservedSearch& observ
   observers.figures.record(tick, tick_ms, observed.blocked_seconds() * 1e3, matches, controller.last_tick().searches);
 
   controller.world_positions(world, pool);
-  const TickView view{tick, input.desired_velocity, input.desired_yaw, matches, world};
+  const TickView view{tick, input.desired_velocity, input.desired_yaw, matches, world, observed.submitted_batch()};
   observers.quality.observe(controller, view);
   if (observers.recording) observers.recording->observe(controller, view);
   return tick_ms;

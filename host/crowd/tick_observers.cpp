@@ -105,6 +105,7 @@ void RecordingObserver::observe(const CrowdController& controller, const TickVie
   for (std::uint32_t b = 0; b < kinds.size(); ++b) {
     if (kinds[b] != 0) searched_now_.push_back(b);
   }
+  recorder_.record_submitted(searched_now_, view.submitted);
   searched_before_.swap(searched_now_);
   std::copy(kinds.begin(), kinds.end(), kinds_before_.begin());
   const auto frames = controller.frames();

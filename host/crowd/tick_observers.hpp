@@ -31,6 +31,7 @@ struct TickView {
   std::span<const float> desired_yaw;     // [agents] desired facing, radians; empty: facing the velocity
   std::span<const Match> matches;         // the matches the tick applied, in order
   std::span<const glm::vec3> world;       // [agents x joints] displayed world joint positions, metres
+  QueryBatch submitted;                   // the queries the tick submitted (CrowdController::searched() order)
 };
 
 // The ticks' own figures: searches, the time each tick took and blocked on
@@ -85,7 +86,7 @@ class RecordingObserver {
                     std::uint32_t ticks_per_sample);
 
   void observe(const CrowdController& controller, const TickView& view);
-  Recording finish(ThreadPool& pool) { return recorder_.finish(pool); }
+  Result<Recording> finish(ThreadPool& pool) { return recorder_.finish(pool); }
 
  private:
   CrowdRecorder recorder_;

@@ -976,8 +976,9 @@
 
   // URL options, so a page can be opened (or screenshotted) at a known
   // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE&follow=1, and
-  // view=3d&cam=DIST,YAW,PITCH[,HEIGHT] (metres, radians) for the 3D view, why=I to
-  // open the selected character's search I (0-based).
+  // view=3d&cam=DIST,YAW,PITCH[,HEIGHT] (metres, radians) for the 3D view
+  // (characters=0: the empty ground), why=I to open the selected
+  // character's search I (0-based).
   function applyQuery() {
     const q = new URLSearchParams(window.location.search);
     if (q.has('zoom')) state.zoom = parseFloat(q.get('zoom')) > 0 ? clampScale(parseFloat(q.get('zoom'))) : 0;
@@ -996,6 +997,7 @@
         view3d.setCamera(...q.get('cam').split(',').map(parseFloat));
         view3d.lookAtSelected();
       }
+      if (q.get('characters') === '0') view3d.showCharacters(false);
     }
     if (q.has('why')) openWhy(parseInt(q.get('why'), 10));
   }
@@ -1039,6 +1041,11 @@
     statusEl.dataset.decodeMs = String(ms);
     statusEl.dataset.probe = probe();
     statusEl.dataset.view = state.view3d ? '3d' : 'top';
+    if (state.view3d && state.selected >= 0) {
+      // The selected character's hips on the page, CSS px, for a test.
+      const [x, y] = view3d.project(state.selected), box = crowd3dCanvas.getBoundingClientRect();
+      statusEl.dataset.projected = Math.round(box.left + x) + ',' + Math.round(box.top + y);
+    }
     statusEl.dataset.detailAgents = String(D.detailAgents);
     statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + Number(D.rate.toPrecision(4)) + ' Hz, ' + D.P + ' poses' +
       (D.detailAgents ? ', ' + D.detailAgents + ' whole poses at ' + Number(D.detailRate.toPrecision(4)) + ' Hz' : '') + '; loaded in ' + ms + ' ms';

@@ -278,8 +278,22 @@ window.MmvkView3d = (function () {
       cam.dist *= Math.exp(e.deltaY * 0.0015); state.dirty = true;
     }, { passive: false });
 
+    // Where agent a's hips are on the canvas, CSS px [x, y] (after a draw).
+    function project(a) {
+      const p = hooks.sampleAt(a, state.t), v = new THREE.Vector3(p.x, 0.9, p.z).project(camera);
+      return [(v.x + 1) / 2 * canvas.clientWidth, (1 - v.y) / 2 * canvas.clientHeight];
+    }
+
+    // Hides the characters and their marks, leaving the empty ground (a
+    // test compares the two).
+    function showCharacters(on) {
+      for (const object of [boneMesh, jointMesh, ring, ...marks.flat(), ...Object.values(trails)]) object.layers.set(on ? 0 : 1);
+    }
+
     return {
       draw,
+      project,
+      showCharacters,
       camera: cam,
       // ?cam=DIST,YAW,PITCH[,HEIGHT] (metres, radians; HEIGHT: of the
       // point looked at, 0.9 m by default): a known camera.

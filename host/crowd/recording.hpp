@@ -141,6 +141,9 @@ struct Recording {
     float multiplier = 1.0f;  // the clip's cost multiplier
     float bias = 0.0f;        // the clip's cost bias
     float cost = 0.0f;        // the frame's cost: multiplier x sum + bias, then the continuing terms
+    // Why the frame is not a candidate: an index into exclusion_names (0:
+    // it is one; mmvk::Exclusion).
+    std::uint8_t exclusion = 0;
   };
   struct SearchWhy {
     std::size_t search = 0;  // index into searches[agent]
@@ -151,6 +154,7 @@ struct Recording {
   };
   std::vector<std::string> channel_names;  // the schema's, in order
   std::vector<std::string> clip_names;     // the database's, in order
+  std::vector<std::string> exclusion_names;  // mmvk::exclusion_name() of each Exclusion, in order
   // [agent_count][explained searches] (empty lists for characters not
   // detailed), or empty when not recorded.
   std::vector<std::vector<SearchWhy>> why;

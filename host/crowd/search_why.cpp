@@ -17,6 +17,7 @@ Recording::FrameWhy frame_why(const Database& db, const FrameExplanation& e) {
   out.multiplier = e.multiplier;
   out.bias = e.bias;
   out.cost = e.cost;
+  out.exclusion = std::uint8_t(e.exclusion);
   return out;
 }
 
@@ -49,6 +50,8 @@ Status SearchWhyRecorder::finish(Recording& r, ThreadPool& pool) const {
   for (const FeatureChannel& channel : schema.channels) r.channel_names.push_back(channel.name);
   r.clip_names.clear();
   for (const Clip& clip : database_.clips()) r.clip_names.push_back(clip.name);
+  r.exclusion_names.clear();
+  for (std::size_t i = 0; i < kExclusionCount; ++i) r.exclusion_names.emplace_back(exclusion_name(Exclusion(i)));
   std::vector<Recording::SearchWhy> explained(kept_.size());
   std::vector<Status> failed(pool.thread_count());
   const std::size_t dims = database_.dims();

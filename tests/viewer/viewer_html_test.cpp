@@ -93,6 +93,41 @@ TEST(ViewerRecording, ErrorsNameTheField) {
   expect_error(r, "facing[5]");
 }
 
+TEST(ViewerRecording, WholePoseAndExplanationErrorsNameTheField) {
+  Recording r = small_recording();
+  ASSERT_GT(r.detail_agents, 0u);
+  r.detail_positions.pop_back();
+  expect_error(r, "detail_positions");
+
+  r = small_recording();
+  r.detail_agents = r.agent_count + 1;
+  expect_error(r, "detail_agents");
+
+  r = small_recording();
+  r.detail_positions[10] = std::nanf("");
+  expect_error(r, "detail_positions[10]");
+
+  r = small_recording();
+  r.why[1][3].chosen.clip = 9;
+  expect_error(r, "why[1][3].chosen.clip");
+
+  r = small_recording();
+  r.why[1][3].continuing.weighted.pop_back();
+  expect_error(r, "why[1][3].continuing.weighted");
+
+  r = small_recording();
+  r.why[2][1].search = r.why[2][0].search;
+  expect_error(r, "why[2][1].search");
+
+  r = small_recording();
+  r.why[0][0].continuing.exclusion = 7;
+  expect_error(r, "why[0][0].continuing.exclusion");
+
+  r = small_recording();
+  r.why.pop_back();
+  expect_error(r, "why");
+}
+
 TEST(ViewerPage, IsSelfContained) {
   Recording r = small_recording();
   r.title = "a </script> title";

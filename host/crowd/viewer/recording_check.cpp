@@ -1,5 +1,6 @@
 #include "viewer/recording_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -155,6 +156,10 @@ Status check_frame_why(const Recording& r, const Recording::FrameWhy& f, const s
                       "one per channel_names entry"));
   for (float v : f.weighted) {
     if (!std::isfinite(v)) return make_error("recording: " + where + ".weighted is not finite");
+  }
+  if (f.exclusion >= std::max<std::size_t>(r.exclusion_names.size(), 1)) {
+    return make_error("recording: " + where + ".exclusion = " + std::to_string(f.exclusion) +
+                      " is not an index into exclusion_names (" + std::to_string(r.exclusion_names.size()) + ")");
   }
   if (!std::isfinite(f.cost) || !std::isfinite(f.bias) || !std::isfinite(f.multiplier)) {
     return make_error("recording: " + where + ": cost, bias or multiplier is not finite");

@@ -266,6 +266,7 @@ Recording::FrameWhy synthetic_frame_why(int32_t frame, const std::vector<float>&
 void add_why(Recording& r, Rng& rng) {
   r.channel_names = {"trajectory_position", "trajectory_direction", "left_foot_position", "hip_velocity"};
   r.clip_names = {"synthetic walk", "synthetic run"};
+  r.exclusion_names = {"candidate", "excluded"};
   r.why.assign(r.agent_count, {});
   const std::vector<float> weights = {1.0f, 1.5f, 0.75f, 1.0f};
   for (std::size_t a = 0; a < r.detail_agents; ++a) {

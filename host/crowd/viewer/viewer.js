@@ -217,6 +217,7 @@
     decodeDetail(meta, readers, d);
     d.channelNames = meta.why ? meta.why.channel_names : [];
     d.clipNames = meta.why ? meta.why.clip_names : [];
+    d.exclusionNames = meta.why ? meta.why.exclusion_names : [];
     if (meta.why) d.why = window.MmvkWhy.decode(readers.why, N, d.channelNames.length);
     return d;
   }

@@ -38,7 +38,7 @@
 //             z continuing_multiplier_milli; then the chosen and the
 //             continuing frame: u present, and when present: u frame,
 //             u clip, z clip_time_ms, z multiplier_milli, z bias_1e5,
-//             z cost_1e5, for channel: z weighted_1e5
+//             z cost_1e5, u exclusion, for channel: z weighted_1e5
 #include "viewer/viewer_payload.hpp"
 
 #include <algorithm>
@@ -251,6 +251,7 @@ void write_frame_why(VarintWriter& out, const Recording::FrameWhy& f) {
   out.z(quantize(f.multiplier, kMilli));
   out.z(quantize(f.bias, kCost));
   out.z(quantize(f.cost, kCost));
+  out.u(f.exclusion);
   for (float v : f.weighted) out.z(quantize(v, kCost));
 }
 
@@ -385,7 +386,9 @@ std::string meta_json(const Recording& r, const PoseSlots& slots, const nlohmann
       {"has_feet", !r.foot_events.empty()},
       {"detail", {{"agents", r.detail_agents}, {"sample_count", r.detail_sample_count}, {"rate_hz", r.detail_rate_hz}}},
       {"why", r.why.empty() ? nlohmann::json(nullptr)
-                            : nlohmann::json{{"channel_names", r.channel_names}, {"clip_names", r.clip_names}}},
+                            : nlohmann::json{{"channel_names", r.channel_names},
+                                                              {"clip_names", r.clip_names},
+                                                              {"exclusion_names", r.exclusion_names}}},
       {"bounds", bounds_of(r)},
       {"sections", sections},
       {"raw_bytes", raw_bytes},

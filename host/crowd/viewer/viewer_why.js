@@ -18,7 +18,8 @@ window.MmvkWhy = (function () {
   function frameLine(D, label, f) {
     if (!f) return '<div>' + label + ': none</div>';
     return '<div>' + label + ': frame ' + f.frame + ', ' + esc(D.clipNames[f.clip] || ('clip ' + f.clip)) + ' at ' +
-      f.clipTime.toFixed(3) + ' s</div>';
+      f.clipTime.toFixed(3) + ' s' + (f.exclusion ? ' <span style="color:var(--jump)">(not a candidate: ' +
+      esc(D.exclusionNames[f.exclusion] || ('rule ' + f.exclusion)) + ')</span>' : '') + '</div>';
   }
 
   function table(D, w) {
@@ -72,7 +73,8 @@ window.MmvkWhy = (function () {
     const frame = () => {
       if (!r.u()) return null;
       const f = { frame: r.u(), clip: r.u(), clipTime: r.z() / 1000, multiplier: r.z() / 1000, bias: r.z() / 1e5,
-                  cost: r.z() / 1e5, weighted: new Float64Array(C) };
+                  cost: r.z() / 1e5, exclusion: 0, weighted: new Float64Array(C) };
+      f.exclusion = r.u();
       for (let c = 0; c < C; c++) f.weighted[c] = r.z() / 1e5;
       return f;
     };

@@ -74,7 +74,8 @@ window.MmvkView3d = (function () {
 
     const [x0, z0, x1, z1] = D.bounds, span = Math.max(x1 - x0, z1 - z0, 10);
     const ground = new THREE.Mesh(new THREE.PlaneGeometry(span * 4, span * 4),
-      new THREE.MeshLambertMaterial({ color: 0x3a414c }));
+      // Pushed back in depth, so the grid on it wins at any distance.
+      new THREE.MeshLambertMaterial({ color: 0x3a414c, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 4 }));
     ground.rotation.x = -Math.PI / 2;
     ground.position.set((x0 + x1) / 2, 0, (z0 + z1) / 2);
     ground.receiveShadow = true;
@@ -117,13 +118,13 @@ window.MmvkView3d = (function () {
         m.frustumCulled = false; m.count = 0; scene.add(m); return m;
       }));
     }
-    const ring = new THREE.Mesh(new THREE.RingBufferGeometry(0.42, 0.5, 40).rotateX(-Math.PI / 2),
-      new THREE.MeshBasicMaterial({ color: 0xffffff }));
+    const ring = new THREE.Mesh(new THREE.RingBufferGeometry(0.46, 0.5, 48).rotateX(-Math.PI / 2),
+      new THREE.MeshBasicMaterial({ color: 0xffffff, transparent: true, opacity: 0.7, depthWrite: false }));
     scene.add(ring);
     const trails = { past: line(0xc8c8c8), achieved: line(hooks.colors.achieved), desired: line(hooks.colors.desired) };
     Object.values(trails).forEach((l) => scene.add(l));
 
-    const cam = { target: new THREE.Vector3((x0 + x1) / 2, 0, (z0 + z1) / 2), dist: span * 0.85, yaw: 0.6, pitch: 0.75, height: 0.9 };
+    const cam = { target: new THREE.Vector3((x0 + x1) / 2, 0, (z0 + z1) / 2), dist: span * 0.8, yaw: 0.6, pitch: 0.6, height: 0.9 };
     const m = new THREE.Matrix4(), q = new THREE.Quaternion(), up = new THREE.Vector3(0, 1, 0);
     const from = new THREE.Vector3(), to = new THREE.Vector3(), dir = new THREE.Vector3(), scale = new THREE.Vector3();
     const hidden = new THREE.Matrix4().makeScale(0, 0, 0);
@@ -199,6 +200,7 @@ window.MmvkView3d = (function () {
         cam.target.z + cam.dist * cp * Math.cos(cam.yaw));
       camera.lookAt(cam.target);
       camera.aspect = w / Math.max(h, 1);
+      camera.near = Math.max(0.05, cam.dist / 400);
       camera.far = Math.max(3000, cam.dist * 4);
       camera.updateProjectionMatrix();
       // The shadows cover what the camera looks at, more finely up close.

@@ -25,7 +25,7 @@ window.MmvkWhy = (function () {
   function table(D, w) {
     const c = w.chosen, k = w.continuing, max = Math.max(1e-9, ...D.channelNames.map((_, i) =>
       Math.max(c ? c.weighted[i] : 0, k ? k.weighted[i] : 0)));
-    const bar = (v, cls) => '<span class="bar' + cls + '" style="width:' + Math.round(60 * v / max) + 'px"></span>';
+    const bar = (v, cls) => '<span class="bar' + cls + '" style="width:' + Math.round(48 * v / max) + 'px"></span>';
     let rows = '<tr><th>channel</th><th>weight</th><th>chosen</th><th></th><th>continuing</th><th></th></tr>';
     D.channelNames.forEach((name, i) => {
       rows += '<tr><td>' + esc(name) + '</td><td>' + fmt(w.weights[i]) + '</td><td>' + (c ? fmt(c.weighted[i]) : '') +

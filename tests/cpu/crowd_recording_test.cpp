@@ -13,7 +13,6 @@
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/reference_search.hpp"
 #include "observed_search.hpp"
-#include "support/test_data.hpp"
 #include "tick_observers.hpp"
 
 namespace mmvk::crowd {
@@ -21,9 +20,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Database shipped_walks_and_runs() {
-  const fs::path manifest = test::test_source_dir().parent_path() / "host/crowd/data/cmu16/manifest.json";
-  Result<OpenedDatabase> opened = open_database(manifest, fs::path(), [](const std::string&) {});
+// The default data, CMU subject 16's walks and runs, found as `mmvk crowd`
+// finds it (the source tree's host/crowd/data/cmu16) and built uncached.
+Database default_data() {
+  const Result<DataChoice> choice = choose_data(std::nullopt, fs::path());
+  EXPECT_TRUE(choice.ok()) << choice.message();
+  Result<OpenedDatabase> opened = open_database(choice->source, fs::path(), [](const std::string&) {});
   EXPECT_TRUE(opened.ok()) << opened.message();
   return std::move(opened.value().database);
 }
@@ -72,7 +74,7 @@ Recorded record_walk(const Database& db, std::uint32_t characters, std::uint32_t
 }
 
 TEST(CrowdRecording, TheFirstCharactersWholePosesAtTheTickRate) {
-  const Database db = shipped_walks_and_runs();
+  const Database db = default_data();
   constexpr std::uint32_t kCharacters = kDefaultDetailAgents + 4, kTicks = 45;
   const Recorded recorded = record_walk(db, kCharacters, kTicks);
   const Recording& r = recorded.recording;
@@ -117,7 +119,7 @@ void expect_explains(const Recording& r, const SearchEvent& event, const Recordi
 }
 
 TEST(CrowdRecording, EverySearchOfTheFirstCharactersIsExplained) {
-  const Database db = shipped_walks_and_runs();
+  const Database db = default_data();
   constexpr std::uint32_t kCharacters = kDefaultDetailAgents + 4, kTicks = 60;
   const Recording r = record_walk(db, kCharacters, kTicks).recording;
   ASSERT_EQ(r.why.size(), r.agent_count);

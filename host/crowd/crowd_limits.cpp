@@ -15,6 +15,7 @@
 #include "mmvk/search.hpp"
 #include "mmvk/trajectory.hpp"
 #include "crowd_defaults.hpp"
+#include "crowd_recorder.hpp"
 #include "recording.hpp"
 
 namespace mmvk::crowd {
@@ -107,9 +108,15 @@ std::uint64_t estimate_crowd_bytes(const CrowdSettings& options, const RunOutput
     const std::uint64_t samples = ticks / per_sample + 1;
     const auto searches = std::uint64_t(std::ceil(options.seconds / options.search_interval_s)) + 2;
     const auto steps = std::uint64_t(std::ceil(options.seconds * 8.0)) + 2;
+    // The first characters also keep their whole pose after every tick,
+    // and each of their searches its query until it is explained and then
+    // its two frames' channel costs (crowd_recorder.hpp).
+    const std::uint64_t detailed = std::min<std::uint64_t>(agents, kDefaultDetailAgents);
+    const std::uint64_t channels = database.schema().channels.size();
     const std::uint64_t recording =
         agents * (samples * (16 + points * 16 + 6 * 12) + searches * sizeof(SearchEvent) + steps * 16 + 48) +
-        frames * joints * 12;
+        frames * joints * 12 +
+        detailed * ((ticks + 1) * joints * 12 + searches * (dims * 4 + params + 160 + channels * 12));
     bytes += recording * 4;
   }
   if (outputs.trace_agents > 0) {

@@ -188,7 +188,10 @@ Result<std::size_t> CrowdSession::write_html(const std::filesystem::path& path) 
   if (ticks_ == 0) return make_error("write_html: nothing was recorded yet (step the crowd first)");
   // The recording ends at the first page, but is kept: a write that fails
   // (a missing folder, a full disk) can be retried with the same run.
-  if (!finished_) finished_ = recording_->finish(pool_);
+  if (!finished_) {
+    MMVK_ASSIGN_OR_RETURN(Recording finished, recording_->finish(pool_));
+    finished_ = std::move(finished);
+  }
   return write_viewer_html(path, *finished_);
 }
 

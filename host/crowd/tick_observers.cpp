@@ -111,6 +111,7 @@ void RecordingObserver::observe(const CrowdController& controller, const TickVie
   recorder_.record_tick(view.tick, controller.applied_matches(), controller.applied_characters(), kinds_before_,
                         frames_before_, view.world);
   const auto kinds = controller.searched();
+  recorder_.record_submitted(controller.submitted_characters(), controller.submitted_batch());
   std::copy(kinds.begin(), kinds.end(), kinds_before_.begin());
   const auto frames = controller.frames();
   std::copy(frames.begin(), frames.end(), frames_before_.begin());

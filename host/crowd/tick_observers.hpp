@@ -86,7 +86,7 @@ class RecordingObserver {
                     std::uint32_t ticks_per_sample);
 
   void observe(const CrowdController& controller, const TickView& view);
-  Recording finish(ThreadPool& pool) { return recorder_.finish(pool); }
+  Result<Recording> finish(ThreadPool& pool) { return recorder_.finish(pool); }
 
  private:
   CrowdRecorder recorder_;

@@ -174,6 +174,14 @@ class CrowdController {
     return std::span<const std::uint32_t>(applied_.characters).first(applied_.count);
   }
   std::span<const Match> applied_matches() const { return std::span<const Match>(applied_.matches).first(applied_.count); }
+  // The batch the last tick searched (for the deferred tick, the one it
+  // submitted): its characters, ascending, and its queries, row i for
+  // character submitted_characters()[i]; views of the controller's buffers,
+  // valid until its next tick.
+  std::span<const std::uint32_t> submitted_characters() const {
+    return std::span<const std::uint32_t>(batch_.characters).first(batch_.count);
+  }
+  QueryBatch submitted_batch() const { return batch_queries(); }
 
   // Per-character output, [B] unless noted.
   std::span<const std::uint32_t> frames() const { return playback_.frames; }       // database frame played

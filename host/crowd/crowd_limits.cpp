@@ -123,6 +123,12 @@ std::uint64_t estimate_crowd_bytes(const CrowdSettings& options, const RunOutput
     // --trace: the traced characters' world joints and contact bits per tick.
     bytes += ticks * std::min<std::uint64_t>(outputs.trace_agents, agents) * (joints * 12 + 2);
   }
+  if (outputs.export_agents > 0) {
+    // --bvh / --gltf: the exported characters' roots and local poses per
+    // tick (pose_recording.hpp), and while the glTF is written its binary
+    // chunk and the file, each about the recording's size (a BVH is smaller).
+    bytes += 3 * ticks * std::min<std::uint64_t>(outputs.export_agents, agents) * (joints * 16 + 40);
+  }
   return bytes;
 }
 

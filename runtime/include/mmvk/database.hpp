@@ -12,6 +12,7 @@
 
 #include "mmvk/animation_data.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/gait_bands.hpp"
 #include "mmvk/normalization.hpp"
 #include "mmvk/status.hpp"
 
@@ -66,6 +67,10 @@ struct DatabaseParts {
   // The manifest's "crowd" block as JSON text (a crowd host's tuned settings
   // for this data), or empty; not part of content_hash().
   std::string crowd_settings;
+  // The parameters the build measured the gait tags with (gait_bands.hpp),
+  // or none (measurement off, a file before format 7). When set, the tag
+  // names hold every kGaitTagNames entry.
+  std::optional<GaitBandParams> gait_bands;
 };
 
 class Database {
@@ -90,6 +95,8 @@ class Database {
   const AnimationData* animation() const { return parts_.animation ? &*parts_.animation : nullptr; }
   // DatabaseParts::crowd_settings: JSON text of an object, or empty.
   const std::string& crowd_settings() const { return parts_.crowd_settings; }
+  // DatabaseParts::gait_bands, or null when the frames carry no measured gait tags.
+  const GaitBandParams* gait_bands() const { return parts_.gait_bands ? &*parts_.gait_bands : nullptr; }
 
   // Per-frame metadata, [frame_count] each (the clip's values repeated, or
   // DatabaseParts' per-frame values, so backends index them by frame without

@@ -306,6 +306,16 @@ std::string read_animation(Reader& in, std::uint32_t version, AnimationData& a) 
   return {};
 }
 
+// Version 7: a presence byte, then the measured gait bands' parameters.
+void write_gait_bands(Writer& file, const std::optional<GaitBandParams>& bands) {
+  file.u8(bands ? 1 : 0);
+  if (!bands) return;
+  for (float value : {bands->walk_from_mps, bands->jog_from_mps, bands->run_from_mps, bands->hysteresis,
+                      bands->smoothing_seconds, bands->transition_seconds}) {
+    file.f32(value);
+  }
+}
+
 }  // namespace
 
 std::string serialize_database(const Database& database) {
@@ -315,13 +325,13 @@ std::string serialize_database(const Database& database) {
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
   // The oldest version that holds the database, so that older builds read
-  // what they can: 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
+  // what they can: 7 with measured gait bands, 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
   // with import units, else 3 with per-frame modifiers, else 2.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
   const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
                                  [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
   const std::uint32_t version =
-      !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
+      parts.gait_bands ? 7u : !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
   file.u32(version);
   file.u32(0);
   file.u64(0);
@@ -362,6 +372,7 @@ std::string serialize_database(const Database& database) {
     for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
   if (version >= 6) file.str(parts.crowd_settings);
+  if (version >= 7) write_gait_bands(file, parts.gait_bands);
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
 
@@ -524,6 +535,7 @@ class PayloadReader {
       }
     }
     if (version_ >= 6 && !in_.str(parts.crowd_settings)) return corrupt("crowd settings");
+    if (version_ >= 7) MMVK_TRY(read_gait_bands(parts));
     if (version_ >= 2) {
       std::uint8_t has_animation = 0;
       if (!in_.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");
@@ -538,6 +550,18 @@ class PayloadReader {
   }
 
  private:
+  Status read_gait_bands(DatabaseParts& parts) {
+    std::uint8_t present = 0;
+    if (!in_.u8(present) || present > 1) return corrupt("gait bands presence byte");
+    if (!present) return {};
+    GaitBandParams& bands = parts.gait_bands.emplace();
+    for (float* value : {&bands.walk_from_mps, &bands.jog_from_mps, &bands.run_from_mps, &bands.hysteresis,
+                         &bands.smoothing_seconds, &bands.transition_seconds}) {
+      if (!in_.f32(*value)) return corrupt("gait bands");
+    }
+    return {};
+  }
+
   Error corrupt(const std::string& what) const {
     return make_error(source_ + ": corrupt mmvk database payload: " + what + " at byte " +
                       std::to_string(in_.position()));

@@ -59,7 +59,10 @@ std::string crowd_footer() {
   std::string out = kCrowdFiles;
   out += "\nshipped motion sets (--data NAME; the first is the default):\n";
   for (const crowd::ShippedData& data : crowd::shipped_data()) {
-    out += help_entry(data.name, std::string(data.description) + shipped_settings(data), 22);
+    out += help_entry(data.name,
+                      std::string(data.description) + ". Can do: " + std::string(data.capabilities) +
+                          " (measured gait tags; mmvk inspect has the counts)" + shipped_settings(data),
+                      22);
   }
   return out + "\nbackends:\n" + crowd::crowd_backend_help();
 }

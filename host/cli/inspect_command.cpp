@@ -11,6 +11,7 @@
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "mmvk/database_io.hpp"
+#include "mmvk/gait_coverage.hpp"
 #include "mmvk/hash.hpp"
 #include "mmvk/input_text.hpp"
 #include "mmvk/normalization.hpp"
@@ -29,7 +30,8 @@ constexpr std::size_t kMaxListBytes = 1024;
 
 constexpr const char* kInspectDescription =
     "Prints the database's frames, clips, fps, tags, frame flag counts, the metres per file unit the import used, "
-    "the skeleton's standing height, the walk and run speeds the crowd measures and, per channel and dimension, the "
+    "the skeleton's standing height, the walk and run speeds the crowd measures, what the data can do (stand, start, "
+    "stop, the speed bands it covers: the measured gait tags), and, per channel and dimension, the "
     "normalization offset and scale and the raw (unnormalized) mean, std, min and max.";
 
 std::string tag_list(const Database& db, TagMask mask) {
@@ -104,6 +106,32 @@ nlohmann::json channels_json(const Database& db, const std::vector<RawDimStats>&
   return channels;
 }
 
+// The measured gait tags' coverage (mmvk/gait_coverage.hpp); null when the
+// database has none.
+nlohmann::json gait_json(const Database& db) {
+  const GaitCoverage coverage = measure_gait_coverage(db);
+  if (!coverage.measured) return nullptr;
+  const GaitBandParams& params = *db.gait_bands();
+  nlohmann::json bands = nlohmann::json::object();
+  for (std::size_t b = 0; b < kGaitBandCount; ++b) {
+    bands[std::string(kGaitTagNames[b].substr(kGaitTagPrefix.size()))] = coverage.band_frames[b];
+  }
+  return {{"capabilities", gait_capabilities(coverage)},
+          {"stands", coverage.can_stand()},
+          {"longest_stand_s", coverage.longest_stand_seconds},
+          {"stand_loop", coverage.stand_loop},
+          {"band_frames", bands},
+          {"start_frames", coverage.start_frames},
+          {"stop_frames", coverage.stop_frames},
+          {"stand_both_feet_frames", coverage.has_contacts ? nlohmann::json(coverage.stand_both_feet_frames) : nullptr},
+          {"moving_mps_p5", coverage.moving_p95_mps > 0.0f ? nlohmann::json(coverage.moving_p5_mps) : nullptr},
+          {"moving_mps_p95", coverage.moving_p95_mps > 0.0f ? nlohmann::json(coverage.moving_p95_mps) : nullptr},
+          {"thresholds", {{"walk_from_mps", params.walk_from_mps}, {"jog_from_mps", params.jog_from_mps},
+                          {"run_from_mps", params.run_from_mps}, {"hysteresis", params.hysteresis},
+                          {"smoothing_seconds", params.smoothing_seconds},
+                          {"transition_seconds", params.transition_seconds}}}};
+}
+
 void print_json(const Database& db, const std::string& path, const Counts& counts) {
   nlohmann::json out;
   out["file"] = path;
@@ -120,6 +148,7 @@ void print_json(const Database& db, const std::string& path, const Counts& count
   out["channels"] = channels_json(db, raw_statistics(db));
   out["animation"] = animation_json(db);
   out["units"] = units_json(db);
+  out["gait"] = gait_json(db);
   out["clips"] = nlohmann::json::array();
   for (const Clip& clip : db.clips()) {
     out["clips"].push_back({{"name", clip.name}, {"source", clip.source}, {"first_frame", clip.first_frame},
@@ -139,6 +168,9 @@ void print_summary(const Database& db, const std::string& path, const Counts& co
   std::printf("content hash: %s\n", hash_hex(db.content_hash()).c_str());
   print_animation(db);
   print_units(db);
+  const GaitCoverage coverage = measure_gait_coverage(db);
+  std::printf("can do: %s\n", gait_capabilities(coverage).c_str());
+  if (coverage.measured) std::printf("%s\n", describe_gait_coverage(coverage, db.gait_bands()).c_str());
   std::printf("frame flags: %s do_not_use, %s block_transition, %s edge_excluded; %s candidate frames\n",
               thousands(counts.do_not_use).c_str(), thousands(counts.block).c_str(), thousands(counts.edge).c_str(),
               thousands(counts.candidates).c_str());

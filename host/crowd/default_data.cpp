@@ -62,11 +62,14 @@ std::span<const ShippedData> shipped_data() {
   static constexpr ShippedData kShipped[] = {
       {"cmu-walk-run", "cmu16", "CMU 16 walks and runs",
        "CMU subject 16: walks (veer left, 90-degree left turn) at 1.6 m/s, jogs (90-degree turns, a jog "
-       "to a stop) at 1.7-2.4 m/s, a run (veer right) at 3.6 m/s; tagged walk/jog/run. 6 short takes, 329 "
-       "frames (11 s) at 30 fps, mirrored, trajectories extrapolated past the takes' ends"},
+       "to a stop) at 1.7-2.4 m/s, a run (veer right) at 3.6 m/s; tagged walk/jog/run; a 0.2 s standing loop "
+       "cut from the stop's end, tagged stand. 6 short takes, 335 frames (11 s) at 30 fps, mirrored, "
+       "trajectories extrapolated past the takes' ends",
+       "stands: yes, starts: no, stops: yes, speeds: walk, jog, run"},
       {"cmu-walks", "cmu131", "CMU 131 walks",
        "CMU subject 131: start/walk/stop and curved walks at 0.2-0.7 m/s (stylised, slow); no run. "
-       "8 takes, 2,876 frames at 30 fps, mirrored"},
+       "8 takes and two 0.2 s standing loops cut from their ends (tagged stand), 2,889 frames at 30 fps, mirrored",
+       "stands: yes, starts: yes, stops: yes, speeds: walk"},
   };
   return kShipped;
 }

@@ -32,6 +32,10 @@ struct ShippedData {
   std::string_view folder;       // under host/crowd/data (installed: <prefix>/share/mmvk/crowd)
   std::string_view label;        // short, for the viewer's header: "CMU 131 walks"
   std::string_view description;  // what it holds, for --help and the README
+  // What it can do, for --help without reading the data: the line
+  // gait_capabilities() (mmvk/gait_coverage.hpp) gives for the built set,
+  // which a test checks against the build.
+  std::string_view capabilities;
 };
 
 // Every shipped set; the first is the default.

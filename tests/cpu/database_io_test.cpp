@@ -132,6 +132,33 @@ TEST(DatabaseIo, ImportUnitsMakeAVersion4FileAndRoundTrip) {
   }
 }
 
+TEST(DatabaseIo, GaitBandsMakeAVersion7FileAndRoundTrip) {
+  const Database without = make_database();
+  DatabaseParts parts = without.parts();
+  for (std::string_view name : kGaitTagNames) parts.tag_names.emplace_back(name);
+  parts.gait_bands.emplace().run_from_mps = 3.5f;
+  Result<Database> with = Database::create(parts);
+  ASSERT_TRUE(with.ok()) << with.message();
+  const std::string bytes = serialize_database(*with);
+  EXPECT_EQ(bytes[8], char(7));
+  Result<Database> back = deserialize_database(bytes, "db.mmdb");
+  ASSERT_TRUE(back.ok()) << back.message();
+  ASSERT_NE(back->gait_bands(), nullptr);
+  EXPECT_EQ(back->gait_bands()->run_from_mps, 3.5f);
+  EXPECT_EQ(back->gait_bands()->walk_from_mps, GaitBandParams{}.walk_from_mps);
+  EXPECT_EQ(serialize_database(*back), bytes);
+  for (std::size_t size = 0; size < bytes.size(); size += 7) {
+    EXPECT_FALSE(deserialize_database(std::string_view(bytes).substr(0, size), "db.mmdb").ok()) << size;
+  }
+  // Parameters the build would refuse, or bands without their tags, are refused on load too.
+  parts.gait_bands->run_from_mps = 1.0f;
+  EXPECT_NE(Database::create(parts).message().find("gait_bands.run_from_mps: must be above jog_from_mps"),
+            std::string::npos);
+  DatabaseParts untagged = without.parts();
+  untagged.gait_bands.emplace();
+  EXPECT_NE(Database::create(untagged).message().find("the tag 'gait:stand' is missing"), std::string::npos);
+}
+
 TEST(DatabaseIo, CrowdSettingsMakeAVersion6FileAndRoundTrip) {
   const Database without = make_database();
   DatabaseParts parts = without.parts();

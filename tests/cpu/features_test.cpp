@@ -210,8 +210,9 @@ TEST(DatabaseFromMotions, FlagsTagsMirrorsAndNormalization) {
   EXPECT_TRUE(db->clips()[2].mirrored);
   EXPECT_EQ(db->clips()[1].first_frame, 90u);
   EXPECT_EQ(db->clips()[1].cost_multiplier, 2.0f);
-  ASSERT_EQ(db->tag_names().size(), 2u);
+  ASSERT_EQ(db->tag_names().size(), 2u + kGaitTagNames.size());  // the manifest's, then the measured gait tags
   EXPECT_EQ(db->tag_names()[0], "walk");
+  EXPECT_EQ(db->tag_names()[2], kGaitTagNames[0]);
   EXPECT_EQ(db->clips()[1].tags, TagMask{3});
   std::uint32_t do_not_use = 0, block = 0, edge = 0;
   for (std::uint32_t f = 0; f < 240; ++f) {
@@ -276,6 +277,8 @@ TEST(DatabaseFromMotions, FlagsTagsMirrorsAndNormalization) {
   EXPECT_NE(mixed.message().find("b.bvh"), std::string::npos) << mixed.message();
 }
 
+// 64 tags in all: the measured gait tags (gait_bands.hpp) count, 58 of the
+// manifest's with them, 64 without.
 TEST(DatabaseFromMotions, AtMost64Tags) {
   std::vector<MotionClip> clips(2);
   for (MotionClip& clip : clips) {
@@ -287,13 +290,25 @@ TEST(DatabaseFromMotions, AtMost64Tags) {
   // (-Wrestrict, a known false positive) on the latter here.
   auto tag = [](int t) { return std::string("t").append(std::to_string(t)); };
   for (int t = 0; t < 40; ++t) clips[0].meta.tags.push_back(tag(t));
-  for (int t = 30; t < 64; ++t) clips[1].meta.tags.push_back(tag(t));
+  for (int t = 30; t < 58; ++t) clips[1].meta.tags.push_back(tag(t));
   Result<Database> full = build_database_from_motions(clips, {});
   ASSERT_TRUE(full.ok()) << full.message();
   EXPECT_EQ(full->tag_names().size(), 64u);
-  EXPECT_EQ(full->clips()[1].tags, ~TagMask{0} << 30);
+  EXPECT_EQ(full->clips()[1].tags, (~TagMask{0} << 30) & ~(~TagMask{0} << 58));
+  clips[1].meta.tags.push_back("t58");
+  Result<Database> no_room = build_database_from_motions(clips, {});
+  ASSERT_FALSE(no_room.ok());
+  EXPECT_NE(no_room.message().find("59 tags and the 6 measured gait tags are more than 64"), std::string::npos)
+      << no_room.message();
+  MotionBuildSettings unmeasured;
+  unmeasured.gait_bands.enabled = false;
+  for (int t = 59; t < 64; ++t) clips[1].meta.tags.push_back(tag(t));
+  Result<Database> own = build_database_from_motions(clips, unmeasured);
+  ASSERT_TRUE(own.ok()) << own.message();
+  EXPECT_EQ(own->tag_names().size(), 64u);
+  EXPECT_EQ(own->clips()[1].tags, ~TagMask{0} << 30);
   clips[1].meta.tags.push_back("one_too_many");
-  Result<Database> over = build_database_from_motions(clips, {});
+  Result<Database> over = build_database_from_motions(clips, unmeasured);
   ASSERT_FALSE(over.ok());
   EXPECT_NE(over.message().find("more than 64 distinct tags"), std::string::npos) << over.message();
   EXPECT_NE(over.message().find("one_too_many"), std::string::npos) << over.message();

@@ -393,7 +393,7 @@ TEST(FootContactsFile, LabelsJointsAndParametersRoundTrip) {
   Result<Database> db = build(rolling_step(), unusual_params());
   ASSERT_TRUE(db.ok()) << db.message();
   const std::string bytes = serialize_database(*db);
-  EXPECT_EQ(bytes[8], char(5));  // the animation section's version (no crowd settings)
+  EXPECT_EQ(bytes[8], char(7));  // the build's measured gait bands (format 7) carry the version 5 animation section
   Result<Database> back = deserialize_database(bytes, "feet.mmdb");
   ASSERT_TRUE(back.ok()) << back.message();
   const AnimationData& a = *db->animation();
@@ -433,8 +433,15 @@ std::uint32_t get_u32(const std::string& bytes, std::size_t at) {
 
 // The same database as a format 3 or 4 file would hold it: the old contact
 // setup (one joint per side, max height and 3-D speed) and planted bits
-// alone; format 3 without the import units' presence byte.
-std::string as_old_format(const Database& db, std::uint32_t version) {
+// alone; format 3 without the import units' presence byte. Made from the
+// database as a format 5 file would hold it: without the gait bands that
+// format 7 adds (their tags stay, as ordinary per-frame tags).
+std::string as_old_format(const Database& measured, std::uint32_t version) {
+  DatabaseParts parts = measured.parts();
+  parts.gait_bands.reset();
+  Result<Database> unmeasured = Database::create(std::move(parts));
+  EXPECT_TRUE(unmeasured.ok()) << unmeasured.message();
+  const Database& db = *unmeasured;
   std::string bytes = serialize_database(db);
   const AnimationData& a = *db.animation();
   // The new setup starts 16 bytes (4 joints) before the left toe's name.

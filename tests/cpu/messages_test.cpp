@@ -39,7 +39,9 @@ TEST(Messages, UnknownTagListsTheKnownOnes) {
   const std::vector<std::string> jump = {"jump"};
   const Result<TagMask> mask = database.tag_mask(jump);
   ASSERT_FALSE(mask.ok());
-  EXPECT_EQ(mask.message(), "unknown tag 'jump': the database's tags are walk, run, fast (exact, case-sensitive)");
+  EXPECT_EQ(mask.message(),
+            "unknown tag 'jump': the database's tags are walk, run, fast, gait:stand, gait:walk, gait:jog, gait:run, "
+            "gait:start, gait:stop (exact, case-sensitive)");
 }
 
 TEST(Messages, MissingAnimationNamesEveryCauseWhenTheFileDoesNotSay) {

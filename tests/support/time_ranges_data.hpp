@@ -20,12 +20,14 @@
 namespace mmvk::test {
 
 // A manifest over two Bandai walks (9 s each) at 30 fps; `clip0_extra` and
-// `clip1_extra` are JSON members added to each clip object.
+// `clip1_extra` are JSON members added to each clip object. The measured
+// gait tags are off, so that the range tags are the frames' only per-frame
+// tags (tests/cpu/gait_bands_test.cpp has the two together).
 inline std::filesystem::path write_ranges_manifest(const std::filesystem::path& data, const std::string& clip0_extra,
                                                    const std::string& clip1_extra) {
   const std::filesystem::path dir = make_temp_dir();
   const std::filesystem::path folder = data / "bandai-namco-nc/locomotion-normal";
-  std::ofstream(dir / "m.json") << R"({"fps": 30, "clips": [
+  std::ofstream(dir / "m.json") << R"({"fps": 30, "gait_bands": {"enabled": false}, "clips": [
       {"file": ")" << (folder / "dataset-2_walk_normal_001.bvh").string()
                                 << R"(", "tags": ["walk"])" << clip0_extra << R"(},
       {"file": ")" << (folder / "dataset-2_walk_normal_002.bvh").string()

@@ -12,6 +12,7 @@
 
 #include "mmvk/animation_data.hpp"
 #include "mmvk/feature_schema.hpp"
+#include "mmvk/gait_bands.hpp"
 #include "mmvk/normalization.hpp"
 #include "mmvk/status.hpp"
 
@@ -75,6 +76,10 @@ struct DatabaseParts {
   // --no-animation", or the clips whose skeletons differ); empty when it is
   // present or the file does not say (before format 7).
   std::string no_animation_reason;
+  // The parameters the build measured the gait tags with (gait_bands.hpp),
+  // or none (measurement off, a file before format 7). When set, the tag
+  // names hold every kGaitTagNames entry.
+  std::optional<GaitBandParams> gait_bands;
 };
 
 class Database {
@@ -101,6 +106,8 @@ class Database {
   const std::string& crowd_settings() const { return parts_.crowd_settings; }
   // DatabaseParts::no_animation_reason.
   const std::string& no_animation_reason() const { return parts_.no_animation_reason; }
+  // DatabaseParts::gait_bands, or null when the frames carry no measured gait tags.
+  const GaitBandParams* gait_bands() const { return parts_.gait_bands ? &*parts_.gait_bands : nullptr; }
 
   // Per-frame metadata, [frame_count] each (the clip's values repeated, or
   // DatabaseParts' per-frame values, so backends index them by frame without

@@ -29,6 +29,11 @@
 //     ("db.json: clips[2].tag_ranges.jump[0]: ... lies outside the clip").
 //     With any of them, the database stores per-frame tags and costs
 //     (DatabaseParts::frame_tags and the others), which every backend reads.
+//   - Gait tags: with gait_bands enabled (the default), every frame carries
+//     the measured tags of gait_bands.hpp (its speed band, and start or stop
+//     near a stand), numbered after the manifest's own tags, and the
+//     database keeps the parameters (Database::gait_bands). A manifest tag
+//     that begins with "gait:" is an error naming the field.
 //   - Normalization statistics are taken over every frame of the database
 //     (normalization.hpp); tags are numbered in order of first appearance.
 //   - Skeletons may differ between clips as long as the schema's bones
@@ -103,6 +108,7 @@ struct MotionBuildSettings {
   EdgeRule edge_rule = EdgeRule::Exclude;
   AnimationBuildOptions animation;
   FootContactParams contacts;  // the animation's contacts and the foot_contact channel (Manifest::contacts)
+  GaitBandParams gait_bands;   // the measured gait tags (Manifest::gait_bands)
 };
 
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings);

@@ -27,6 +27,9 @@
 //                         str  the crowd settings (DatabaseParts::crowd_settings;
 //                              version 6 on; version 6 is written only for a
 //                              database that has them)
+//                         u8   1 when the gait bands follow, else 0 (version 7
+//                              on): f32 walk_from, jog_from, run_from (m/s),
+//                              hysteresis, smoothing seconds, transition seconds
 //                         u8   1 when the animation section follows, else 0 (version 2)
 //                         the animation section (version 2, animation_data.hpp):
 //                              u32 joints, then per joint: str name, i32 parent,
@@ -75,13 +78,15 @@ namespace mmvk {
 // contact labels of foot_contacts.hpp (toe and heel bits, hysteresis and
 // minimum durations on horizontal speed), version 6 the manifest's crowd
 // settings, version 7 the record of the import (each clip's units_from and
-// axes_from, the no_animation_reason). A file gets the oldest version that
-// holds it: 7 with an import record, else 6 with crowd settings, else 5 with animation, else 4 with import units, else 3 with
-// per-frame modifiers, else 2. Versions 1 to 6 still load (version 1:
-// features only, Database::animation() null; before 4: Clip::metres_per_unit
-// 0; before 5: the planted bits gain the bit of the point they were detected
-// on, and AnimationData::legacy_contacts is set; before 7: the import record
-// empty).
+// axes_from, the no_animation_reason) and the measured gait bands
+// (gait_bands.hpp). A file gets the oldest version that holds it: 7 with an
+// import record or gait bands, else 6 with crowd settings, else 5 with
+// animation, else 4 with import units, else 3 with per-frame modifiers, else
+// 2. Versions 1 to 6 still load (version 1: features only,
+// Database::animation() null; before 4: Clip::metres_per_unit 0; before 5:
+// the planted bits gain the bit of the point they were detected on, and
+// AnimationData::legacy_contacts is set; before 7: no import record and no
+// gait bands).
 inline constexpr std::uint32_t kDatabaseFormatVersion = 7;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 

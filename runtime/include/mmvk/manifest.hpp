@@ -16,6 +16,11 @@
 //   "contacts": { "enter_speed": 0.1, "exit_speed": 0.2, ... },
 //                              // foot contact detection: any FootContactParams
 //                              // field by name (foot_contacts.hpp; defaults there)
+//   "gait_bands": { "walk_from_mps": 0.15, "jog_from_mps": 2.0, "run_from_mps": 3.0,
+//                   "hysteresis": 0.1, "smoothing_seconds": 0.25, "transition_seconds": 1.0,
+//                   "enabled": true },
+//                              // the measured gait tags: any GaitBandParams field
+//                              // by name (gait_bands.hpp; defaults there)
 //   "crowd": { "correction_half_life": 0.07, ... },
 //                              // settings a crowd host tuned for this data, kept in
 //                              // the database as they are (Database::crowd_settings)
@@ -52,6 +57,7 @@
 #include "mmvk/character.hpp"
 #include "mmvk/feature_schema.hpp"
 #include "mmvk/foot_contacts.hpp"
+#include "mmvk/gait_bands.hpp"
 #include "mmvk/motion.hpp"
 #include "mmvk/status.hpp"
 
@@ -158,6 +164,7 @@ struct Manifest {
   std::vector<BonePair> mirror_bones;     // overrides mirror_pairs()' heuristics
   std::vector<SidecarMirror> mirror_map;
   FootContactParams contacts;      // the animation's contacts and the foot_contact channel
+  GaitBandParams gait_bands;       // the measured gait tags (gait_bands.hpp)
   // The "crowd" object as JSON text, or empty: read by the crowd host
   // (host/crowd/data_settings.hpp), which names its unknown keys; the build
   // only carries it into the database.

@@ -40,8 +40,21 @@ Status validate_frame_modifiers(const DatabaseParts& parts, TagMask valid_tags) 
   return {};
 }
 
+// Measured gait tags need their parameters valid and their names present.
+Status validate_gait_bands(const DatabaseParts& parts) {
+  if (!parts.gait_bands) return {};
+  MMVK_TRY(validate_gait_band_params(*parts.gait_bands, "database: gait_bands"));
+  for (std::string_view name : kGaitTagNames) {
+    if (std::find(parts.tag_names.begin(), parts.tag_names.end(), name) == parts.tag_names.end()) {
+      return make_error("database: gait bands are set but the tag '" + std::string(name) + "' is missing");
+    }
+  }
+  return {};
+}
+
 Status validate_parts(const DatabaseParts& parts) {
   MMVK_TRY(parts.schema.validate());
+  MMVK_TRY(validate_gait_bands(parts));
   const std::uint32_t dims = parts.schema.dims();
   if (!(parts.fps > 0.0f) || !std::isfinite(parts.fps)) {
     return make_error("database: fps must be positive, got " + std::to_string(parts.fps));

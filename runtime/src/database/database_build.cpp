@@ -1,6 +1,7 @@
 #include "mmvk/database_build.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,7 @@ struct ProcessedClip {
   // [frames] each when the clip has cost ranges, else empty (the clip's values).
   std::vector<float> multiplier;
   std::vector<float> bias;
+  std::vector<GaitTags> gait;  // [frames] when gait bands are measured
 };
 
 bool in_range(std::size_t frame, float fps, const TimeRange& range) {
@@ -99,6 +101,10 @@ Result<std::size_t> tag_index(std::vector<std::string>& names, const std::string
                               const std::string& clip) {
   auto it = std::find(names.begin(), names.end(), tag);
   if (it != names.end()) return static_cast<std::size_t>(it - names.begin());
+  if (tag.starts_with(kGaitTagPrefix)) {
+    return make_error(source + ": clip '" + clip + "': tag '" + tag + "' begins with '" + std::string(kGaitTagPrefix) +
+                      "', which is kept for the measured gait tags (gait_bands.hpp)");
+  }
   if (names.size() == kMaxTags) {
     return make_error(source + ": more than " + std::to_string(kMaxTags) + " distinct tags (clip '" + clip +
                       "' adds '" + tag + "')");
@@ -173,6 +179,7 @@ Result<ProcessedClip> process_motion(const ManifestClip& meta, const Motion& mot
   flag_ranges(meta.do_not_use, motion.fps, kFrameDoNotUse, out.flags);
   flag_ranges(meta.block_transition, motion.fps, kFrameBlockTransition, out.flags);
   MMVK_TRY(apply_time_ranges(meta, motion.frame_count, motion.fps, out));
+  if (settings.gait_bands.enabled) out.gait = measure_gait_tags(root->positions, motion.fps, meta.loop, settings.gait_bands);
   out.raw = std::move(*raw);
   if (settings.animation.enabled) {
     Result<detail::ClipAnimation> animation =
@@ -254,9 +261,44 @@ Status add_frame_modifiers(const ProcessedClip& processed, const Clip& clip, con
   return {};
 }
 
+// The measured gait tags (gait_bands.hpp), numbered after the clips' own,
+// on every frame; the database then keeps per-frame tags.
+Status add_gait_tags(const std::vector<ProcessedClip>& clips, const GaitBandParams& params, const std::string& source,
+                     DatabaseParts& parts) {
+  if (!params.enabled) return {};
+  if (parts.tag_names.size() + kGaitTagNames.size() > kMaxTags) {
+    return make_error(source + ": " + std::to_string(parts.tag_names.size()) + " tags and the " +
+                      std::to_string(kGaitTagNames.size()) + " measured gait tags are more than " +
+                      std::to_string(kMaxTags) + " distinct tags; use fewer tags or turn the measured ones off "
+                      "(\"gait_bands\": {\"enabled\": false})");
+  }
+  std::array<TagMask, kGaitTagNames.size()> bits{};
+  for (std::size_t i = 0; i < kGaitTagNames.size(); ++i) {
+    bits[i] = TagMask{1} << parts.tag_names.size();
+    parts.tag_names.emplace_back(kGaitTagNames[i]);
+  }
+  if (parts.frame_tags.empty()) {
+    for (const Clip& clip : parts.clips) {
+      parts.frame_tags.insert(parts.frame_tags.end(), clip.frame_count, clip.tags);
+      parts.frame_multiplier.insert(parts.frame_multiplier.end(), clip.frame_count, clip.cost_multiplier);
+      parts.frame_bias.insert(parts.frame_bias.end(), clip.frame_count, clip.cost_bias);
+    }
+  }
+  for (std::size_t c = 0; c < clips.size(); ++c) {
+    const std::uint32_t first = parts.clips[c].first_frame;
+    for (std::size_t f = 0; f < clips[c].gait.size(); ++f) {
+      for (std::size_t i = 0; i < bits.size(); ++i) {
+        if ((clips[c].gait[f] >> i) & 1u) parts.frame_tags[first + f] |= bits[i];
+      }
+    }
+  }
+  parts.gait_bands = params;
+  return {};
+}
+
 // Concatenates processed clips, normalizes and creates the Database.
 Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema& schema, float fps,
-                          const FootContactParams& contacts,
+                          const FootContactParams& contacts, const GaitBandParams& gait_bands,
                           const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
                           const std::string& source, const std::string& crowd_settings) {
   if (clips.empty()) return make_error(source + ": no clips");
@@ -287,6 +329,7 @@ Result<Database> assemble(std::vector<ProcessedClip>& clips, const FeatureSchema
     processed.raw = {};
     processed.flags = {};
   }
+  MMVK_TRY(add_gait_tags(clips, gait_bands, source, parts));
   Result<std::vector<DimNormalization>> normalization = compute_normalization(schema, parts.features);
   if (!normalization.ok()) return make_error(source + ": " + normalization.message());
   parts.normalization = std::move(*normalization);
@@ -438,7 +481,7 @@ Status load_motion(const Manifest& manifest, const ManifestClip& meta, SourceMot
     keep_frames(*motion, custom, first, end - first);
   }
   const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation,
-                                     manifest.contacts};
+                                     manifest.contacts, manifest.gait_bands};
   MMVK_ASSIGN_OR_RETURN(ProcessedClip processed, process_motion(meta, *motion, custom, false, settings));
   record_import(source, processed.clip);
   out.clips.push_back(std::move(processed));
@@ -489,6 +532,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     if (!valid.ok()) return make_error(source + ": " + valid.message());
   }
   MMVK_TRY(validate_foot_contact_params(manifest.contacts, source + ": contacts"));
+  MMVK_TRY(validate_gait_band_params(manifest.gait_bands, source + ": gait_bands"));
   if (manifest.clips.empty()) return make_error(source + ": no clips");
   // 0 keeps the source rate; anything else is a resampling target (the
   // manifest parser checks this too, but --fps overrides it afterwards).
@@ -542,7 +586,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
     clip.clips.clear();
   }
   MMVK_ASSIGN_OR_RETURN(Database database,
-                        assemble(clips, manifest.schema, fps, manifest.contacts, options.animation, manifest.mirror_bones, source,
+                        assemble(clips, manifest.schema, fps, manifest.contacts, manifest.gait_bands, options.animation, manifest.mirror_bones, source,
                                  manifest.crowd));
   MMVK_TRY(detail::check_cost_overflow(database, source));
   return database;
@@ -551,6 +595,7 @@ Result<Database> build_database(const Manifest& manifest, const BuildOptions& op
 Result<Database> build_database_from_motions(std::span<const MotionClip> clips, const MotionBuildSettings& settings) {
   MMVK_TRY(settings.schema.validate());
   MMVK_TRY(validate_foot_contact_params(settings.contacts, "build_database_from_motions: contacts"));
+  MMVK_TRY(validate_gait_band_params(settings.gait_bands, "build_database_from_motions: gait_bands"));
   if (clips.empty()) return make_error("build_database_from_motions: no clips");
   const float fps = clips[0].motion.fps;
   std::vector<ProcessedClip> processed;
@@ -563,7 +608,7 @@ Result<Database> build_database_from_motions(std::span<const MotionClip> clips, 
     if (!one.ok()) return one.error();
     processed.push_back(std::move(*one));
   }
-  MMVK_ASSIGN_OR_RETURN(Database database, assemble(processed, settings.schema, fps, settings.contacts,
+  MMVK_ASSIGN_OR_RETURN(Database database, assemble(processed, settings.schema, fps, settings.contacts, settings.gait_bands,
                                                     settings.animation, {}, "build_database_from_motions", ""));
   MMVK_TRY(detail::check_cost_overflow(database, "build_database_from_motions"));
   return database;

@@ -237,6 +237,16 @@ void write_import_record(Writer& file, const DatabaseParts& parts) {
   file.str(parts.no_animation_reason);
 }
 
+// Version 7: a presence byte, then the measured gait bands' parameters.
+void write_gait_bands(Writer& file, const std::optional<GaitBandParams>& bands) {
+  file.u8(bands ? 1 : 0);
+  if (!bands) return;
+  for (float value : {bands->walk_from_mps, bands->jog_from_mps, bands->run_from_mps, bands->hysteresis,
+                      bands->smoothing_seconds, bands->transition_seconds}) {
+    file.f32(value);
+  }
+}
+
 }  // namespace
 
 std::string serialize_database(const Database& database) {
@@ -246,13 +256,13 @@ std::string serialize_database(const Database& database) {
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
   // The oldest version that holds the database, so that older builds read
-  // what they can: 7 with a record of the import, 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
+  // what they can: 7 with a record of the import or measured gait bands, 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
   // with import units, else 3 with per-frame modifiers, else 2.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
   const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
                                  [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
   const std::uint32_t version =
-      has_import_record(parts) ? 7u : !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
+      has_import_record(parts) || parts.gait_bands ? 7u : !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
   file.u32(version);
   file.u32(0);
   file.u64(0);
@@ -293,7 +303,10 @@ std::string serialize_database(const Database& database) {
     for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
   if (version >= 6) file.str(parts.crowd_settings);
-  if (version >= 7) write_import_record(file, parts);
+  if (version >= 7) {
+    write_import_record(file, parts);
+    write_gait_bands(file, parts.gait_bands);
+  }
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
 
@@ -461,6 +474,7 @@ class PayloadReader {
         if (!in_.str(clip.units_from) || !in_.str(clip.axes_from)) return corrupt("import record of clip '" + clip.name + "'");
       }
       if (!in_.str(parts.no_animation_reason)) return corrupt("import record's animation note");
+      MMVK_TRY(read_gait_bands(parts));
     }
     if (version_ >= 2) {
       std::uint8_t has_animation = 0;
@@ -476,6 +490,18 @@ class PayloadReader {
   }
 
  private:
+  Status read_gait_bands(DatabaseParts& parts) {
+    std::uint8_t present = 0;
+    if (!in_.u8(present) || present > 1) return corrupt("gait bands presence byte");
+    if (!present) return {};
+    GaitBandParams& bands = parts.gait_bands.emplace();
+    for (float* value : {&bands.walk_from_mps, &bands.jog_from_mps, &bands.run_from_mps, &bands.hysteresis,
+                         &bands.smoothing_seconds, &bands.transition_seconds}) {
+      if (!in_.f32(*value)) return corrupt("gait bands");
+    }
+    return {};
+  }
+
   Error corrupt(const std::string& what) const {
     return make_error(source_ + ": corrupt mmvk database payload: " + what + " at byte " +
                       std::to_string(in_.position()));

@@ -84,11 +84,24 @@ Result<float> read_multiplier(const Json& value, const std::string& where) {
   return multiplier;
 }
 
+// A manifest's own tag: not empty, and not one of the measured gait tags'
+// names (gait_bands.hpp), which the build adds itself.
+Status check_tag_name(const std::string& tag, const std::string& where) {
+  if (tag.empty()) return make_error(where + ": empty tag");
+  if (tag.starts_with(kGaitTagPrefix)) {
+    return make_error(where + ": '" + printable_text(tag) + "' begins with '" + std::string(kGaitTagPrefix) +
+                      "', which is kept for the tags the build measures (gait:stand, gait:walk, gait:jog, "
+                      "gait:run, gait:start, gait:stop); name it otherwise");
+  }
+  return {};
+}
+
 Result<std::vector<TagRange>> read_tag_ranges(const Json& value, const std::string& where) {
   if (!value.is_object()) return make_error(where + ": expected an object {\"tag\": [[begin, end], ...]}");
   std::vector<TagRange> out;
   for (const auto& item : value.items()) {
     if (item.key().empty()) return make_error(where + ": empty tag name");
+    MMVK_TRY(check_tag_name(item.key(), where + "." + printable_text(item.key())));
     Result<std::vector<TimeRange>> ranges = read_ranges(item.value(), where + "." + item.key());
     if (!ranges.ok()) return ranges.error();
     for (const TimeRange& range : *ranges) out.push_back({item.key(), range});
@@ -167,7 +180,7 @@ Result<ManifestClip> parse_clip(const Json& object, const std::string& where, co
     for (std::size_t i = 0; i < tags.size(); ++i) {
       std::string tag;
       MMVK_READ(tag, read_string(tags[i], where + ".tags[" + std::to_string(i) + "]"));
-      if (tag.empty()) return make_error(where + ".tags[" + std::to_string(i) + "]: empty tag");
+      MMVK_TRY(check_tag_name(tag, where + ".tags[" + std::to_string(i) + "]"));
       if (std::find(clip.tags.begin(), clip.tags.end(), tag) == clip.tags.end()) clip.tags.push_back(tag);
     }
   }
@@ -304,6 +317,26 @@ Result<FootContactParams> read_contacts(const Json& value, const std::string& wh
   read("height_above_clip_floor", params.height_above_clip_floor, read_bool);
   if (error) return *error;
   MMVK_TRY(validate_foot_contact_params(params, where));
+  return params;
+}
+
+// The "gait_bands" block: any subset of GaitBandParams' fields by name,
+// validated whole (the thresholds' order needs all three).
+Result<GaitBandParams> read_gait_bands(const Json& value, const std::string& where) {
+  if (!value.is_object()) return make_error(where + ": expected an object");
+  GaitBandParams params;
+  const std::pair<const char*, float*> numbers[] = {
+      {"walk_from_mps", &params.walk_from_mps},          {"jog_from_mps", &params.jog_from_mps},
+      {"run_from_mps", &params.run_from_mps},            {"hysteresis", &params.hysteresis},
+      {"smoothing_seconds", &params.smoothing_seconds}, {"transition_seconds", &params.transition_seconds}};
+  std::set<std::string> known = {"enabled"};
+  for (const auto& [name, target] : numbers) known.insert(name);
+  MMVK_TRY(check_fields(value, where, known));
+  if (value.contains("enabled")) MMVK_READ(params.enabled, read_bool(value["enabled"], where + ".enabled"));
+  for (const auto& [name, target] : numbers) {
+    if (value.contains(name)) MMVK_READ(*target, json_float(value[name], where + "." + name));
+  }
+  MMVK_TRY(validate_gait_band_params(params, where));
   return params;
 }
 
@@ -444,7 +477,7 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
   const Json root = std::move(*parsed);
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"clips\"");
   MMVK_TRY(check_fields(root, name + ": ", {"schema", "fps", "import", "character_root", "edge_rule", "mirror", "mirror_bones",
-                                          "mirror_map", "contacts", "crowd", "clips"}));
+                                          "mirror_map", "contacts", "gait_bands", "crowd", "clips"}));
 
   Manifest manifest;
   manifest.source = name;
@@ -469,6 +502,9 @@ Result<Manifest> parse_manifest_json(std::string_view json_text, std::string_vie
     MMVK_READ(manifest.mirror_map, read_mirror_map(root["mirror_map"], manifest.schema, at + "mirror_map"));
   }
   if (root.contains("contacts")) MMVK_READ(manifest.contacts, read_contacts(root["contacts"], at + "contacts"));
+  if (root.contains("gait_bands")) {
+    MMVK_READ(manifest.gait_bands, read_gait_bands(root["gait_bands"], at + "gait_bands"));
+  }
   if (root.contains("crowd")) {
     if (!root["crowd"].is_object()) return make_error(at + "crowd: expected an object of crowd settings");
     manifest.crowd = root["crowd"].dump();

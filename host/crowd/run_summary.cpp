@@ -29,6 +29,7 @@ CrowdSummary summarize_run(const RunParts& run) {
   s.forced_searches = run.controller.totals().forced;
   s.no_candidate = run.controller.totals().no_candidate;
   s.foot_ik = run.foot_ik;
+  s.speed_from_animation = run.speed_from_animation;
   // 0.07, not 0.0700000003.
   s.correction_half_life_s = std::round(double(run.params.correction_half_life) * 1e6) / 1e6;
   run.quality.summarize(s);

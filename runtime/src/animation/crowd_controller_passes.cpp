@@ -65,8 +65,9 @@ void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, floa
     // The simulated root's speed is the command as the character can follow
     // it: the animation moves at it where the bounds allow.
     const glm::vec3 v = roots_.simulated[b].velocity;
-    const detail::SpeedScale scale =
-        detail::speed_scale(params_, stride_speeds_[nearest_frame(database, before)], std::hypot(v.x, v.z));
+    const float target = std::sqrt(v.x * v.x + v.z * v.z);
+    const float stride_speed = stride_speeds_[nearest_frame(database, before)];
+    const detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target);
     playback_.rate[b] = scale.play_rate;
     playback_.stride[b] = scale.stride_scale;
     const PlaybackStep step = advance_playback(database, before, dt * database.fps() * scale.play_rate);
@@ -99,7 +100,7 @@ void CrowdController::blend(std::size_t begin, std::size_t end, float dt) {
     float& yaw = roots_.yaw[b];
     roots_.start_yaw[b] = yaw;
     const glm::vec3 step = playback_.step_translation[b] + offset.velocity * dt;
-    roots_.animated_speed[b] = std::hypot(step.x, step.z) / dt;
+    roots_.animated_speed[b] = std::sqrt(step.x * step.x + step.z * step.z) / dt;
     roots_.position[b] += detail::yaw_rotate(step, yaw);
     roots_.position[b].y = 0.0f;
     yaw = wrap_angle(yaw + playback_.step_yaw[b] + offset.yaw_rate * dt);

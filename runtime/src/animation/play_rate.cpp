@@ -16,14 +16,16 @@ std::vector<float> stride_speeds(const Database& database, float stride_window) 
   for (const Clip& clip : database.clips()) {
     path.assign(clip.frame_count, 0.0);
     for (std::uint32_t i = 1; i < clip.frame_count; ++i) {
-      const glm::vec3 step = animation.root_positions[clip.first_frame + i] - animation.root_positions[clip.first_frame + i - 1];
+      const glm::vec3* root = animation.root_positions.data() + clip.first_frame + i;
+      const glm::vec3 step = root[0] - root[-1];
       path[i] = path[i - 1] + std::hypot(double(step.x), double(step.z));
     }
     const auto last = std::int64_t(clip.frame_count) - 1;
     for (std::int64_t i = 0; i <= last; ++i) {
       const std::int64_t from = std::max<std::int64_t>(0, i - half), to = std::min(last, i + half);
       if (to == from) continue;  // a one-frame clip stands
-      speeds[clip.first_frame + std::size_t(i)] = float((path[std::size_t(to)] - path[std::size_t(from)]) * fps / double(to - from));
+      const double metres = path[std::size_t(to)] - path[std::size_t(from)];
+      speeds[clip.first_frame + std::size_t(i)] = float(metres * fps / double(to - from));
     }
   }
   return speeds;

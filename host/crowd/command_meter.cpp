@@ -66,7 +66,15 @@ void CommandMeter::record_steady(Agent& a, const Tick& tick, std::size_t b, doub
   a.shown_m += shown;
   a.commanded_m += horizontal(desired) * dt_;
   if (++a.window_ticks < settle_ticks_) return;
-  played_error_.add(std::abs(a.played_m / a.commanded_m - 1.0));
+  const double played_ratio = a.played_m / a.commanded_m;
+  played_error_.add(std::abs(played_ratio - 1.0));
+  if (std::abs(played_ratio - 1.0) > kMissedSpeed) {
+    CommandFigures::Missed& missed = played_ratio > 1.0 ? too_fast_ : too_slow_;
+    const double commanded = a.commanded_m / (double(a.window_ticks) * dt_);
+    ++missed.windows;
+    missed.min_mps = missed.windows == 1 ? commanded : std::min(missed.min_mps, commanded);
+    missed.max_mps = missed.windows == 1 ? commanded : std::max(missed.max_mps, commanded);
+  }
   shown_error_.add(std::abs(a.shown_m / a.commanded_m - 1.0));
   a.window_ticks = 0, a.played_m = a.shown_m = a.commanded_m = 0.0;
 }
@@ -89,6 +97,9 @@ CommandFigures CommandMeter::figures() const {
   f.shown_speed_error_p95 = shown_error_.quantile(0.95);
   f.heading_error_deg_median = heading_error_.quantile(0.5);
   f.heading_error_deg_p95 = heading_error_.quantile(0.95);
+  f.too_fast = too_fast_;
+  f.too_slow = too_slow_;
+  f.windows = played_error_.count();
   return f;
 }
 

@@ -21,6 +21,9 @@
 //   - heading error: on steady moving ticks, the shown root's yaw against the
 //     desired yaw (or, without one, the desired velocity's direction),
 //     degrees: median and p95.
+//   - missed speeds: the windows whose played speed is more than 20% off
+//     the command, too fast or too slow, with the commanded speeds they
+//     span: the speeds the data cannot play within the play-rate bounds.
 // A step longer than kTeleport (a character placed elsewhere between ticks)
 // is not travel and is left out.
 #pragma once
@@ -46,11 +49,21 @@ struct CommandFigures {
   double played_speed_error_median = kNone, played_speed_error_p95 = kNone;  // fractions of the command
   double shown_speed_error_median = kNone, shown_speed_error_p95 = kNone;
   double heading_error_deg_median = kNone, heading_error_deg_p95 = kNone;
+  // The speeds the data lacks: of the held windows, those whose played
+  // speed was more than kMissedSpeed above (too_fast) or below (too_slow)
+  // the command, their count and the range of commanded speeds (m/s).
+  struct Missed {
+    std::uint64_t windows = 0;
+    double min_mps = kNone, max_mps = kNone;
+  };
+  Missed too_fast, too_slow;
+  std::uint64_t windows = 0;  // held windows in all
 };
 
 class CommandMeter {
  public:
   static constexpr double kTeleport = 5.0;  // metres in one tick
+  static constexpr double kMissedSpeed = 0.2;  // fraction of the command
 
   CommandMeter(std::size_t agents, double dt);
 
@@ -88,6 +101,7 @@ class CommandMeter {
   Histogram glide_;           // cm/s
   Histogram played_error_, shown_error_;  // fractions
   Histogram heading_error_;   // degrees
+  CommandFigures::Missed too_fast_, too_slow_;
 };
 
 }  // namespace mmvk::crowd

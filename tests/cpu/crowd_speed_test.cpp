@@ -3,9 +3,10 @@
 // and 1.3 m/s through CrowdSession::step gets played speeds nearer the
 // command than the data's own speed (--speed-from-animation off), and the
 // root correction supplies less of the travel, little where the command is
-// within the play-rate bounds.
+// within the play-rate bounds; beyond them the summary's notes say so.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <vector>
@@ -37,7 +38,7 @@ Database default_data() {
 }
 
 // Four characters told to walk straight on at `speed` for 6 s.
-CommandFigures walk(const Database& db, float speed, bool speed_from_animation) {
+CrowdSummary walk(const Database& db, float speed, bool speed_from_animation) {
   CrowdSessionOptions options;
   options.agents = 4;
   options.backend = "fast-box";
@@ -48,19 +49,25 @@ CommandFigures walk(const Database& db, float speed, bool speed_from_animation) 
   for (std::uint32_t b = 0; b < 4; ++b) EXPECT_TRUE((*session)->place(b, 4.0f * float(b), 0.0f, 0.0f).ok());
   const std::vector<glm::vec3> velocity(4, glm::vec3(0.0f, 0.0f, speed));
   for (int tick = 0; tick < 180; ++tick) EXPECT_TRUE((*session)->step(velocity, {}).ok());
-  return (*session)->summary().command;
+  return (*session)->summary();
 }
 
 TEST(CrowdSpeed, PlayedSpeedNearerTheCommandAndLittleGlide) {
   const Database db = default_data();
   for (const float speed : {0.8f, 1.3f}) {
     SCOPED_TRACE(speed);
-    const CommandFigures on = walk(db, speed, true);
-    const CommandFigures off = walk(db, speed, false);
+    const CrowdSummary summary = walk(db, speed, true);
+    const CommandFigures& on = summary.command;
+    const CommandFigures off = walk(db, speed, false).command;
     std::printf("%.1f m/s: played speed error %.3f (off %.3f), glide share %.3f (off %.3f)\n", double(speed),
                 on.played_speed_error_median, off.played_speed_error_median, on.glide_share_of_travel,
                 off.glide_share_of_travel);
     EXPECT_LT(on.played_speed_error_median, off.played_speed_error_median);
+    // Beyond the bounds the notes say the data lacks slower motion.
+    const bool noted = std::any_of(summary.notes.begin(), summary.notes.end(), [](const std::string& note) {
+      return note.find("lacks slower motion") != std::string::npos;
+    });
+    EXPECT_EQ(noted, speed != kWithinBounds);
     if (speed == kWithinBounds) {
       EXPECT_LT(on.glide_share_of_travel, kMaxGlideShareWithinBounds);
     }

@@ -127,7 +127,7 @@ class Crowd:
                  scenario: Union[None, PathLike, Mapping[str, Any]] = None,
                  search_interval: float = 0.1, foot_ik: bool = True, record: bool = False,
                  title: str = "", correction_half_life: Optional[float] = None,
-                 record_poses: int = 0) -> None: ...
+                 record_poses: int = 0, speed_from_animation: bool = True) -> None: ...
     def step(self, desired_velocity: Optional[FloatArray] = None,
              desired_facing: Optional[FloatArray] = None) -> None:
         """One tick: own steering, or desired_velocity float32 [agents x 2|3] m/s and
@@ -171,6 +171,11 @@ class Crowd:
     @property
     def foot_locked(self) -> npt.NDArray[np.uint8]:
         """[agents x 2] (left, right)."""
+    @property
+    def play_rates(self) -> FloatArray:
+        """[agents] clip seconds per second in the last step."""
+    stride_scales: FloatArray  # read-only: [agents] the root motion's scale in the last step
+    root_corrections: FloatArray  # read-only: [agents x 3] the last step's root correction (the glide), metres
     @property
     def joint_positions(self) -> FloatArray:
         """[agents x joints x 3] displayed world positions, metres."""

@@ -107,15 +107,26 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.text("--html", options.html, "FILE", "write the viewer: one self-contained page");
 }
 
-// How the characters move: foot locking and the search's cost terms.
+// A switch's parser: `flag` on|off.
+auto on_off(const char* flag) {
+  return [flag](const std::string& text) -> Result<bool> {
+    if (text != "on" && text != "off") return make_error(std::string(flag) + " expects on or off, got '" + text + "'");
+    return text == "on";
+  };
+}
+
+// How the characters move: foot locking, speed from the animation and the
+// search's cost terms.
 void declare_motion(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.value("--foot-ik", options.foot_ik, "on|off",
             "lock planted feet where they touched down, legs solved by two-bone IK (default " +
                 std::string(options.foot_ik ? "on" : "off") + ")",
-            [](const std::string& text) -> Result<bool> {
-              if (text != "on" && text != "off") return make_error("--foot-ik expects on or off, got '" + text + "'");
-              return text == "on";
-            });
+            on_off("--foot-ik"));
+  cli.value("--speed-from-animation", options.speed_from_animation, "on|off",
+            "play each clip faster or slower and scale its stride toward the commanded speed, and hold the root "
+            "correction to half the animation's own speed (default " +
+                std::string(options.speed_from_animation ? "on" : "off") + "; off: the data's own speeds)",
+            on_off("--speed-from-animation"));
   cli.finite("--continuing-bias", options.continuing_bias, "B",
              "added to the cost of the frame a character would play anyway (default " +
                  number_text(crowd::kContinuingBias) + ": a jump must win by " + number_text(-crowd::kContinuingBias) +

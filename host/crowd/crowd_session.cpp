@@ -176,7 +176,7 @@ Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const fl
 CrowdSummary CrowdSession::summary() const {
   CrowdSummary s = summarize_run({database_, scenario_, speeds_, search_, *controller_, params_, *quality_, clips_,
                                   *steering_, ticks_, options_.rate_hz, options_.search_interval_s, options_.seed,
-                                  options_.foot_ik});
+                                  options_.foot_ik, options_.speed_from_animation});
   figures_.summarize(s, wall_s_);
   return s;
 }

@@ -112,6 +112,11 @@ ControllerParams controller_params(const CrowdSettings& s, const DataSettings& d
       s.continuing_multiplier.value_or(data.continuing_multiplier.value_or(params.continuing_multiplier));
   params.exclusion_window = s.exclusion_window.value_or(data.exclusion_window.value_or(params.exclusion_window));
   params.foot_ik.enabled = s.foot_ik;
+  if (!s.speed_from_animation) {
+    params.min_play_rate = params.max_play_rate = params.min_stride_scale = params.max_stride_scale = 1.0f;
+    // A floor at the cap leaves the cap as the only bound.
+    params.min_correction_speed = params.max_correction_speed;
+  }
   return params;
 }
 

@@ -36,6 +36,11 @@ struct CrowdSettings {
   std::optional<std::uint32_t> device;  // Vulkan device index; none = the best
   std::uint64_t seed = 1;               // the random scenario's
   bool foot_ik = true;                  // lock planted feet with two-bone IK
+  // Play rate and stride warping toward the commanded speed, and the root
+  // correction held to the animation's own speed (ControllerParams'
+  // defaults); false: every clip at its own speed, the correction bounded
+  // by max_correction_speed alone (the controller before them).
+  bool speed_from_animation = true;
   // Motion matching controls: none keeps the data's, else the crowd's defaults.
   std::optional<float> continuing_bias;
   std::optional<float> continuing_multiplier;  // >= 0

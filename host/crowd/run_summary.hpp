@@ -34,6 +34,7 @@ struct RunParts {
   double search_interval_s;
   std::uint64_t seed;
   bool foot_ik;
+  bool speed_from_animation;
 };
 
 CrowdSummary summarize_run(const RunParts& run);

@@ -23,6 +23,20 @@ void add_motion(nlohmann::ordered_json& j, const MotionFigures& m) {
                                     {"p95", number(m.foot_height_in_contact_cm_p95)}};
 }
 
+// The glide and the errors against the command (command_meter.hpp).
+void add_command(nlohmann::ordered_json& j, const CommandFigures& c) {
+  j["glide_cm_s"] = {{"mean", number(c.glide_cm_s_mean)},
+                     {"median", number(c.glide_cm_s_median)},
+                     {"p95", number(c.glide_cm_s_p95)}};
+  j["glide_share_of_travel"] = number(c.glide_share_of_travel);
+  j["animation_share_of_travel"] = number(c.animation_share_of_travel);
+  j["steady_moving_fraction"] = number(c.steady_moving_fraction);
+  j["played_speed_error"] = {{"median", number(c.played_speed_error_median)},
+                             {"p95", number(c.played_speed_error_p95)}};
+  j["shown_speed_error"] = {{"median", number(c.shown_speed_error_median)}, {"p95", number(c.shown_speed_error_p95)}};
+  j["heading_error_deg"] = {{"median", number(c.heading_error_deg_median)}, {"p95", number(c.heading_error_deg_p95)}};
+}
+
 }  // namespace
 
 std::string summary_to_json(const CrowdSummary& s) {
@@ -55,6 +69,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   j["realtime_factor"] = number(s.realtime_factor);
   j["trajectory_error_m_1s"] = number(s.trajectory_error_m_1s);
   j["foot_ik"] = s.foot_ik;
+  j["speed_from_animation"] = s.speed_from_animation;
   add_motion(j, s.motion);
   j["foot_sliding_before_ik_cm_s"] = number(s.motion.foot_sliding_before_ik_cm_s);
   j["foot_sliding_database_cm_s"] = number(s.clips.foot_sliding_cm_s);
@@ -67,6 +82,7 @@ std::string summary_to_json(const CrowdSummary& s) {
   clips["pose_acceleration_p99_m_s2"] = number(s.clips.pose_acceleration_p99_m_s2);
   clips["planted_height_m"] = {number(s.planted_height_m[0]), number(s.planted_height_m[1])};
   j["clips"] = clips;
+  add_command(j, s.command);
   j["transitions_per_agent_s"] = number(s.transitions_per_agent_s);
   j["goals_reached"] = s.goals_reached;
   // A string: a 64-bit value is not exact in every JSON reader's doubles.
@@ -83,18 +99,26 @@ std::string summary_to_json(const CrowdSummary& s) {
 std::string describe_motion(const CrowdSummary& s) {
   const MotionFigures& m = s.motion;
   const MotionFigures& c = s.clips;
-  char text[768];
+  const CommandFigures& g = s.command;
+  char text[1280];
   std::snprintf(text, sizeof(text),
                 "mmvk crowd: feet%s: sliding in contact %.2f cm/s (before IK %.2f, the clips %.2f), "
                 "%.1f%% of planted foot-ticks locked, %.2f%% of foot-ticks reach-clamped, toe height in contact "
                 "%.2f / %.2f cm mean / p95 (the clips %.2f / %.2f)\n"
                 "mmvk crowd: knees %.0f deg/s p99 (the clips %.0f); pose acceleration p99 %.1f m/s^2 at jumps, "
-                "%.1f elsewhere (the clips %.1f)\n",
+                "%.1f elsewhere (the clips %.1f)\n"
+                "mmvk crowd: glide (the root correction) %.1f / %.1f / %.1f cm/s mean / median / p95, %.1f%% of the "
+                "travel (the animation %.1f%%); held commands: played speed off by %.1f%% (p95 %.1f%%), shown "
+                "%.1f%% (p95 %.1f%%), heading %.1f deg (p95 %.1f)\n",
                 s.foot_ik ? "" : " (foot IK off)", m.foot_sliding_cm_s, m.foot_sliding_before_ik_cm_s,
                 c.foot_sliding_cm_s, 100.0 * m.foot_lock_fraction, 100.0 * m.ik_reach_clamped_fraction,
                 m.foot_height_in_contact_cm_mean, m.foot_height_in_contact_cm_p95, c.foot_height_in_contact_cm_mean,
                 c.foot_height_in_contact_cm_p95, m.knee_speed_p99_deg_s, c.knee_speed_p99_deg_s,
-                m.pose_acceleration_p99_at_jumps_m_s2, m.pose_acceleration_p99_m_s2, c.pose_acceleration_p99_m_s2);
+                m.pose_acceleration_p99_at_jumps_m_s2, m.pose_acceleration_p99_m_s2, c.pose_acceleration_p99_m_s2,
+                g.glide_cm_s_mean, g.glide_cm_s_median, g.glide_cm_s_p95, 100.0 * g.glide_share_of_travel,
+                100.0 * g.animation_share_of_travel, 100.0 * g.played_speed_error_median,
+                100.0 * g.played_speed_error_p95, 100.0 * g.shown_speed_error_median, 100.0 * g.shown_speed_error_p95,
+                g.heading_error_deg_median, g.heading_error_deg_p95);
   return text;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "command_meter.hpp"
 #include "mmvk/status.hpp"
 #include "motion_meter.hpp"
 
@@ -42,8 +43,10 @@ struct CrowdSummary {
   // How well.
   double trajectory_error_m_1s = 0.0;
   bool foot_ik = true;             // --foot-ik
+  bool speed_from_animation = true;  // --speed-from-animation
   MotionFigures motion;            // the crowd's displayed pose (motion_meter.hpp)
   MotionFigures clips;             // the same measures on the database's own clips (clip_quality.hpp)
+  CommandFigures command;          // glide and errors against the command (command_meter.hpp)
   std::array<float, 2> planted_height_m{0.0f, 0.0f};  // the toes' height when planted, from the clips
   double transitions_per_agent_s = 0.0;
   std::uint64_t goals_reached = 0;
@@ -56,7 +59,7 @@ struct CrowdSummary {
 };
 
 std::string summary_to_json(const CrowdSummary& summary);
-// The motion figures for the user, two lines ending in '\n', each figure
+// The motion figures for the user, three lines ending in '\\n', each figure
 // with the clips' beside it.
 std::string describe_motion(const CrowdSummary& summary);
 Status write_summary(const CrowdSummary& summary, const std::filesystem::path& path);

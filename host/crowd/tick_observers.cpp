@@ -70,6 +70,7 @@ QualityObserver::QualityObserver(const CrowdController& controller, const Contro
       meter_(controller.size(), dt, controller.trajectory_offsets()[horizon_index_]),
       motion_(controller.size(), controller.animation().joint_count(),
               motion_params(controller, params, clips, dt, rate_hz, fps)),
+      command_(controller.size(), dt),
       desired_xz_(2 * std::size_t{controller.size()}),
       root_xz_(2 * std::size_t{controller.size()}) {}
 
@@ -93,11 +94,13 @@ void QualityObserver::observe(const CrowdController& controller, const TickView&
   // latter the tick's own FK.
   motion_.record({view.world, controller.animated_world_positions(), controller.contacts(), controller.foot_locked(),
                   controller.ik_reach_clamped(), controller.jumped()});
+  command_.record({view.desired, view.desired_yaw, roots, controller.root_yaws(), controller.root_corrections()});
 }
 
 void QualityObserver::summarize(CrowdSummary& s) const {
   s.trajectory_error_m_1s = meter_.trajectory_error_m_median();
   s.motion = motion_.figures();
+  s.command = command_.figures();
   s.transitions_per_agent_s = meter_.transitions_per_agent_s();
 }
 

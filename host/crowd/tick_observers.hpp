@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "clip_quality.hpp"
+#include "command_meter.hpp"
 #include "crowd_recorder.hpp"
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/hash.hpp"
@@ -56,8 +57,9 @@ class TickFigures {
 
 // Trajectory error at 1 s (the controller's own predictions, from each
 // search: CrowdController::predicted_positions at its offset nearest 1 s),
-// transitions, and the motion as displayed against the motion as animated
-// (motion_meter.hpp).
+// transitions, the motion as displayed against the motion as animated
+// (motion_meter.hpp), and the glide and the errors against the command
+// (command_meter.hpp).
 class QualityObserver {
  public:
   // `clips`: the database's own figures; their planted toe height is the
@@ -75,6 +77,7 @@ class QualityObserver {
   std::size_t horizon_index_;  // into the controller's trajectory offsets
   QualityMeter meter_;
   MotionMeter motion_;
+  CommandMeter command_;
   // Per tick, sized once: [agents x 2].
   std::vector<float> desired_xz_, root_xz_;
 };

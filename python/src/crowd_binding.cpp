@@ -246,13 +246,15 @@ void add_construction(py::class_<PyCrowd>& crowd) {
       .def(py::init([](std::shared_ptr<Database> db, const py::object& agents, const std::string& backend,
                        double rate, std::uint64_t seed, const py::object& device, const py::object& scenario,
                        double search_interval, bool foot_ik, bool record, const std::string& title,
-                       const py::object& correction_half_life, std::uint32_t record_poses) {
+                       const py::object& correction_half_life, std::uint32_t record_poses,
+                       bool speed_from_animation) {
              CrowdSessionOptions options;
              options.backend = backend;
              options.rate_hz = rate;
              options.seed = seed;
              options.search_interval_s = search_interval;
              options.foot_ik = foot_ik;
+             options.speed_from_animation = speed_from_animation;
              options.record = record;
              options.title = title;
              if (!device.is_none()) options.device = device.cast<std::uint32_t>();
@@ -270,7 +272,8 @@ void add_construction(py::class_<PyCrowd>& crowd) {
            py::arg("rate") = kDefaults.rate_hz, py::arg("seed") = kDefaults.seed, py::arg("device") = py::none(),
            py::arg("scenario") = py::none(), py::arg("search_interval") = kDefaults.search_interval_s,
            py::arg("foot_ik") = kDefaults.foot_ik, py::arg("record") = false,
-           py::arg("title") = "", py::arg("correction_half_life") = py::none(), py::arg("record_poses") = 0);
+           py::arg("title") = "", py::arg("correction_half_life") = py::none(), py::arg("record_poses") = 0,
+           py::arg("speed_from_animation") = kDefaults.speed_from_animation);
 }
 
 // The ticks: the crowd's own steering, or another simulator's.
@@ -470,6 +473,37 @@ void add_exports(py::class_<PyCrowd>& crowd) {
           "joint nodes, animated at the tick rate (`mmvk crowd --gltf`).");
 }
 
+// One value per character from the controller, copied: `name`, [agents].
+template <class T>
+void add_per_character(py::class_<PyCrowd>& crowd, const char* name,
+                       std::span<const T> (CrowdController::*values)() const, const char* doc) {
+  crowd.def_property_readonly(
+      name,
+      [values](const PyCrowd& c) {
+        const auto session = c.session();
+        return copy_array((session->controller().*values)(), {py::ssize_t(c.agents())});
+      },
+      doc);
+}
+
+// Speed from the animation after the last step: the play rates, stride
+// scales and root corrections (the glide).
+void add_speed_arrays(py::class_<PyCrowd>& crowd) {
+  add_per_character(crowd, "play_rates", &CrowdController::play_rates,
+                    "The rate each character played its clip at in the last step (clip seconds per second), "
+                    "float32 [agents].");
+  add_per_character(crowd, "stride_scales", &CrowdController::stride_scales,
+                    "The scale of each character's root motion in the last step, float32 [agents].");
+  crowd.def_property_readonly(
+      "root_corrections",
+      [](const PyCrowd& c) {
+        const auto session = c.session();
+        return vec3_array(session->controller().root_corrections(), {py::ssize_t(c.agents()), 3});
+      },
+      "The root correction of the last step (the glide), float32 [agents x 3], world metres, y = 0: the shown root "
+      "moved by its animation's root motion plus this.");
+}
+
 // The summary, the viewer page and the repr.
 void add_outputs(py::class_<PyCrowd>& crowd) {
   crowd
@@ -509,7 +543,8 @@ const char* crowd_doc() {
   static const std::string doc =
       "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
       "figures and defaults. Crowd(db, agents=None, backend='auto', rate=30.0, seed=1, device=None, scenario=None, "
-      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None, record_poses=0). agents: the number of "
+      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None, record_poses=0, "
+      "speed_from_animation=True). agents: the number of "
       "characters (1 to " + std::to_string(crowd::kMaxAgents) + "), drawn with goals from seed (default " +
       std::to_string(crowd::kDefaultAgents) + "), or scenario: a scenario JSON file or "
       "dict (starts, goals, speeds, tags; `mmvk crowd --scenario`), which sets the count. backend 'auto': a Vulkan "
@@ -519,9 +554,11 @@ const char* crowd_doc() {
       " s. correction_half_life: seconds of the pull of each character's animated root towards its simulated "
       "position (None: the database's, from its manifest's \"crowd\" block, else " +
       number_text(crowd::kCorrectionHalfLife) + "; `mmvk crowd "
-      "--correction-half-life`). Every setting is checked before anything is allocated. record=True keeps the "
-      "viewer's recording for write_html(); record_poses=M keeps the displayed poses of the first M characters "
-      "every tick for write_bvh() and write_gltf().";
+      "--correction-half-life`). speed_from_animation: play each clip faster or slower and scale its stride toward "
+      "the commanded speed, the root correction held to half the animation's own speed (False: the data's own "
+      "speeds; `mmvk crowd --speed-from-animation`). Every setting is checked before anything is allocated. "
+      "record=True keeps the viewer's recording for write_html(); record_poses=M keeps the displayed poses of the "
+      "first M characters every tick for write_bvh() and write_gltf().";
   return doc.c_str();
 }
 
@@ -535,6 +572,7 @@ void bind_crowd(py::module_& m) {
   add_state_arrays(crowd);
   add_pose_arrays(crowd);
   add_exports(crowd);
+  add_speed_arrays(crowd);
   add_outputs(crowd);
 }
 

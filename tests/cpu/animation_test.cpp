@@ -291,6 +291,67 @@ TEST(CrowdController, BadParametersAndInputAreNamed) {
   EXPECT_FALSE(controller->place(0, glm::vec3(0.0f), 0.0f, 600).ok());
 }
 
+// Play-rate and stride bounds: not finite, not positive or not ordered is an
+// error that names the field.
+TEST(CrowdController, PlayRateAndStrideBoundsAreNamed) {
+  const Database db = make_database(true);
+  const float nan = std::nanf("");
+  const struct {
+    float ControllerParams::*field;
+    float value;
+    const char* named;
+  } cases[] = {{&ControllerParams::min_play_rate, nan, "min_play_rate"},
+               {&ControllerParams::min_play_rate, 0.0f, "min_play_rate"},
+               {&ControllerParams::max_play_rate, INFINITY, "max_play_rate"},
+               {&ControllerParams::max_play_rate, 0.5f, "max_play_rate"},  // below min_play_rate
+               {&ControllerParams::min_stride_scale, -1.0f, "min_stride_scale"},
+               {&ControllerParams::max_stride_scale, nan, "max_stride_scale"},
+               {&ControllerParams::min_stride_scale, 2.0f, "max_stride_scale"},  // above max_stride_scale
+               {&ControllerParams::stride_window, 0.0f, "stride_window"},
+               {&ControllerParams::correction_speed_ratio, nan, "correction_speed_ratio"},
+               {&ControllerParams::min_correction_speed, -0.1f, "min_correction_speed"}};
+  for (const auto& c : cases) {
+    ControllerParams params;
+    params.*c.field = c.value;
+    Result<CrowdController> bad = CrowdController::create(db, 2, params);
+    ASSERT_FALSE(bad.ok()) << c.named << " = " << c.value;
+    EXPECT_NE(bad.message().find(c.named), std::string::npos) << bad.message();
+  }
+  ControllerParams fixed;
+  fixed.min_play_rate = fixed.max_play_rate = 1.3f;  // equal bounds are ordered
+  EXPECT_TRUE(CrowdController::create(db, 2, fixed).ok());
+}
+
+// The synthetic clip walks at 1 m/s: asked for 0.8 m/s the clip plays
+// slower and the root travels near 0.8 m/s by the animation, the
+// correction adding little; with the rate and stride held at 1 it plays the
+// clip's 1 m/s and the correction supplies the rest.
+TEST(CrowdController, PlayRateBringsThePlayedSpeedToTheCommand) {
+  const Database db = make_database(true);
+  ReferenceSearch reference(db);
+  ThreadPool pool(1);
+  const auto played_speed = [&](const ControllerParams& params) {
+    Result<CrowdController> controller = CrowdController::create(db, 1, params);
+    EXPECT_TRUE(controller.ok()) << controller.message();
+    std::vector<glm::vec3> velocity(1, glm::vec3(0.0f, 0.0f, 0.8f));
+    double played = 0.0;
+    const float dt = 1.0f / 30.0f;
+    for (int tick = 0; tick < 90; ++tick) {
+      const glm::vec3 before = controller->root_positions()[0];
+      EXPECT_TRUE(controller->tick(dt, CrowdInput{velocity, {}}, reference, pool).ok());
+      if (tick < 30) continue;  // the spring settles
+      played += glm::length(controller->root_positions()[0] - before - controller->root_corrections()[0]);
+      EXPECT_GE(controller->play_rates()[0], params.min_play_rate);
+      EXPECT_LE(controller->play_rates()[0], params.max_play_rate);
+    }
+    return played / (60.0 * dt);
+  };
+  ControllerParams off;
+  off.min_play_rate = off.max_play_rate = off.min_stride_scale = off.max_stride_scale = 1.0f;
+  EXPECT_NEAR(played_speed(off), 1.0, 0.02);
+  EXPECT_NEAR(played_speed(ControllerParams{}), 0.8, 0.04);
+}
+
 TEST(CrowdController, DeferredAppliesResultsOneTickLater) {
   const Database db = make_database(true);
   ReferenceSearch reference(db);

@@ -8,15 +8,18 @@
 // One tick (dt seconds), synchronous form tick(dt, input, backend, pool):
 //   1. simulate and play: each simulated root moves toward its desired
 //      velocity and facing (critically damped springs, trajectory.hpp); each
-//      character's continuous time in its clip advances by dt * fps frames
-//      (playback.hpp: a looping clip wraps to its first frame; a non-looping
-//      clip holds its last frame);
+//      character's continuous time in its clip advances by dt * fps * its
+//      play rate frames, the rate and the stride scale of its root motion
+//      chosen so that the animation moves at the simulated root's speed
+//      (within ControllerParams' bounds; playback.hpp: a looping clip wraps
+//      to its first frame; a non-looping clip holds its last frame);
 //   2. blend: its pose is interpolated between the two neighbouring frames,
 //      plus the decaying inertialization offsets (pose_batch.hpp), and its
 //      animated root moves along the clip's root path plus the
 //      inertialization's root offset;
 //   3. correct: the animated root is pulled toward the simulated root with a
-//      bounded correction (ControllerParams); its path is recorded
+//      bounded correction (ControllerParams; at most a fraction of the
+//      animated root's own speed, so it removes drift); its path is recorded
 //      (RootHistory), and the animated pose is measured: one forward
 //      kinematics in the world per character, from which the queries' joint
 //      positions (character space) and velocities come and which the foot
@@ -91,6 +94,27 @@ struct ControllerParams {
   float max_correction_distance = 0.5f;   // metres
   float max_correction_yaw_rate = 3.0f;   // rad/s
   float max_correction_yaw = 0.6f;        // radians
+  // The correction removes drift, it does not carry the character: its
+  // speed is also held to correction_speed_ratio times the animated root's
+  // own speed this tick (orangeduck's controller holds it to half), but
+  // never below min_correction_speed, so a standing character is still
+  // brought to its place. Finite, > 0 and >= 0.
+  float correction_speed_ratio = 0.5f;
+  float min_correction_speed = 0.1f;  // m/s
+  // Speed from the animation. Each tick a character's clip plays at the
+  // rate that brings its stride speed (the root's mean speed over
+  // stride_window seconds about the frame) to the simulated root's speed,
+  // within [min_play_rate, max_play_rate]; what the rate cannot reach is
+  // made up by stride warping: the played root motion is scaled, within
+  // [min_stride_scale, max_stride_scale] (planted feet are held by the foot
+  // locker meanwhile). A standing frame (stride speed under 0.1 m/s) plays
+  // at rate 1, unwarped. All four 1: the data's own speeds. Each bound
+  // finite and > 0, each pair ordered.
+  float min_play_rate = 0.75f;
+  float max_play_rate = 1.3f;
+  float min_stride_scale = 0.85f;
+  float max_stride_scale = 1.15f;
+  float stride_window = 1.0f;  // seconds
   // Search options applied to every query (per-character tags: query_params()).
   float continuing_bias = 0.0f;
   float continuing_multiplier = 1.0f;  // finite, >= 0 (QueryParams::continuing_multiplier)
@@ -193,6 +217,14 @@ class CrowdController {
   std::span<const std::uint8_t> jumped() const { return outcome_.jumped; }          // 1: jumped this tick
   std::span<const float> match_costs() const { return outcome_.match_cost; }        // last applied match (inf: none)
   std::span<const std::uint8_t> contacts() const { return playback_.contacts; }     // FootContact bits of the nearest frame
+  // Speed from the animation (ControllerParams::min_play_rate, ...): the
+  // rate each character played its clip at this tick, and the scale of its
+  // root motion, [B].
+  std::span<const float> play_rates() const { return playback_.rate; }
+  std::span<const float> stride_scales() const { return playback_.stride; }
+  // This tick's root correction (step 3), world metres, y = 0, [B]: the
+  // shown root moved by its clip's root motion plus this.
+  std::span<const glm::vec3> root_corrections() const { return roots_.correction; }
   // The trajectory of each character's last search: [B x T] world positions
   // and yaws, T = trajectory_offsets().size(), predicted at that search's
   // tick (searched() != None) for the times trajectory_offsets() after it.
@@ -231,6 +263,7 @@ class CrowdController {
     std::vector<std::uint8_t> contacts;      // FootContact bits of the nearest frame
     std::vector<glm::vec3> played_velocity;  // root velocity of the played frames, character space, m/s
     std::vector<float> played_yaw_rate;      // rad/s
+    std::vector<float> rate, stride;         // this tick's play rate and stride scale
     // This tick's step along the clip's root path (character space, metres;
     // radians), which step 2 moves the root by.
     std::vector<glm::vec3> step_translation;
@@ -243,6 +276,8 @@ class CrowdController {
     std::vector<float> yaw;
     std::vector<float> start_yaw;     // the yaw at the tick's start
     std::vector<float> yaw_rate;      // the animated root's turning rate, rad/s
+    std::vector<float> animated_speed;   // this tick's root motion before the correction, m/s
+    std::vector<glm::vec3> correction;   // this tick's correction, world metres
     std::vector<SimulationState> simulated;
     RootHistory history;
   };
@@ -336,6 +371,7 @@ class CrowdController {
   const Database* database_ = nullptr;
   const AnimationData* animation_ = nullptr;
   ControllerParams params_;
+  std::vector<float> stride_speeds_;  // [frames] m/s (play_rate.hpp), made once
   QueryAssembler assembler_;
   Inertializer inertializer_;
   std::uint32_t characters_ = 0;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "mmvk/spring.hpp"
+#include "play_rate.hpp"
 
 namespace mmvk {
 
@@ -58,7 +59,7 @@ Status check_controller_params(const Database& database, std::uint32_t character
   if (!std::isfinite(params.same_location_window) || params.same_location_window < 0.0f) {
     return make_error("crowd controller: same_location_window must be finite and >= 0 (seconds)");
   }
-  return {};
+  return detail::check_speed_params(params);
 }
 
 
@@ -73,12 +74,16 @@ void CrowdController::size_state(std::uint32_t characters) {
   playback_.contacts.assign(n, animation_->contacts[0]);
   playback_.played_velocity.assign(n, glm::vec3(0.0f));
   playback_.played_yaw_rate.assign(n, 0.0f);
+  playback_.rate.assign(n, 1.0f);
+  playback_.stride.assign(n, 1.0f);
   playback_.step_translation.assign(n, glm::vec3(0.0f));
   playback_.step_yaw.assign(n, 0.0f);
   roots_.position.assign(n, glm::vec3(0.0f));
   roots_.yaw.assign(n, 0.0f);
   roots_.start_yaw.assign(n, 0.0f);
   roots_.yaw_rate.assign(n, 0.0f);
+  roots_.animated_speed.assign(n, 0.0f);
+  roots_.correction.assign(n, glm::vec3(0.0f));
   roots_.simulated.assign(n, SimulationState{});
   const std::span<const float> past = assembler_.past_offsets();
   roots_.history = RootHistory(characters, past.empty() ? 0.0f : *std::max_element(past.begin(), past.end()));
@@ -144,6 +149,7 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.characters_ = characters;
   c.joints_ = static_cast<std::uint32_t>(animation->joint_count());
   c.trajectory_size_ = static_cast<std::uint32_t>(c.assembler_.trajectory_offsets().size());
+  c.stride_speeds_ = detail::stride_speeds(database, params.stride_window);
   c.size_state(characters);
   if (locker.ok()) c.locker_ = std::move(*locker);
   for (std::uint32_t b = 0; b < characters; ++b) MMVK_TRY(c.place(b, glm::vec3(0.0f), 0.0f, 0));
@@ -162,6 +168,7 @@ Status CrowdController::place(std::uint32_t b, const glm::vec3& position, float 
   roots_.position[b] = ground;
   roots_.yaw[b] = facing;
   roots_.yaw_rate[b] = 0.0f;
+  roots_.correction[b] = glm::vec3(0.0f);
   roots_.simulated[b] = SimulationState{};
   roots_.simulated[b].position = ground;
   roots_.simulated[b].yaw = facing;
@@ -174,6 +181,7 @@ Status CrowdController::place(std::uint32_t b, const glm::vec3& position, float 
   playback_.held[b] = 0;
   playback_.played_velocity[b] = glm::vec3(0.0f);
   playback_.played_yaw_rate[b] = 0.0f;
+  playback_.rate[b] = playback_.stride[b] = 1.0f;
   playback_.contacts[b] = animation_->contacts[frame];
   inertializer_.reset(b);
   const std::size_t base = std::size_t{b} * joints_;

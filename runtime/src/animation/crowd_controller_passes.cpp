@@ -8,6 +8,7 @@
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/playback.hpp"
 #include "mmvk/spring.hpp"
+#include "play_rate.hpp"
 #include "pose_velocity.hpp"
 #include "root_correction.hpp"
 #include "shown_pose.hpp"
@@ -61,18 +62,26 @@ void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, floa
 
     const PlayTime before{playback_.frames[b], playback_.fractions[b]};
     schedule_.was_blocked[b] = (flags[nearest_frame(database, before)] & kFrameBlockTransition) != 0 ? 1 : 0;
-    const PlaybackStep step = advance_playback(database, before, dt * database.fps());
+    // The simulated root's speed is the command as the character can follow
+    // it: the animation moves at it where the bounds allow.
+    const glm::vec3 v = roots_.simulated[b].velocity;
+    const float target = std::sqrt(v.x * v.x + v.z * v.z);
+    const float stride_speed = stride_speeds_[nearest_frame(database, before)];
+    const detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target);
+    playback_.rate[b] = scale.play_rate;
+    playback_.stride[b] = scale.stride_scale;
+    const PlaybackStep step = advance_playback(database, before, dt * database.fps() * scale.play_rate);
     playback_.frames[b] = step.time.frame;
     playback_.fractions[b] = step.time.fraction;
     playback_.held[b] = step.reached_end ? 1 : 0;
-    playback_.step_translation[b] = step.root_translation;
+    playback_.step_translation[b] = step.root_translation * scale.stride_scale;
     playback_.step_yaw[b] = step.root_yaw;
     playback_.contacts[b] = animation_->contacts[nearest_frame(database, step.time)];
-    // The root motion of the frame interval now played (the source velocity
-    // of a jump).
+    // The root motion of the frame interval now played, as played (the
+    // source velocity of a jump).
     const RootDelta velocity = root_velocity_at(database, step.time.frame);
-    playback_.played_velocity[b] = velocity.translation;
-    playback_.played_yaw_rate[b] = velocity.yaw;
+    playback_.played_velocity[b] = velocity.translation * (scale.play_rate * scale.stride_scale);
+    playback_.played_yaw_rate[b] = velocity.yaw * scale.play_rate;
   }
 }
 
@@ -90,7 +99,9 @@ void CrowdController::blend(std::size_t begin, std::size_t end, float dt) {
                                                                  translations);
     float& yaw = roots_.yaw[b];
     roots_.start_yaw[b] = yaw;
-    roots_.position[b] += detail::yaw_rotate(playback_.step_translation[b] + offset.velocity * dt, yaw);
+    const glm::vec3 step = playback_.step_translation[b] + offset.velocity * dt;
+    roots_.animated_speed[b] = std::sqrt(step.x * step.x + step.z * step.z) / dt;
+    roots_.position[b] += detail::yaw_rotate(step, yaw);
     roots_.position[b].y = 0.0f;
     yaw = wrap_angle(yaw + playback_.step_yaw[b] + offset.yaw_rate * dt);
   }
@@ -100,7 +111,10 @@ void CrowdController::blend(std::size_t begin, std::size_t end, float dt) {
 // animated pose measured.
 void CrowdController::correct(std::size_t begin, std::size_t end, float dt, float fraction) {
   for (std::size_t b = begin; b < end; ++b) {
-    detail::correct_root(params_, dt, fraction, roots_.simulated[b], roots_.position[b], roots_.yaw[b]);
+    const glm::vec3 animated = roots_.position[b];
+    detail::correct_root(params_, dt, fraction, roots_.animated_speed[b], roots_.simulated[b], roots_.position[b],
+                         roots_.yaw[b]);
+    roots_.correction[b] = roots_.position[b] - animated;
     roots_.yaw_rate[b] = wrap_angle(roots_.yaw[b] - roots_.start_yaw[b]) / dt;
     const auto character = static_cast<std::uint32_t>(b);
     roots_.history.record(character, dt, roots_.position[b], roots_.yaw[b]);
@@ -221,7 +235,12 @@ void CrowdController::jump(std::uint32_t b, std::uint32_t to, ThreadScratch& s) 
   const std::span<glm::vec3> translations(poses_.animated_translations.data() + std::size_t{b} * joints_, joints_);
   // Source: what the character shows now (played pose + offsets), moving at
   // the played velocities plus the offsets' own rates.
+  // Both poses' velocities at the rate the character plays (rate and
+  // stride carry over to the destination), so the offsets start from what
+  // is shown.
+  const float rate = playback_.rate[b], speed = rate * playback_.stride[b];
   detail::pose_velocity(database, animation, playback_.frames[b], s.source_angular, s.source_velocities);
+  detail::scale_pose_velocity(rate, s.source_angular, s.source_velocities);
   const std::span<const glm::vec3> rotation_rates = inertializer_.rotation_offset_velocities(b);
   for (std::size_t j = 0; j < joints_; ++j) s.source_angular[j] += rotation_rates[j];
   const std::span<const glm::vec3> translation_rates = inertializer_.translation_offset_velocities(b);
@@ -234,7 +253,10 @@ void CrowdController::jump(std::uint32_t b, std::uint32_t to, ThreadScratch& s) 
                                  playback_.played_yaw_rate[b] + root.yaw_rate};
   sample_pose(animation, to, s.rotations, s.translations);
   detail::pose_velocity(database, animation, to, s.angular, s.velocities);
-  const RootDelta to_root = root_velocity_at(database, to);
+  detail::scale_pose_velocity(rate, s.angular, s.velocities);
+  RootDelta to_root = root_velocity_at(database, to);
+  to_root.translation *= speed;
+  to_root.yaw *= rate;
   Inertializer::PoseState destination{s.rotations, s.angular, s.translations, s.velocities, to_root.translation,
                                       to_root.yaw};
   inertializer_.transition(b, source, destination);

@@ -50,4 +50,10 @@ void pose_velocity(const Database& database, const AnimationData& animation, std
   }
 }
 
+void scale_pose_velocity(float rate, std::span<glm::vec3> angular, std::span<glm::vec3> velocities) {
+  if (rate == 1.0f) return;
+  for (glm::vec3& w : angular) w *= rate;
+  for (glm::vec3& v : velocities) v *= rate;
+}
+
 }  // namespace mmvk::detail

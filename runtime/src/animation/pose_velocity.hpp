@@ -23,4 +23,7 @@ glm::vec3 frame_rotation_vector(const glm::quat& q);
 void pose_velocity(const Database& database, const AnimationData& animation, std::uint32_t frame,
                    std::span<glm::vec3> angular, std::span<glm::vec3> velocities);
 
+// The same velocities for the frame played at `rate` clip seconds per second.
+void scale_pose_velocity(float rate, std::span<glm::vec3> angular, std::span<glm::vec3> velocities);
+
 }  // namespace mmvk::detail

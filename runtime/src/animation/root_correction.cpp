@@ -10,13 +10,18 @@
 
 namespace mmvk::detail {
 
-void correct_root(const ControllerParams& params, float dt, float fraction, const SimulationState& simulated,
-                  glm::vec3& position, float& yaw) {
+float correction_speed(const ControllerParams& params, float animated_speed) {
+  return std::min(params.max_correction_speed,
+                  std::max(params.min_correction_speed, params.correction_speed_ratio * animated_speed));
+}
+
+void correct_root(const ControllerParams& params, float dt, float fraction, float animated_speed,
+                  const SimulationState& simulated, glm::vec3& position, float& yaw) {
   glm::vec3 gap = simulated.position - position;
   gap.y = 0.0f;
   glm::vec3 step = gap * fraction;
   const float step_length = glm::length(step);
-  const float max_step = params.max_correction_speed * dt;
+  const float max_step = correction_speed(params, animated_speed) * dt;
   if (step_length > max_step) step *= max_step / step_length;
   position += step;
   gap = simulated.position - position;

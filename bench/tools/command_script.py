@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""A host's scripted commands through mmvk.Crowd.step, and how closely the
+characters follow them: the measurement of bench/RESULTS.md, "Speed from the
+animation".
+
+16 characters, 4 m apart, each given the same script of desired velocities
+(stand, walk 1.3 m/s, turn 90 degrees, walk 0.8, run 3.0, turn 180 degrees
+at 1.3, stop, walk 0.8). Prints one JSON object: the summary's figures
+(glide, speed and heading errors, trajectory error, sliding, pose
+acceleration, jumps) and, per commanded speed, the played and shown root
+speeds over the held part of each segment (from 1 s after its command).
+
+  PYTHONPATH=build/python python3 bench/tools/command_script.py DATA [--rate 30] [--speed-from-animation off]
+      [--correction-half-life S]
+
+DATA: a manifest.json or a .mmdb. Works with a module that lacks
+root_corrections (main before speed from the animation): its played speeds
+are then null.
+"""
+import argparse
+import json
+import math
+
+import numpy as np
+
+import mmvk
+
+AGENTS = 16
+# (seconds, speed m/s, heading degrees): the heading turns at the segment's start.
+SCRIPT = [(2.0, 0.0, 0.0), (4.0, 1.3, 0.0), (4.0, 1.3, 90.0), (4.0, 0.8, 90.0), (4.0, 3.0, 90.0),
+          (4.0, 1.3, 270.0), (3.0, 0.0, 270.0), (4.0, 0.8, 270.0)]
+SETTLE_S = 1.0
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("data")
+    parser.add_argument("--rate", type=float, default=30.0)
+    parser.add_argument("--speed-from-animation", default="on", choices=["on", "off"])
+    parser.add_argument("--correction-half-life", type=float, default=None)
+    args = parser.parse_args()
+    db = mmvk.Database.load(args.data) if args.data.endswith(".mmdb") else mmvk.build(args.data)
+    kwargs = {} if args.speed_from_animation == "on" else {"speed_from_animation": False}
+    if args.correction_half_life is not None:
+        kwargs["correction_half_life"] = args.correction_half_life
+    crowd = mmvk.Crowd(db, agents=AGENTS, backend="fast-box", rate=args.rate, seed=1, **kwargs)
+    for i in range(AGENTS):
+        crowd.place(i, 4.0 * i, 0.0, 0.0)
+    has_corrections = hasattr(crowd, "root_corrections")
+    segments = []
+    last = crowd.root_positions.copy()
+    for seconds, speed, heading in SCRIPT:
+        h = math.radians(heading)
+        velocity = np.tile(np.array([speed * math.sin(h), speed * math.cos(h)], np.float32), (AGENTS, 1))
+        facing = np.full(AGENTS, h, np.float32)
+        ticks = int(round(seconds * crowd.rate))
+        shown = played = held = 0.0
+        for tick in range(ticks):
+            crowd.step(velocity, facing)
+            roots = crowd.root_positions
+            step = np.hypot(*(roots - last)[:, [0, 2]].T)
+            if tick * crowd.dt >= SETTLE_S:
+                held += crowd.dt
+                shown += step.mean()
+                if has_corrections:
+                    own = (roots - last - crowd.root_corrections)[:, [0, 2]]
+                    played += np.hypot(*own.T).mean()
+            last = roots.copy()
+        segments.append({"speed_mps": speed, "heading_deg": heading,
+                         "shown_mps": round(shown / held, 3),
+                         "played_mps": round(played / held, 3) if has_corrections else None})
+    s = crowd.summary()
+    keys = ["trajectory_error_m_1s", "foot_sliding_cm_s", "foot_sliding_before_ik_cm_s", "pose_acceleration_p99_m_s2",
+            "transitions_per_agent_s", "glide_cm_s", "glide_share_of_travel", "animation_share_of_travel",
+            "played_speed_error", "shown_speed_error", "heading_error_deg", "chosen_frames_hash"]
+    print(json.dumps({"data": args.data, "rate": args.rate, "speed_from_animation": args.speed_from_animation,
+                      "summary": {k: s.get(k) for k in keys}, "segments": segments}))
+
+
+if __name__ == "__main__":
+    main()

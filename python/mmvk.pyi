@@ -126,7 +126,8 @@ class Crowd:
                  rate: float = 30.0, seed: int = 1, device: Optional[int] = None,
                  scenario: Union[None, PathLike, Mapping[str, Any]] = None,
                  search_interval: float = 0.1, foot_ik: bool = True, record: bool = False,
-                 title: str = "", correction_half_life: Optional[float] = None) -> None: ...
+                 title: str = "", correction_half_life: Optional[float] = None,
+                 record_poses: int = 0) -> None: ...
     def step(self, desired_velocity: Optional[FloatArray] = None,
              desired_facing: Optional[FloatArray] = None) -> None:
         """One tick: own steering, or desired_velocity float32 [agents x 2|3] m/s and
@@ -173,6 +174,22 @@ class Crowd:
     @property
     def joint_positions(self) -> FloatArray:
         """[agents x joints x 3] displayed world positions, metres."""
+    @property
+    def skeleton(self) -> dict[str, Any]:
+        """names, parents (int32), rest_offsets [joints x 3] metres, translated_joints."""
+    @property
+    def local_rotations(self) -> FloatArray:
+        """[agents x joints x 4] displayed (after foot IK) unit quaternions (x, y, z, w), parent's frame."""
+    @property
+    def local_translations(self) -> FloatArray:
+        """[agents x joints x 3] displayed local translations, metres."""
+    @property
+    def root_rotations(self) -> FloatArray:
+        """[agents x 4] R_y(root_yaws) as quaternions (x, y, z, w)."""
+    def write_bvh(self, folder: PathLike) -> None:
+        """One BVH per recorded character (record_poses=M): folder/agent_0000.bvh, ..."""
+    def write_gltf(self, path: PathLike) -> None:
+        """The recorded characters (record_poses=M) in one glTF 2.0 binary (.glb)."""
     def summary(self) -> dict[str, Any]:
         """The figures of `mmvk crowd --summary`."""
     def write_html(self, path: PathLike) -> int:

@@ -21,11 +21,7 @@ const char* encoding_name(RotationEncoding encoding) {
 void print_animation(const Database& database) {
   const AnimationData* a = database.animation();
   if (a == nullptr) {
-    // The file does not say why: the causes, so as not to blame a flag the
-    // user never passed.
-    std::printf("animation: none (features only: the clips' skeletons differ, which the build warned of, or it was "
-                "built with --no-animation, or it is a format 1 file; rebuild from clips of one skeleton to add "
-                "poses)\n");
+    std::printf("animation: none, features only (%s)\n", no_animation_explanation(database.no_animation_reason()).c_str());
     return;
   }
   std::printf("animation: %zu joints (%zu translated per frame), rotations %s; %zu bytes per frame in the file, "
@@ -38,7 +34,9 @@ void print_animation(const Database& database) {
 
 nlohmann::json animation_json(const Database& database) {
   const AnimationData* a = database.animation();
-  if (a == nullptr) return {{"present", false}};
+  if (a == nullptr) {
+    return {{"present", false}, {"reason", no_animation_explanation(database.no_animation_reason())}};
+  }
   nlohmann::json joints = nlohmann::json::array();
   for (std::size_t j = 0; j < a->joint_count(); ++j) {
     const glm::vec3& r = a->skeleton.rest_offsets[j];
@@ -59,7 +57,7 @@ nlohmann::json animation_json(const Database& database) {
 Status export_animation(const Database& database, const std::string& source, const std::filesystem::path& values,
                         const std::filesystem::path& sidecar) {
   const AnimationData* a = database.animation();
-  if (a == nullptr) return missing_animation_error("mmvk export --animation");
+  if (a == nullptr) return missing_animation_error("mmvk export --animation", database.no_animation_reason());
   const std::size_t joints = a->joint_count();
   const std::size_t translated = a->translated_joints.size();
   // Columns: rotations (x, y, z, w per joint), translations (x, y, z per

@@ -142,6 +142,18 @@ void declare_trace(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.integer("--trace-agents", options.trace_agents, "M", "characters in the trace (default " + std::to_string(options.trace_agents) + ")", 1);
 }
 
+void declare_export(CommandLine& cli, crowd::CrowdOptions& options) {
+  cli.text("--bvh", options.bvh, "DIR",
+           "write the displayed pose (after foot IK) of the first --export-agents characters as one BVH each, "
+           "DIR/agent_0000.bvh ..., at the tick rate on the database's skeleton (centimetres, ZXY degrees)");
+  cli.text("--gltf", options.gltf, "FILE.glb",
+           "write the same characters into one glTF 2.0 binary: each a skin over its joint nodes, animated at the "
+           "tick rate; the poses of both are held in memory until the run ends, at most 512 MiB");
+  cli.integer("--export-agents", options.export_agents, "M",
+              "characters in --bvh and --gltf, the first of the crowd (default " +
+                  std::to_string(crowd::kDefaultExportAgents) + ", or the crowd when smaller)", 1);
+}
+
 // Returns the exit code when the crowd must not run (help, bad options).
 std::optional<int> parse_crowd_args(Args args, crowd::CrowdOptions& options) {
   CommandLine cli(kCrowdCommand, kCrowdDescription);
@@ -150,11 +162,15 @@ std::optional<int> parse_crowd_args(Args args, crowd::CrowdOptions& options) {
   declare_run(cli, options);
   declare_motion(cli, options);
   declare_trace(cli, options);
+  declare_export(cli, options);
   cli.footer(crowd_footer);
   cli.stray_argument_hint("the data goes after --data");
   if (const std::optional<int> exit_code = cli.parse(args)) return exit_code;
   if (cli.given("--trace-agents") && !options.trace) {
     return report_error("crowd", "--trace-agents needs --trace FILE", 1);
+  }
+  if (cli.given("--export-agents") && !options.bvh && !options.gltf) {
+    return report_error("crowd", "--export-agents needs --bvh DIR or --gltf FILE.glb", 1);
   }
   return std::nullopt;
 }
@@ -190,6 +206,8 @@ Status finish_outputs(const crowd::CrowdOptions& options, const crowd::CrowdSumm
     std::fprintf(stderr, "mmvk crowd: summary written to %s\n", options.summary->string().c_str());
   }
   if (options.trace) std::fprintf(stderr, "mmvk crowd: trace written to %s\n", options.trace->string().c_str());
+  if (options.bvh) std::fprintf(stderr, "mmvk crowd: BVH files written to %s\n", options.bvh->string().c_str());
+  if (options.gltf) std::fprintf(stderr, "mmvk crowd: glTF written to %s\n", options.gltf->string().c_str());
   if (options.html) {
     std::error_code ec;
     const auto absolute = std::filesystem::absolute(*options.html, ec);

@@ -102,6 +102,45 @@ std::optional<PoseFigures> pose_figures(const Database& database) {
   return out;
 }
 
+struct SourceCount {
+  std::string from;  // empty = not recorded
+  std::size_t clips;
+};
+
+// The distinct values of a clip's record of the import (units_from or
+// axes_from), in order of first use.
+std::vector<SourceCount> source_counts(const Database& database, std::string Clip::*field) {
+  std::vector<SourceCount> counts;
+  for (const Clip& clip : database.clips()) {
+    auto it = std::find_if(counts.begin(), counts.end(), [&](const SourceCount& c) { return c.from == clip.*field; });
+    if (it == counts.end()) {
+      counts.push_back({clip.*field, 1});
+    } else {
+      ++it->clips;
+    }
+  }
+  return counts;
+}
+
+// "the manifest's import.up_axis, 12 clips; ..." for `mmvk inspect`.
+std::string sources_text(const Database& database, std::string Clip::*field) {
+  const std::vector<SourceCount> counts = source_counts(database, field);
+  std::string text;
+  for (const SourceCount& count : counts) {
+    text += (text.empty() ? "" : "; ") + (count.from.empty() ? std::string("not recorded (before format 7)") : count.from);
+    if (counts.size() > 1) text += ", " + counted(count.clips, "clip");
+  }
+  return text;
+}
+
+nlohmann::json sources_json(const Database& database, std::string Clip::*field) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SourceCount& count : source_counts(database, field)) {
+    out.push_back({{"from", count.from.empty() ? nlohmann::json() : nlohmann::json(count.from)}, {"clips", count.clips}});
+  }
+  return out;
+}
+
 }  // namespace
 
 void print_units(const Database& database) {
@@ -121,6 +160,8 @@ void print_units(const Database& database) {
     }
   }
   std::printf("units: %s\n", units.c_str());
+  std::printf("units taken from: %s\n", sources_text(database, &Clip::units_from).c_str());
+  std::printf("up axis taken from: %s\n", sources_text(database, &Clip::axes_from).c_str());
   const std::optional<PoseFigures> figures = pose_figures(database);
   if (figures) {
     std::printf("standing height: %.2f m (highest joint above the lowest, 90th percentile of the frames; the "
@@ -156,6 +197,8 @@ nlohmann::json units_json(const Database& database) {
                                       {"clips", count.clips},
                                       {"name", name ? nlohmann::json(name) : nlohmann::json()}});
   }
+  out["units_from"] = sources_json(database, &Clip::units_from);
+  out["axes_from"] = sources_json(database, &Clip::axes_from);
   const std::optional<PoseFigures> figures = pose_figures(database);
   out["standing_height_m"] = figures ? nlohmann::json(figures->height) : nlohmann::json();
   out["body_up"] = figures && figures->body_up ? nlohmann::json(*figures->body_up) : nlohmann::json();

@@ -6,7 +6,9 @@
 namespace mmvk::crowd {
 
 Status validate_cache_entry(const Database& database, const Manifest& manifest) {
-  if (!database.animation()) return make_error("it has no animation");
+  if (!database.animation()) {
+    return make_error("it has no animation: " + no_animation_explanation(database.no_animation_reason()));
+  }
   if (database.dims() != manifest.schema.dims()) {
     return make_error("it has " + std::to_string(database.dims()) + " feature dims, the manifest's schema " +
                       std::to_string(manifest.schema.dims()));

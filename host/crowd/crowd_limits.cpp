@@ -15,6 +15,7 @@
 #include "mmvk/search.hpp"
 #include "mmvk/trajectory.hpp"
 #include "crowd_defaults.hpp"
+#include "crowd_recorder.hpp"
 #include "recording.hpp"
 
 namespace mmvk::crowd {
@@ -107,14 +108,26 @@ std::uint64_t estimate_crowd_bytes(const CrowdSettings& options, const RunOutput
     const std::uint64_t samples = ticks / per_sample + 1;
     const auto searches = std::uint64_t(std::ceil(options.seconds / options.search_interval_s)) + 2;
     const auto steps = std::uint64_t(std::ceil(options.seconds * 8.0)) + 2;
+    // The first characters also keep their whole pose after every tick,
+    // and each of their searches its query until it is explained and then
+    // its two frames' channel costs (crowd_recorder.hpp).
+    const std::uint64_t detailed = std::min<std::uint64_t>(agents, kDefaultDetailAgents);
+    const std::uint64_t channels = database.schema().channels.size();
     const std::uint64_t recording =
         agents * (samples * (16 + points * 16 + 6 * 12) + searches * sizeof(SearchEvent) + steps * 16 + 48) +
-        frames * joints * 12;
+        frames * joints * 12 +
+        detailed * ((ticks + 1) * joints * 12 + searches * (dims * 4 + params + 160 + channels * 12));
     bytes += recording * 4;
   }
   if (outputs.trace_agents > 0) {
     // --trace: the traced characters' world joints and contact bits per tick.
     bytes += ticks * std::min<std::uint64_t>(outputs.trace_agents, agents) * (joints * 12 + 2);
+  }
+  if (outputs.export_agents > 0) {
+    // --bvh / --gltf: the exported characters' roots and local poses per
+    // tick (pose_recording.hpp), and while the glTF is written its binary
+    // chunk and the file, each about the recording's size (a BVH is smaller).
+    bytes += 3 * ticks * std::min<std::uint64_t>(outputs.export_agents, agents) * (joints * 16 + 40);
   }
   return bytes;
 }

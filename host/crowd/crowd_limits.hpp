@@ -40,6 +40,7 @@ std::uint64_t tick_count(const CrowdSettings& settings);
 struct RunOutputs {
   bool html = false;              // the viewer's recording of settings.seconds
   std::uint32_t trace_agents = 0;  // characters traced every tick; 0: no trace
+  std::uint32_t export_agents = 0;  // characters whose poses are exported (--bvh, --gltf); 0: none
   // A scenario file still to be read: its count is checked once it is loaded.
   bool scenario_file = false;
 };

@@ -4,6 +4,7 @@
 
 #include "mmvk/database_io.hpp"
 #include "mmvk/manifest.hpp"
+#include "pose_export.hpp"
 #include "trace.hpp"
 
 namespace mmvk::crowd {
@@ -30,6 +31,7 @@ std::vector<NamedPath> crowd_paths(const CrowdOptions& options, const std::files
     paths.push_back({"--trace", *options.trace, true});
     paths.push_back({"the trace's sidecar (--trace + .json)", trace_sidecar_path(*options.trace), true});
   }
+  if (options.gltf) paths.push_back({"--gltf", *options.gltf, true});
   return paths;
 }
 
@@ -40,6 +42,7 @@ Status check_crowd_paths(const CrowdOptions& options, const std::filesystem::pat
     return make_error("--trace " + options.trace->string() + " is a device or FIFO: its sidecar would be " +
                       trace_sidecar_path(*options.trace).string() + " beside it; write the trace to a file");
   }
+  MMVK_TRY(check_pose_export_paths(options));
   return check_command_paths(crowd_paths(options, data_source));
 }
 

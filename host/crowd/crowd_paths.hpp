@@ -1,5 +1,6 @@
 // The crowd's paths, checked before the database is opened or a tick runs:
-// every output (--summary, --html, --trace and its sidecar) writable, and
+// every output (--summary, --html, --trace and its sidecar, --gltf, --bvh's
+// folder) writable, and
 // none of them the same file as an input (the data, the BVH and sidecars
 // its manifest or folder names, --scenario) or as another output. Before this check the crowd found a bad
 // output path only after the simulation, and `--html c.mmdb --data c.mmdb`

@@ -45,8 +45,11 @@ constexpr float kAnchorMoveM = 0.001f;
 }  // namespace
 
 CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& scenario, std::string title, float dt,
-                             std::uint32_t ticks_per_sample)
-    : controller_(controller), dt_(dt), ticks_per_sample_(std::max<std::uint32_t>(1, ticks_per_sample)) {
+                             std::uint32_t ticks_per_sample, std::size_t detail_agents)
+    : controller_(controller),
+      dt_(dt),
+      ticks_per_sample_(std::max<std::uint32_t>(1, ticks_per_sample)),
+      why_(controller.database(), std::min<std::size_t>(detail_agents, controller.size())) {
   Recording& r = recording_;
   r.title = std::move(title);
   r.sample_rate_hz = 1.0f / (dt * float(ticks_per_sample_));
@@ -65,13 +68,15 @@ CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& 
   matched_dims_ = matched_trajectory_dims(controller.database(), offsets);
   r.leg_joints = ik_leg_joints(skeleton);
   r.foot_events.resize(r.agent_count);
+  r.detail_agents = std::min<std::size_t>(detail_agents, r.agent_count);
+  r.detail_rate_hz = 1.0f / dt;
   feet_now_.assign(r.agent_count, FootEvent{});
   for (FootEvent& now : feet_now_) now.state = 0xff;  // none yet: the first tick adds one
 }
 
 void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> collected,
                                 std::span<const std::uint32_t> searched_before,
-                                std::span<const std::uint8_t> kinds_before,
+                                std::span<const SearchKind> kinds_before,
                                 std::span<const std::uint32_t> frames_before, std::span<const glm::vec3> world) {
   const auto jumped = controller_.jumped();
   // The searches ran at the end of the previous tick.
@@ -81,15 +86,29 @@ void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> colle
     SearchEvent event;
     event.time_s = searched_at;
     event.jumped = jumped[b] != 0;
-    event.forced = kinds_before[b] == 2;
+    event.forced = kinds_before[b] == SearchKind::Forced;
     event.from_frame = std::int32_t(frames_before[b]);
     event.to_frame = collected[i].frame == kNoFrame ? -1 : std::int32_t(collected[i].frame);
     event.cost = std::isfinite(collected[i].cost) ? collected[i].cost : 0.0f;
+    why_.applied(b, recording_.searches[b].size(), collected[i].frame);
     recording_.searches[b].push_back(event);
   }
   // Samples and foot events carry the time of the tick they were taken after.
   record_feet(float(tick) * dt_);
   if (tick % ticks_per_sample_ == 0) sample(world);
+  sample_detail(world);
+}
+
+void CrowdRecorder::sample_detail(std::span<const glm::vec3> world) {
+  Recording& r = recording_;
+  const std::size_t joints = controller_.animation().joint_count();
+  for (std::size_t b = 0; b < r.detail_agents; ++b) {
+    for (std::size_t j = 0; j < joints; ++j) {
+      const glm::vec3& p = world[b * joints + j];
+      r.detail_positions.insert(r.detail_positions.end(), {p.x, p.y, p.z});
+    }
+  }
+  if (r.detail_agents > 0) ++r.detail_sample_count;
 }
 
 void CrowdRecorder::record_feet(float time_s) {
@@ -156,7 +175,7 @@ void CrowdRecorder::sample(std::span<const glm::vec3> world) {
   ++r.sample_count;
 }
 
-Recording CrowdRecorder::finish(ThreadPool& pool) {
+Result<Recording> CrowdRecorder::finish(ThreadPool& pool) {
   Recording& r = recording_;
   const AnimationData& animation = controller_.animation();
   const std::size_t joints = animation.joint_count();
@@ -176,6 +195,7 @@ Recording CrowdRecorder::finish(ThreadPool& pool) {
   forward_kinematics_batch(animation.skeleton, rotations, translations, origins, zero_yaws, world, &pool);
   r.pose_positions.reserve(count * joints * 3);
   for (const glm::vec3& p : world) r.pose_positions.insert(r.pose_positions.end(), {p.x, p.y, p.z});
+  MMVK_TRY(why_.finish(r, pool));
   return std::move(recording_);
 }
 

@@ -9,6 +9,7 @@
 #include "crowd_paths.hpp"
 #include "crowd_session.hpp"
 #include "default_data.hpp"
+#include "pose_export.hpp"
 #include "progress_line.hpp"
 #include "scenario.hpp"
 #include "trace.hpp"
@@ -36,6 +37,8 @@ Result<CrowdSessionOptions> session_options(const CrowdOptions& options, const D
   }
   session.outputs.html = options.html.has_value();
   session.outputs.trace_agents = options.trace ? options.trace_agents : 0;
+  session.outputs.export_agents =
+      options.bvh || options.gltf ? (options.export_agents > 0 ? options.export_agents : kDefaultExportAgents) : 0;
   session.record = options.html.has_value();
   session.data_label = data.short_label;
   session.data_source = data.label;
@@ -74,24 +77,26 @@ Result<std::optional<TraceWriter>> open_trace(const CrowdOptions& options, const
   return std::optional<TraceWriter>(std::move(writer.value()));
 }
 
-// The loop: the crowd's own steering for every tick, the trace and the
-// progress line after each.
-Status run_ticks(CrowdSession& crowd, const CrowdOptions& options, TraceWriter* trace, std::FILE* log) {
+// The loop: the crowd's own steering for every tick, the trace, the pose
+// export and the progress line after each.
+Status run_ticks(CrowdSession& crowd, const CrowdOptions& options, TraceWriter* trace, PoseExport* poses,
+                 std::FILE* log) {
   const std::uint64_t ticks = tick_count(options);
   ProgressLine progress(options.progress ? log : nullptr, double(ticks) * crowd.dt(),
                         std::size_t(std::max(1.0, options.rate_hz)));
   for (std::uint64_t t = 0; t < ticks; ++t) {
     MMVK_TRY(crowd.step());
     if (trace) trace->record(crowd.world_positions(), crowd.controller().contacts(), crowd.controller().foot_locked());
+    if (poses) MMVK_TRY(poses->record(crowd.controller()));
     progress.tick(double(t + 1) * crowd.dt(), crowd.controller().last_tick().searches, crowd.last_search_ms());
   }
   progress.finish();
   return {};
 }
 
-// The outputs after the loop: the pipeline cache, the trace and the page.
+// The outputs after the loop: the pipeline cache, the trace, the exports and the page.
 Status finish_outputs(CrowdSession& crowd, const CrowdOptions& options, std::optional<TraceWriter>& trace,
-                      std::FILE* log, CrowdSummary& s) {
+                      const std::optional<PoseExport>& poses, std::FILE* log, CrowdSummary& s) {
   if (Status saved = save_crowd_pipeline_cache(crowd.search()); !saved && log) {
     std::fprintf(log, "mmvk crowd: note: the Vulkan pipeline cache was not saved: %s\n", saved.message().c_str());
   }
@@ -99,6 +104,7 @@ Status finish_outputs(CrowdSession& crowd, const CrowdOptions& options, std::opt
     MMVK_TRY(trace->finish());
     s.trace = options.trace->string();
   }
+  if (poses) MMVK_TRY(poses->finish());
   if (options.html) {
     MMVK_ASSIGN_OR_RETURN(const std::size_t bytes, crowd.write_html(*options.html));
     s.html = options.html->string();
@@ -124,10 +130,12 @@ Result<CrowdSummary> run_crowd(const CrowdOptions& options, std::FILE* log) {
 
   // The loop, then the summary and the outputs.
   MMVK_ASSIGN_OR_RETURN(std::optional<TraceWriter> trace, open_trace(options, *crowd));
-  MMVK_TRY(run_ticks(*crowd, options, trace ? &*trace : nullptr, log));
+  MMVK_ASSIGN_OR_RETURN(std::optional<PoseExport> poses,
+                        PoseExport::open(options, crowd->controller().animation(), crowd->agents(), tick_count(options)));
+  MMVK_TRY(run_ticks(*crowd, options, trace ? &*trace : nullptr, poses ? &*poses : nullptr, log));
   CrowdSummary s = crowd->summary();
   s.database = opened.path.empty() ? data.label : opened.path.string();
-  MMVK_TRY(finish_outputs(*crowd, options, trace, log, s));
+  MMVK_TRY(finish_outputs(*crowd, options, trace, poses, log, s));
   return s;
 }
 

@@ -10,7 +10,6 @@
 #include "data_settings.hpp"
 #include "mmvk/number_text.hpp"
 #include "gait_plan.hpp"
-#include "observed_search.hpp"
 #include "observed_tick.hpp"
 #include "run_summary.hpp"
 #include "viewer/viewer_html.hpp"
@@ -28,7 +27,7 @@ std::string data_name(const CrowdSessionOptions& o) {
 // The motion checked for a crowd: it has animation and walks.
 Result<GaitSpeeds> check_motion(const Database& database, const CrowdSessionOptions& o) {
   const std::string caller = o.names == SettingNames::Flags ? "mmvk crowd" : "mmvk.Crowd";
-  if (!database.animation()) return make_error(data_name(o) + ": " + missing_animation_error(caller).message);
+  if (!database.animation()) return make_error(data_name(o) + ": " + missing_animation_error(caller, database.no_animation_reason()).message);
   Result<GaitSpeeds> speeds = measure_gait_speeds(database);
   if (!speeds) return make_error(data_name(o) + ": " + speeds.message());
   return speeds;
@@ -112,7 +111,6 @@ Status CrowdSession::set_up(const ControllerParams& params) {
     MMVK_TRY(c.place(b, glm::vec3(plan.start[0], 0.0f, plan.start[1]), yaw));
   }
   MMVK_ASSIGN_OR_RETURN(search_, make_crowd_search(o.backend, o.device, database_, agents_, pool_, o.cache_dir));
-  observed_ = std::make_unique<ObservedSearch>(*search_.deferred, agents_);
   steering_ = std::make_unique<Steering>(scenario_, speeds_);
   // The clips first: their planted toe height is the crowd's floor.
   clips_ = measure_clip_quality(database_, pool_);
@@ -124,8 +122,7 @@ Status CrowdSession::set_up(const ControllerParams& params) {
     recording_ = std::make_unique<RecordingObserver>(c, scenario_, page_title(o, agents_, search_), float(dt_),
                                                      per_sample);
   }
-  x_.resize(agents_), z_.resize(agents_), vx_.resize(agents_), vz_.resize(agents_);
-  desired_.resize(agents_), world_.resize(std::size_t{agents_} * c.animation().joint_count());
+  desired_.resize(agents_);
   return {};
 }
 
@@ -136,10 +133,7 @@ Status CrowdSession::place(std::uint32_t b, float x, float z, float yaw, std::ui
 Status CrowdSession::step() {
   // The tick's time counts the steering too.
   const auto tick_start = Clock::now();
-  const auto roots = controller_->root_positions();
-  for (std::uint32_t b = 0; b < agents_; ++b) x_[b] = roots[b].x, z_[b] = roots[b].z;
-  steering_->update(x_, z_, vx_, vz_, &pool_);
-  for (std::uint32_t b = 0; b < agents_; ++b) desired_[b] = glm::vec3(vx_[b], 0.0f, vz_[b]);
+  steering_->update(controller_->root_positions(), desired_, &pool_);
   return tick(desired_, {}, tick_start);
 }
 
@@ -172,9 +166,8 @@ Status CrowdSession::tick(std::span<const glm::vec3> desired, std::span<const fl
   RecordingObserver* recording = finished_ ? nullptr : recording_.get();
   if (ticks_ == 0) figures_.reserve(tick_count(options_));
   MMVK_ASSIGN_OR_RETURN(const double tick_ms,
-                        observed_tick(*controller_, *observed_, pool_, ticks_, float(dt_),
-                                      CrowdInput{desired, desired_yaw}, tick_start, world_,
-                                      {figures_, *quality_, recording}));
+                        observed_tick(*controller_, *search_.deferred, pool_, ticks_, float(dt_),
+                                      CrowdInput{desired, desired_yaw}, tick_start, {figures_, *quality_, recording}));
   wall_s_ += tick_ms / 1e3;
   ++ticks_;
   return {};
@@ -195,7 +188,10 @@ Result<std::size_t> CrowdSession::write_html(const std::filesystem::path& path) 
   if (ticks_ == 0) return make_error("write_html: nothing was recorded yet (step the crowd first)");
   // The recording ends at the first page, but is kept: a write that fails
   // (a missing folder, a full disk) can be retried with the same run.
-  if (!finished_) finished_ = recording_->finish(pool_);
+  if (!finished_) {
+    MMVK_ASSIGN_OR_RETURN(Recording finished, recording_->finish(pool_));
+    finished_ = std::move(finished);
+  }
   return write_viewer_html(path, *finished_);
 }
 

@@ -46,8 +46,6 @@ namespace mmvk::crowd {
 // capture, and far below what would overflow the search's costs.
 inline constexpr float kMaxDesiredSpeed = 1000.0f;
 
-class ObservedSearch;
-
 // The crowd's settings (crowd_settings.hpp: the defaults and bounds every
 // entry point shares) and what a session adds.
 struct CrowdSessionOptions : CrowdSettings {
@@ -105,9 +103,8 @@ class CrowdSession {
   // Milliseconds the last step was blocked on its search.
   double last_search_ms() const { return figures_.last_search_ms(); }
   // The displayed world joint positions after the last step, [agents x
-  // joints] metres (before the first step: the placed poses are not yet
-  // shown, all zero).
-  std::span<const glm::vec3> world_positions() const { return world_; }
+  // joints] metres (before the first step: the placed poses).
+  std::span<const glm::vec3> world_positions() const { return controller_->world_positions(); }
   // The run so far: the figures `mmvk crowd --summary` writes.
   CrowdSummary summary() const;
   // Writes the viewer page of the steps so far (options.record); the
@@ -132,7 +129,6 @@ class CrowdSession {
   ThreadPool pool_;
   std::optional<CrowdController> controller_;
   CrowdSearch search_;
-  std::unique_ptr<ObservedSearch> observed_;
   std::unique_ptr<Steering> steering_;
   // The observers run_crowd has too (tick_observers.hpp).
   TickFigures figures_;
@@ -142,8 +138,7 @@ class CrowdSession {
   ClipQuality clips_;
 
   // Per tick, sized once.
-  std::vector<float> x_, z_, vx_, vz_;
-  std::vector<glm::vec3> desired_, world_;
+  std::vector<glm::vec3> desired_;  // [agents] the tick's desired velocities
   double wall_s_ = 0.0;  // the ticks' own time, summed
   std::optional<Recording> finished_;  // the recording, once write_html ended it
 };

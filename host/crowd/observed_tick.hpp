@@ -12,7 +12,7 @@
 #include "mmvk/crowd_controller.hpp"
 #include "mmvk/status.hpp"
 #include "mmvk/thread_pool.hpp"
-#include "observed_search.hpp"
+#include "mmvk/async_search.hpp"
 #include "tick_observers.hpp"
 
 namespace mmvk::crowd {
@@ -25,12 +25,10 @@ struct TickObservers {
 
 // Ticks `controller` by `dt` with `input` on the deferred search, records the
 // tick's figures (its time counted from `tick_start`, which a caller may take
-// before its own steering), writes the displayed world joint positions into
-// `world` [agents x joints] and shows the tick to the observers. Returns the
+// before its own steering) and shows the tick to the observers. Returns the
 // tick's milliseconds.
-Result<double> observed_tick(CrowdController& controller, ObservedSearch& observed, ThreadPool& pool,
-                             std::uint64_t tick, float dt, const CrowdInput& input,
-                             std::chrono::steady_clock::time_point tick_start, std::span<glm::vec3> world,
+Result<double> observed_tick(CrowdController& controller, AsyncSearch& search, ThreadPool& pool, std::uint64_t tick,
+                             float dt, const CrowdInput& input, std::chrono::steady_clock::time_point tick_start,
                              const TickObservers& observers);
 
 }  // namespace mmvk::crowd

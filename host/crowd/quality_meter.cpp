@@ -6,11 +6,11 @@
 
 namespace mmvk::crowd {
 
-QualityMeter::QualityMeter(std::size_t agents, double dt)
+QualityMeter::QualityMeter(std::size_t agents, double dt, double horizon_s)
     : agents_(agents),
       dt_(dt),
-      horizon_ticks_(std::max<std::size_t>(1, std::size_t(std::lround(1.0 / dt)))),
-      desired_ring_(horizon_ticks_ * agents * 2, 0.0f),
+      horizon_ticks_(std::max<std::size_t>(1, std::size_t(std::lround(horizon_s / dt)))),
+      desired_ring_(horizon_ticks_ * agents * 2, std::numeric_limits<float>::quiet_NaN()),
       // 1 mm bins up to 20 m; anything further lands in the last bin.
       error_(0.001, 20000) {}
 
@@ -19,6 +19,7 @@ void QualityMeter::record_trajectory(std::span<const float> desired_1s_xz, std::
   if (ticks_ >= horizon_ticks_) {
     // The slot still holds what was desired horizon_ticks ago for now.
     for (std::size_t a = 0; a < agents_; ++a) {
+      if (std::isnan(slot[2 * a])) continue;
       const double dx = double(root_xz[2 * a]) - slot[2 * a];
       const double dz = double(root_xz[2 * a + 1]) - slot[2 * a + 1];
       error_.add(std::sqrt(dx * dx + dz * dz));

@@ -116,6 +116,49 @@ struct Recording {
   // time order, the first at time 0.
   std::vector<std::vector<FootEvent>> foot_events;
 
+  // --- the whole displayed pose at the tick rate, for the first characters -
+  // The 10 Hz samples above pose a character from its played frame with the
+  // legs as displayed; the first `detail_agents` characters are also
+  // recorded after every tick (at `detail_rate_hz`, the simulation's rate)
+  // with every joint as displayed (after foot IK), upper body included.
+  // Empty (0) when not recorded.
+  float detail_rate_hz = 0.0f;
+  std::size_t detail_agents = 0;
+  std::size_t detail_sample_count = 0;
+  // [detail_sample_count x detail_agents x joint_count x 3], world metres;
+  // detail sample k is the state after tick k, at time k / detail_rate_hz.
+  std::vector<float> detail_positions;
+
+  // --- why each search of the detailed characters chose its frame --------
+  // One frame's cost in one search, channel by channel, as mmvk's
+  // explain_query() computes it from the query and the database's
+  // normalized features (mmvk/explain.hpp: FrameExplanation).
+  struct FrameWhy {
+    std::int32_t frame = -1;  // database frame; -1: none (no candidate, or no continuing frame)
+    std::uint32_t clip = 0;   // index into clip_names
+    float clip_time_s = 0.0f; // the frame's time in its clip, seconds
+    std::vector<float> weighted;  // [channel_names] weight x sum of squared differences
+    float multiplier = 1.0f;  // the clip's cost multiplier
+    float bias = 0.0f;        // the clip's cost bias
+    float cost = 0.0f;        // the frame's cost: multiplier x sum + bias, then the continuing terms
+    // Why the frame is not a candidate: an index into exclusion_names (0:
+    // it is one; mmvk::Exclusion).
+    std::uint8_t exclusion = 0;
+  };
+  struct SearchWhy {
+    std::size_t search = 0;  // index into searches[agent]
+    std::vector<float> weights;  // [channel_names] the query's channel weights
+    float continuing_bias = 0.0f;        // the query's (QueryParams), applied to the continuing frame
+    float continuing_multiplier = 1.0f;
+    FrameWhy chosen, continuing;
+  };
+  std::vector<std::string> channel_names;  // the schema's, in order
+  std::vector<std::string> clip_names;     // the database's, in order
+  std::vector<std::string> exclusion_names;  // mmvk::exclusion_name() of each Exclusion, in order
+  // [agent_count][explained searches] (empty lists for characters not
+  // detailed), or empty when not recorded.
+  std::vector<std::vector<SearchWhy>> why;
+
   std::size_t joint_count() const { return joint_parents.size(); }
   std::size_t trajectory_points() const { return trajectory_times_s.size(); }
 
@@ -131,6 +174,9 @@ struct Recording {
   }
   std::size_t leg_index(std::size_t sample, std::size_t agent, std::size_t leg_joint) const {
     return ((sample * agent_count + agent) * leg_joints.size() + leg_joint) * 3;
+  }
+  std::size_t detail_index(std::size_t sample, std::size_t agent, std::size_t joint) const {
+    return ((sample * detail_agents + agent) * joint_count() + joint) * 3;
   }
 };
 

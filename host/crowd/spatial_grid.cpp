@@ -19,14 +19,16 @@ int SpatialGrid::cell_z(float z) const {
   return std::clamp(int(std::floor((z - min_z_) * inv_cell_)), 0, cells_z_ - 1);
 }
 
-void SpatialGrid::build(std::span<const float> x, std::span<const float> z, float cell_size) {
-  const std::size_t n = x.size();
+void SpatialGrid::build(std::span<const glm::vec3> points, float cell_size) {
+  const std::size_t n = points.size();
   float max_x = 0.0f, max_z = 0.0f;
   min_x_ = min_z_ = 0.0f;
   if (n > 0) {
-    const auto [lo_x, hi_x] = std::minmax_element(x.begin(), x.end());
-    const auto [lo_z, hi_z] = std::minmax_element(z.begin(), z.end());
-    min_x_ = *lo_x, max_x = *hi_x, min_z_ = *lo_z, max_z = *hi_z;
+    min_x_ = max_x = points[0].x, min_z_ = max_z = points[0].z;
+    for (const glm::vec3& p : points) {
+      min_x_ = std::min(min_x_, p.x), max_x = std::max(max_x, p.x);
+      min_z_ = std::min(min_z_, p.z), max_z = std::max(max_z, p.z);
+    }
   }
   const float extent = std::max(max_x - min_x_, max_z - min_z_);
   cell_size = std::max(cell_size, extent / float(kMaxCellsPerSide - 1));
@@ -39,7 +41,7 @@ void SpatialGrid::build(std::span<const float> x, std::span<const float> z, floa
   cell_of_.resize(n);
   order_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t cell = std::uint32_t(cell_z(z[i]) * cells_x_ + cell_x(x[i]));
+    const std::uint32_t cell = std::uint32_t(cell_z(points[i].z) * cells_x_ + cell_x(points[i].x));
     cell_of_[i] = cell;
     ++start_[cell + 1];
   }

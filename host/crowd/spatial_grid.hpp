@@ -7,13 +7,16 @@
 #include <span>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 namespace mmvk::crowd {
 
 class SpatialGrid {
  public:
-  // Cells are `cell_size` metres wide; points outside [min, min + extent)
-  // are clamped into the border cells, which stays correct (only slower).
-  void build(std::span<const float> x, std::span<const float> z, float cell_size);
+  // Over the points' (x, z) (y ignored); cells are `cell_size` metres wide;
+  // points outside [min, min + extent) are clamped into the border cells,
+  // which stays correct (only slower).
+  void build(std::span<const glm::vec3> points, float cell_size);
 
   // Calls visit(j) for every point j in the 3x3 cells around (x, z); with
   // cell_size >= the query radius that covers every point within it.

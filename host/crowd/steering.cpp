@@ -32,42 +32,37 @@ constexpr std::size_t kParallelMin = 128;
 
 }  // namespace
 
-void Steering::update(std::span<const float> x, std::span<const float> z, std::span<float> desired_vx,
-                      std::span<float> desired_vz, ThreadPool* pool) {
+void Steering::update(std::span<const glm::vec3> positions, std::span<glm::vec3> desired_velocity, ThreadPool* pool) {
   const std::size_t n = speed_.size();
-  grid_.build(x.first(n), z.first(n), params_.separation_radius_m);
+  grid_.build(positions.first(n), params_.separation_radius_m);
   if (pool == nullptr || pool->thread_count() == 1 || n < kParallelMin) {
-    steer(0, n, x, z, desired_vx, desired_vz, goals_reached_);
+    steer(0, n, positions, desired_velocity, goals_reached_);
     return;
   }
   // Sized on the first update with this pool: no allocation per tick after it.
   if (reached_by_thread_.size() < pool->thread_count()) reached_by_thread_.resize(pool->thread_count());
   std::fill(reached_by_thread_.begin(), reached_by_thread_.end(), std::uint64_t{0});
-  // One pointer to the spans besides `this`: the body fits std::function's
-  // inline storage (no allocation per tick).
-  const struct {
-    std::span<const float> x, z;
-    std::span<float> vx, vz;
-  } io{x, z, desired_vx, desired_vz};
-  pool->parallel_for(n, [this, &io](std::size_t begin, std::size_t end, unsigned thread) {
-    steer(begin, end, io.x, io.z, io.vx, io.vz, reached_by_thread_[thread]);
+  pool->parallel_for(n, [this, positions, desired_velocity](std::size_t begin, std::size_t end, unsigned thread) {
+    steer(begin, end, positions, desired_velocity, reached_by_thread_[thread]);
   });
   for (const std::uint64_t reached : reached_by_thread_) goals_reached_ += reached;
 }
 
-void Steering::steer(std::size_t begin, std::size_t end, std::span<const float> x, std::span<const float> z,
-                     std::span<float> desired_vx, std::span<float> desired_vz, std::uint64_t& reached) {
+void Steering::steer(std::size_t begin, std::size_t end, std::span<const glm::vec3> positions,
+                     std::span<glm::vec3> desired_velocity, std::uint64_t& reached) {
   const float radius = params_.separation_radius_m;
+  const auto x = [positions](std::size_t a) { return positions[a].x; };
+  const auto z = [positions](std::size_t a) { return positions[a].z; };
   for (std::size_t a = begin; a < end; ++a) {
     std::array<float, 2> target = goal(a);
-    float gx = target[0] - x[a], gz = target[1] - z[a];
+    float gx = target[0] - x(a), gz = target[1] - z(a);
     float distance = std::sqrt(gx * gx + gz * gz);
     if (distance < params_.goal_radius_m) {
       const std::uint32_t count = goal_begin_[a + 1] - goal_begin_[a];
       goal_index_[a] = (goal_index_[a] + 1) % count;
       ++reached;
       target = goal(a);
-      gx = target[0] - x[a], gz = target[1] - z[a];
+      gx = target[0] - x(a), gz = target[1] - z(a);
       distance = std::sqrt(gx * gx + gz * gz);
     }
     const float speed = speed_[a];
@@ -75,9 +70,9 @@ void Steering::steer(std::size_t begin, std::size_t end, std::span<const float> 
     if (distance > 1e-4f) vx = gx / distance * speed, vz = gz / distance * speed;
 
     float sx = 0.0f, sz = 0.0f;
-    grid_.for_each_near(x[a], z[a], [&](std::uint32_t j) {
+    grid_.for_each_near(x(a), z(a), [&](std::uint32_t j) {
       if (j == a) return;
-      const float dx = x[a] - x[j], dz = z[a] - z[j];
+      const float dx = x(a) - x(j), dz = z(a) - z(j);
       const float d2 = dx * dx + dz * dz;
       if (d2 >= radius * radius) return;
       const float d = std::sqrt(d2);
@@ -94,8 +89,7 @@ void Steering::steer(std::size_t begin, std::size_t end, std::span<const float> 
     // character, it does not make it sprint.
     const float len = std::sqrt(vx * vx + vz * vz);
     if (len > speed && len > 0.0f) vx *= speed / len, vz *= speed / len;
-    desired_vx[a] = vx;
-    desired_vz[a] = vz;
+    desired_velocity[a] = glm::vec3(vx, 0.0f, vz);
   }
 }
 

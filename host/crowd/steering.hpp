@@ -36,13 +36,13 @@ class Steering {
   std::array<float, 2> goal(std::size_t agent) const;
   std::uint64_t goals_reached() const { return goals_reached_; }
 
-  // From the characters' current positions (x, z in metres, [N] each):
+  // From the characters' current positions (world metres, y ignored, [N]):
   // advances the goals of those within goal_radius_m and writes desired
-  // velocities (m/s, [N] each). With a pool, the characters are split over
+  // velocities (world m/s, y = 0, [N]). With a pool, the characters are split over
   // its threads (each one's velocity depends only on the positions, so the
   // result is the same bit for bit); the grid is built on the calling thread.
-  void update(std::span<const float> x, std::span<const float> z, std::span<float> desired_vx,
-              std::span<float> desired_vz, ThreadPool* pool = nullptr);
+  void update(std::span<const glm::vec3> positions, std::span<glm::vec3> desired_velocity,
+              ThreadPool* pool = nullptr);
 
  private:
   SteeringParams params_;
@@ -54,8 +54,8 @@ class Steering {
   std::vector<std::uint64_t> reached_by_thread_;  // per pool thread, summed after each update
   SpatialGrid grid_;
 
-  void steer(std::size_t begin, std::size_t end, std::span<const float> x, std::span<const float> z,
-             std::span<float> desired_vx, std::span<float> desired_vz, std::uint64_t& reached);
+  void steer(std::size_t begin, std::size_t end, std::span<const glm::vec3> positions,
+             std::span<glm::vec3> desired_velocity, std::uint64_t& reached);
 };
 
 }  // namespace mmvk::crowd

@@ -2,16 +2,27 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
-#include "mmvk/trajectory.hpp"
 
 namespace mmvk::crowd {
 
 namespace {
 
-// The 1 s horizon of the trajectory error, as the controller would predict it.
-constexpr float kErrorHorizon[1] = {1.0f};
+constexpr float kNoPrediction = std::numeric_limits<float>::quiet_NaN();
+
+// The trajectory error's horizon: the controller's trajectory offset nearest it.
+constexpr float kErrorHorizon = 1.0f;
+
+std::size_t horizon_index(const CrowdController& controller) {
+  const auto offsets = controller.trajectory_offsets();
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < offsets.size(); ++k) {
+    if (std::abs(offsets[k] - kErrorHorizon) < std::abs(offsets[best] - kErrorHorizon)) best = k;
+  }
+  return best;
+}
 
 MotionMeterParams motion_params(const CrowdController& controller, const ControllerParams& params,
                                 const ClipQuality& clips, double dt, double rate_hz, double fps) {
@@ -55,31 +66,32 @@ void TickFigures::summarize(CrowdSummary& s, double wall_seconds) const {
 
 QualityObserver::QualityObserver(const CrowdController& controller, const ControllerParams& params,
                                  const ClipQuality& clips, double dt, double rate_hz, double fps)
-    : spring_(params.spring),
-      meter_(controller.size(), dt),
+    : horizon_index_(horizon_index(controller)),
+      meter_(controller.size(), dt, controller.trajectory_offsets()[horizon_index_]),
       motion_(controller.size(), controller.animation().joint_count(),
               motion_params(controller, params, clips, dt, rate_hz, fps)),
       desired_xz_(2 * std::size_t{controller.size()}),
       root_xz_(2 * std::size_t{controller.size()}) {}
 
 void QualityObserver::observe(const CrowdController& controller, const TickView& view) {
-  // Where the controller wants each character 1 s from now, and where it is.
-  const auto sim = controller.simulation();
+  // Where each character that searched this tick was predicted 1 s from
+  // now, and where each is.
+  const auto searched = controller.searched();
+  const auto predicted = controller.predicted_positions();
   const auto roots = controller.root_positions();
-  glm::vec3 horizon_pos[1];
-  float horizon_yaw[1];
-  for (std::size_t b = 0; b < view.desired.size(); ++b) {
-    const float yaw = view.desired_yaw.empty() ? yaw_of_velocity(view.desired[b], sim[b].yaw) : view.desired_yaw[b];
-    predict_trajectory(sim[b], view.desired[b], yaw, spring_, kErrorHorizon, horizon_pos, horizon_yaw);
-    desired_xz_[2 * b] = horizon_pos[0].x, desired_xz_[2 * b + 1] = horizon_pos[0].z;
+  const std::size_t offsets = controller.trajectory_offsets().size();
+  for (std::size_t b = 0; b < searched.size(); ++b) {
+    const glm::vec3 p = predicted[b * offsets + horizon_index_];
+    const bool fresh = searched[b] != SearchKind::None;
+    desired_xz_[2 * b] = fresh ? p.x : kNoPrediction, desired_xz_[2 * b + 1] = fresh ? p.z : kNoPrediction;
     root_xz_[2 * b] = roots[b].x, root_xz_[2 * b + 1] = roots[b].z;
   }
   meter_.record_trajectory(desired_xz_, root_xz_);
   meter_.add_transitions(controller.last_tick().jumps);
   meter_.end_tick();
   // The pose as displayed (after foot IK) and as animated (before), the
-  // latter kept by the tick's own FK rather than computed again.
-  motion_.record({view.world, controller.displayed_animated_world(), controller.contacts(), controller.foot_locked(),
+  // latter the tick's own FK.
+  motion_.record({view.world, controller.animated_world_positions(), controller.contacts(), controller.foot_locked(),
                   controller.ik_reach_clamped(), controller.jumped()});
 }
 
@@ -93,19 +105,13 @@ RecordingObserver::RecordingObserver(const CrowdController& controller, const Sc
                                      float dt, std::uint32_t ticks_per_sample)
     : recorder_(controller, scenario, std::move(title), dt, ticks_per_sample),
       frames_before_(controller.size()),
-      kinds_before_(controller.size(), 0) {
-  searched_before_.reserve(controller.size());
-  searched_now_.reserve(controller.size());
-}
+      kinds_before_(controller.size(), SearchKind::None) {}
 
 void RecordingObserver::observe(const CrowdController& controller, const TickView& view) {
-  recorder_.record_tick(view.tick, view.matches, searched_before_, kinds_before_, frames_before_, view.world);
-  searched_now_.clear();
+  recorder_.record_tick(view.tick, controller.applied_matches(), controller.applied_characters(), kinds_before_,
+                        frames_before_, view.world);
   const auto kinds = controller.searched();
-  for (std::uint32_t b = 0; b < kinds.size(); ++b) {
-    if (kinds[b] != 0) searched_now_.push_back(b);
-  }
-  searched_before_.swap(searched_now_);
+  recorder_.record_submitted(controller.submitted_characters(), controller.submitted_batch());
   std::copy(kinds.begin(), kinds.end(), kinds_before_.begin());
   const auto frames = controller.frames();
   std::copy(frames.begin(), frames.end(), frames_before_.begin());

@@ -29,12 +29,12 @@ struct TickView {
   std::uint64_t tick = 0;                 // 0-based; it ended at (tick + 1) * dt
   std::span<const glm::vec3> desired;     // [agents] the steering's desired velocity, m/s
   std::span<const float> desired_yaw;     // [agents] desired facing, radians; empty: facing the velocity
-  std::span<const Match> matches;         // the matches the tick applied, in order
   std::span<const glm::vec3> world;       // [agents x joints] displayed world joint positions, metres
 };
 
 // The ticks' own figures: searches, the time each tick took and blocked on
-// its search, and a hash of every applied match in order.
+// its search, and a hash of every applied match in order
+// (CrowdController::applied_matches).
 class TickFigures {
  public:
   void reserve(std::uint64_t ticks);
@@ -54,8 +54,10 @@ class TickFigures {
   Hasher chosen_;
 };
 
-// Trajectory error at 1 s, transitions, and the motion as displayed against
-// the motion as animated (motion_meter.hpp).
+// Trajectory error at 1 s (the controller's own predictions, from each
+// search: CrowdController::predicted_positions at its offset nearest 1 s),
+// transitions, and the motion as displayed against the motion as animated
+// (motion_meter.hpp).
 class QualityObserver {
  public:
   // `clips`: the database's own figures; their planted toe height is the
@@ -64,14 +66,13 @@ class QualityObserver {
   QualityObserver(const CrowdController& controller, const ControllerParams& params, const ClipQuality& clips,
                   double dt, double rate_hz, double fps);
 
-  // After the controller's AsyncSearch tick (the pose before foot IK is then
-  // the one the tick displayed: CrowdController::displayed_animated_world).
+  // After each tick of the controller.
   void observe(const CrowdController& controller, const TickView& view);
   // The trajectory, transition and motion figures into `summary`.
   void summarize(CrowdSummary& summary) const;
 
  private:
-  SpringParams spring_;
+  std::size_t horizon_index_;  // into the controller's trajectory offsets
   QualityMeter meter_;
   MotionMeter motion_;
   // Per tick, sized once: [agents x 2].
@@ -85,14 +86,14 @@ class RecordingObserver {
                     std::uint32_t ticks_per_sample);
 
   void observe(const CrowdController& controller, const TickView& view);
-  Recording finish(ThreadPool& pool) { return recorder_.finish(pool); }
+  Result<Recording> finish(ThreadPool& pool) { return recorder_.finish(pool); }
 
  private:
   CrowdRecorder recorder_;
-  // The characters that searched in the tick before (ascending), that tick's
-  // CrowdController::searched() and the frames they played then.
-  std::vector<std::uint32_t> searched_before_, searched_now_, frames_before_;
-  std::vector<std::uint8_t> kinds_before_;
+  // The tick before's CrowdController::searched() and the frames played
+  // then: what the matches applied now were searched with.
+  std::vector<std::uint32_t> frames_before_;
+  std::vector<SearchKind> kinds_before_;
 };
 
 }  // namespace mmvk::crowd

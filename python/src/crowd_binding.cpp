@@ -1,28 +1,34 @@
 // mmvk.Crowd: the crowd host's CrowdSession (host/crowd/crowd_session.hpp)
 // stepped from Python, by its own steering or by another simulator's.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "arrays.hpp"
+#include "bvh_export.hpp"
 #include "bindings.hpp"
 #include "crowd_defaults.hpp"
 #include "crowd_limits.hpp"
 #include "crowd_session.hpp"
 #include "errors.hpp"
+#include "gltf_export.hpp"
 #include "mmvk/number_text.hpp"
 #include "mmvk/steering_input.hpp"
+#include "pose_recording.hpp"
 #include "scenario.hpp"
 #include "summary.hpp"
 
@@ -54,7 +60,8 @@ constexpr auto kSignalCheckInterval = std::chrono::milliseconds(100);
 
 class PyCrowd {
  public:
-  PyCrowd(std::shared_ptr<Database> database, const CrowdSessionOptions& options) : database_(std::move(database)) {
+  PyCrowd(std::shared_ptr<Database> database, const CrowdSessionOptions& options, std::uint32_t record_poses)
+      : database_(std::move(database)) {
     if (!database_) throw py::type_error("db: expected an mmvk.Database, got None");
     Result<std::unique_ptr<CrowdSession>> made = make_error("");
     {
@@ -66,16 +73,21 @@ class PyCrowd {
     velocity_.resize(agents_);
     next_.resize(agents_);
     positions_.emplace(agents_);
+    if (record_poses > 0) {
+      poses_.emplace(take(crowd::PoseRecorder::create(session_->controller().animation(), record_poses, agents_,
+                                                      session_->rate_hz(), 0, "record_poses", "record_poses")));
+    }
   }
 
   void step(const py::object& desired_velocity, const py::object& desired_facing) {
     const auto held = lock();
     if (desired_velocity.is_none()) {
       if (!desired_facing.is_none()) raise("desired_facing: given without desired_velocity");
+      check_pose_room(1);
       Status status;
       {
         py::gil_scoped_release released;
-        status = session_->step();
+        status = step_and_record();
       }
       check(status);
       return;
@@ -97,13 +109,14 @@ class PyCrowd {
     check(crowd::check_tick_count(seconds, session_->rate_hz(), 0, "seconds", crowd::SettingNames::Keywords));
     const auto ticks = std::uint64_t(std::llround(seconds / session_->dt()));
     const auto held = lock();
+    check_pose_room(ticks);
     Status status;
     for (std::uint64_t t = 0; t < ticks && status.ok();) {
       {
         py::gil_scoped_release released;
         const auto until = std::chrono::steady_clock::now() + kSignalCheckInterval;
         do {
-          status = session_->step();
+          status = step_and_record();
           ++t;
         } while (t < ticks && status.ok() && std::chrono::steady_clock::now() < until);
       }
@@ -117,6 +130,12 @@ class PyCrowd {
     const auto held = lock();
     check(session_->place(index, x, z, yaw, frame));
     positions_->reset();  // a teleport is no motion of the host's
+  }
+
+  // The recorded poses (record_poses), or an error naming `what`.
+  HeldSession<const crowd::PoseRecording> poses(const char* what) const {
+    if (!poses_) raise(std::string(what) + ": the crowd records no poses: make it with record_poses=M");
+    return {lock(), poses_->recording()};
   }
 
   HeldSession<const CrowdSession> session() const { return {lock(), *session_}; }
@@ -133,6 +152,18 @@ class PyCrowd {
       held.lock();
     }
     return held;
+  }
+
+  // Before `ticks` more steps: an error, before any of them, when the pose
+  // recording would pass its cap.
+  void check_pose_room(std::uint64_t ticks) const {
+    if (poses_) check(poses_->check_room(ticks));
+  }
+
+  // One tick of the crowd's own steering, and its poses recorded.
+  Status step_and_record() {
+    MMVK_TRY(session_->step());
+    return poses_ ? poses_->record(session_->controller()) : Status{};
   }
 
   // (x, z) rows, or (x, y, z) with y ignored: [agents x 2|3] float32 into out.
@@ -153,10 +184,12 @@ class PyCrowd {
     py::array keep;
     std::span<const float> yaw;
     if (!desired_facing.is_none()) yaw = float_vector(desired_facing, agents_, "desired_facing", keep);
+    check_pose_room(1);
     Status status;
     {
       py::gil_scoped_release released;
       status = session_->step(velocity_, yaw);
+      if (status.ok() && poses_) status = poses_->record(session_->controller());
     }
     check(status);
   }
@@ -166,6 +199,7 @@ class PyCrowd {
   std::uint32_t agents_ = 0;
   std::vector<glm::vec3> velocity_, next_;  // [agents]
   std::optional<PositionSteering> positions_;  // step_toward's
+  std::optional<crowd::PoseRecorder> poses_;  // the first record_poses characters' poses, every tick
   // One call at a time: a session is not thread-safe, and two threads
   // stepping, or one reading while another steps, corrupted it.
   mutable std::mutex mutex_;
@@ -175,6 +209,17 @@ class PyCrowd {
 py::array vec3_array(std::span<const glm::vec3> values, std::vector<py::ssize_t> shape) {
   py::array_t<float> out(shape);
   std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(glm::vec3));
+  return out;
+}
+
+// A copy of per-joint values of `agents` characters ([agents x joints] vec3
+// or quaternions, x, y, z, w) as float32 [agents x joints x 3|4].
+template <class T>
+py::array per_joint_array(std::span<const T> values, std::uint32_t agents) {
+  constexpr auto width = py::ssize_t(sizeof(T) / sizeof(float));
+  const auto joints = py::ssize_t(values.size() / std::max<std::size_t>(agents, 1));
+  py::array_t<float> out({py::ssize_t(agents), joints, width});
+  std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
   return out;
 }
 
@@ -201,7 +246,7 @@ void add_construction(py::class_<PyCrowd>& crowd) {
       .def(py::init([](std::shared_ptr<Database> db, const py::object& agents, const std::string& backend,
                        double rate, std::uint64_t seed, const py::object& device, const py::object& scenario,
                        double search_interval, bool foot_ik, bool record, const std::string& title,
-                       const py::object& correction_half_life) {
+                       const py::object& correction_half_life, std::uint32_t record_poses) {
              CrowdSessionOptions options;
              options.backend = backend;
              options.rate_hz = rate;
@@ -219,13 +264,13 @@ void add_construction(py::class_<PyCrowd>& crowd) {
                check(crowd::check_agent_count(double(n), crowd::SettingNames::Keywords));
                options.agents = std::uint64_t(n);
              }
-             return std::make_unique<PyCrowd>(std::move(db), options);
+             return std::make_unique<PyCrowd>(std::move(db), options, record_poses);
            }),
            py::arg("db"), py::arg("agents") = py::none(), py::arg("backend") = kDefaults.backend,
            py::arg("rate") = kDefaults.rate_hz, py::arg("seed") = kDefaults.seed, py::arg("device") = py::none(),
            py::arg("scenario") = py::none(), py::arg("search_interval") = kDefaults.search_interval_s,
            py::arg("foot_ik") = kDefaults.foot_ik, py::arg("record") = false,
-           py::arg("title") = "", py::arg("correction_half_life") = py::none());
+           py::arg("title") = "", py::arg("correction_half_life") = py::none(), py::arg("record_poses") = 0);
 }
 
 // The ticks: the crowd's own steering, or another simulator's.
@@ -330,14 +375,99 @@ void add_state_arrays(py::class_<PyCrowd>& crowd) {
           "1 while a foot (left, right) is held where it was planted, uint8 [agents x 2].")
       .def_property_readonly(
           "joint_positions",
-          [](const PyCrowd& c) {
-            const auto session = c.session();
-            const auto world = session->world_positions();
-            const auto joints = py::ssize_t(world.size() / std::max<std::size_t>(c.agents(), 1));
-            return vec3_array(world, {py::ssize_t(c.agents()), joints, 3});
-          },
+          [](const PyCrowd& c) { return per_joint_array(c.session()->world_positions(), c.agents()); },
           "The displayed global joint positions after the last step (foot IK included), float32 [agents x joints "
           "x 3], metres.");
+}
+
+// The displayed pose after the last step (after foot IK), as a renderer
+// skinning a mesh takes it: the skeleton, the roots and the local rotations.
+void add_pose_arrays(py::class_<PyCrowd>& crowd) {
+  crowd
+      .def_property_readonly(
+          "skeleton",
+          [](const PyCrowd& c) {
+            const auto session = c.session();
+            const AnimationData& animation = session->controller().animation();
+            const Skeleton& skeleton = animation.skeleton;
+            py::dict out;
+            out["names"] = skeleton.names;
+            out["parents"] = copy_array(std::span<const int>(skeleton.parents), {py::ssize_t(skeleton.size())});
+            out["rest_offsets"] = vec3_array(skeleton.rest_offsets, {py::ssize_t(skeleton.size()), 3});
+            out["translated_joints"] = animation.translated_joints;
+            return out;
+          },
+          "The database's skeleton: names, parents (int32, -1 for a root), rest_offsets (float32 [joints x 3], "
+          "metres, in the parent's frame) and translated_joints (the joints whose translation varies: the hips).")
+      .def_property_readonly(
+          "local_rotations",
+          [](const PyCrowd& c) { return per_joint_array(c.session()->controller().local_rotations(), c.agents()); },
+          "The displayed pose's local joint rotations (after foot IK), float32 [agents x joints x 4], unit "
+          "quaternions (x, y, z, w) in the parent's frame; a root's (and so the hips') in character space, placed "
+          "by root_positions and root_rotations.")
+      .def_property_readonly(
+          "local_translations",
+          [](const PyCrowd& c) {
+            return per_joint_array(c.session()->controller().local_translations(), c.agents());
+          },
+          "The displayed pose's local joint translations, float32 [agents x joints x 3], metres: the rest offsets, "
+          "and the translated joints' own (the hips, lowered by foot IK where it drops them).")
+      .def_property_readonly(
+          "root_rotations",
+          [](const PyCrowd& c) {
+            const auto yaws = c.session()->controller().root_yaws();
+            std::vector<glm::quat> rotations(yaws.size());
+            std::transform(yaws.begin(), yaws.end(), rotations.begin(),
+                           [](float yaw) { return glm::angleAxis(yaw, glm::vec3(0.0f, 1.0f, 0.0f)); });
+            // [agents x 1 x 4] as [agents x 4].
+            return per_joint_array(std::span<const glm::quat>(rotations), c.agents()).attr("reshape")(c.agents(), 4);
+          },
+          "Each character's root rotation R_y(root_yaws), float32 [agents x 4] (x, y, z, w). A joint's world "
+          "transform is T(root_positions) * R(root_rotations) * the chain of T(local_translations) * "
+          "R(local_rotations) from its root.");
+}
+
+// `write` (a Status of the recording) with the GIL released; its error
+// raised as OSError once the GIL is back. Errors: no poses recorded, naming `what`.
+template <class Write>
+void write_poses(const PyCrowd& c, const char* what, const Write& write) {
+  const auto poses = c.poses(what);
+  Status written;
+  {
+    py::gil_scoped_release released;
+    written = write(*poses.operator->());
+  }
+  check(written, ErrorKind::OS);
+}
+
+// The recorded poses (record_poses=M) written as BVH and glTF.
+void add_exports(py::class_<PyCrowd>& crowd) {
+  crowd
+      .def(
+          "write_bvh",
+          [](const PyCrowd& c, const py::object& folder) {
+            const std::filesystem::path dir = to_path(folder, "folder");
+            write_poses(c, "write_bvh", [&dir](const crowd::PoseRecording& poses) -> Status {
+              MMVK_TRY(crowd::prepare_bvh_folder(dir, poses.agents, "folder"));
+              return crowd::write_bvh_files(poses, dir);
+            });
+          },
+          py::arg("folder"),
+          "Writes one BVH per recorded character (record_poses=M), folder/agent_0000.bvh ...: the displayed pose "
+          "of every step so far at the tick rate on the database's skeleton (`mmvk crowd --bvh`). The folder is "
+          "made when missing.")
+      .def(
+          "write_gltf",
+          [](const PyCrowd& c, const py::object& path) {
+            const std::filesystem::path p = to_path(path, "path");
+            write_poses(c, "write_gltf", [&p](const crowd::PoseRecording& poses) -> Status {
+              MMVK_TRY(crowd::check_gltf_path(p, "path"));
+              return crowd::write_gltf(poses, p);
+            });
+          },
+          py::arg("path"),
+          "Writes the recorded characters (record_poses=M) into one glTF 2.0 binary (.glb): each a skin over its "
+          "joint nodes, animated at the tick rate (`mmvk crowd --gltf`).");
 }
 
 // The summary, the viewer page and the repr.
@@ -379,7 +509,7 @@ const char* crowd_doc() {
   static const std::string doc =
       "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
       "figures and defaults. Crowd(db, agents=None, backend='auto', rate=30.0, seed=1, device=None, scenario=None, "
-      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None). agents: the number of "
+      "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None, record_poses=0). agents: the number of "
       "characters (1 to " + std::to_string(crowd::kMaxAgents) + "), drawn with goals from seed (default " +
       std::to_string(crowd::kDefaultAgents) + "), or scenario: a scenario JSON file or "
       "dict (starts, goals, speeds, tags; `mmvk crowd --scenario`), which sets the count. backend 'auto': a Vulkan "
@@ -390,7 +520,8 @@ const char* crowd_doc() {
       "position (None: the database's, from its manifest's \"crowd\" block, else " +
       number_text(crowd::kCorrectionHalfLife) + "; `mmvk crowd "
       "--correction-half-life`). Every setting is checked before anything is allocated. record=True keeps the "
-      "viewer's recording for write_html().";
+      "viewer's recording for write_html(); record_poses=M keeps the displayed poses of the first M characters "
+      "every tick for write_bvh() and write_gltf().";
   return doc.c_str();
 }
 
@@ -402,6 +533,8 @@ void bind_crowd(py::module_& m) {
   add_stepping(crowd);
   add_settings(crowd);
   add_state_arrays(crowd);
+  add_pose_arrays(crowd);
+  add_exports(crowd);
   add_outputs(crowd);
 }
 

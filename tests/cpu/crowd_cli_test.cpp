@@ -151,6 +151,28 @@ TEST_F(CrowdCli, ControlsAndTraceErrorsNameTheOption) {
   EXPECT_EQ(unwritable.output.find("building the database"), std::string::npos) << unwritable.output;
 }
 
+TEST_F(CrowdCli, ExportErrorsNameTheOptionBeforeTheRun) {
+  const std::string run = "--backend fast-box --agents 3 --seconds 1 ";
+  expect_failure("--export-agents 2", "--export-agents needs --bvh DIR or --gltf FILE.glb");
+  const std::string glb = (dir_ / "c.glb").string();
+  expect_failure(run + "--gltf " + glb + " --export-agents 4", "--export-agents 4 must be in [1, 3]");
+  expect_failure(run + "--gltf " + glb + " --summary " + glb, "name the same file");
+  expect_failure(run + "--gltf " + (dir_ / "c.gltf").string(), "--gltf");
+  // A folder that cannot be made, and a glTF that cannot be written, are
+  // refused before the database is built.
+  for (const std::string option : {"--bvh /nonexistent/folder/bvh", "--gltf /nonexistent/folder/c.glb"}) {
+    const auto refused = run_command(mmvk_ + " crowd " + run + option);
+    EXPECT_EQ(refused.exit_code, 1) << refused.output;
+    EXPECT_NE(refused.output.find(option.substr(0, option.find(' '))), std::string::npos) << refused.output;
+    EXPECT_NE(refused.output.find("/nonexistent/folder"), std::string::npos) << refused.output;
+    EXPECT_EQ(refused.output.find("building the database"), std::string::npos) << refused.output;
+  }
+  // Over the recording's cap: 1,000,000 ticks of one character.
+  expect_failure("--backend fast-box --agents 3 --rate 10 --seconds 100000 --gltf " + glb + " --export-agents 1",
+                 "over the 512 MiB an export may hold");
+  EXPECT_FALSE(fs::exists(glb));
+}
+
 TEST_F(CrowdCli, TraceWritesThePositionsAndTheSidecar) {
   const fs::path trace = dir_ / "walk.f32";
   const auto ran = run_command(mmvk_ + " crowd --backend fast-box --agents 4 --seconds 1 --rate 60 --foot-ik off " +
@@ -255,6 +277,9 @@ TEST_F(CrowdCli, ADatabaseWithoutAnimationOrTrajectoryIsAClearError) {
   auto built = run_command(mmvk_ + " build " + manifest + " --no-animation -o " + no_animation);
   ASSERT_EQ(built.exit_code, 0) << built.output;
   expect_failure("--backend fast-box --agents 5 --data " + no_animation, "mmvk build");
+  // The database records why it has no animation, so the crowd says it.
+  expect_failure("--backend fast-box --agents 5 --data " + no_animation,
+                 "the database has no animation section: built with --no-animation");
 
   const fs::path schema = dir_ / "feet-only.json";
   std::ofstream(schema) << R"({"channels": [{"name": "left_foot", "kind": "bone_position", "bone": "@left_foot"},

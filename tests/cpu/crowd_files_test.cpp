@@ -162,7 +162,7 @@ TEST_F(CrowdFiles, BadCacheEntriesAreRebuiltWithANote) {
   fs::copy_file(dir_ / "plain.mmdb", entry, fs::copy_options::overwrite_existing);
   auto again = crowd(run);
   ASSERT_EQ(again.exit_code, 0) << again.output;
-  EXPECT_TRUE(contains(again.output, entry.string() + " is not usable (it has no animation)")) << again.output;
+  EXPECT_TRUE(contains(again.output, entry.string() + " is not usable (it has no animation: built with --no-animation)")) << again.output;
   EXPECT_EQ(read_text(entry), good);
 
   // A database of other motion (one clip of the set).

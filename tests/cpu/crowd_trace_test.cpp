@@ -48,7 +48,8 @@ TEST(CrowdTrace, RoundTripsWhatTheControllerShowed) {
   for (std::uint32_t t = 0; t < kTicks; ++t) {
     for (std::uint32_t b = 0; b < kCharacters; ++b) velocities[b] = {0.3f * float(b), 0.0f, 1.2f};
     ASSERT_TRUE(controller.tick(1.0f / 60.0f, CrowdInput{velocities, {}}, search, pool).ok());
-    controller.world_positions(world, pool);
+    const auto displayed = controller.world_positions();
+    world.assign(displayed.begin(), displayed.end());
     writer->record(world, controller.contacts(), controller.foot_locked());
     shown.insert(shown.end(), world.begin(), world.begin() + std::ptrdiff_t(kTraced * joints));
     for (std::uint32_t b = 0; b < kTraced; ++b) {

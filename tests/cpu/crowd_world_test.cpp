@@ -104,8 +104,10 @@ TEST(CrowdGrid, FindsTheSameNeighboursAsBruteForce) {
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = random.uniform(-40, 40), z[i] = random.uniform(-25, 25);
   x[5] = 1000.0f;  // a stray point far away: cells grow, answers stay right
   const float radius = 1.5f;
+  std::vector<glm::vec3> points(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) points[i] = glm::vec3(x[i], 0.0f, z[i]);
   SpatialGrid grid;
-  grid.build(x, z, radius);
+  grid.build(points, radius);
   for (std::size_t i = 0; i < x.size(); i += 7) {
     std::set<std::uint32_t> found, expected;
     grid.for_each_near(x[i], z[i], [&](std::uint32_t j) {
@@ -139,42 +141,42 @@ TEST(CrowdSteering, SeeksTheGoalAtThePreferredSpeedCappedToTheDatabase) {
   Steering steering(s, speeds);
   EXPECT_FLOAT_EQ(steering.preferred_speed(0), 1.2f);
   EXPECT_FLOAT_EQ(steering.preferred_speed(1), 3.0f);  // capped to max_mps
-  const std::vector<float> x{0, 10}, z{0, 10};
-  std::vector<float> vx(2), vz(2);
-  steering.update(x, z, vx, vz);
-  EXPECT_NEAR(vx[0], 1.2f, 1e-6f);
-  EXPECT_NEAR(vz[0], 0.0f, 1e-6f);
-  EXPECT_NEAR(vx[1], 0.0f, 1e-6f);
-  EXPECT_NEAR(vz[1], -3.0f, 1e-6f);
+  const std::vector<glm::vec3> positions{{0, 0, 0}, {10, 0, 10}};
+  std::vector<glm::vec3> v(2);
+  steering.update(positions, v);
+  EXPECT_NEAR(v[0].x, 1.2f, 1e-6f);
+  EXPECT_NEAR(v[0].z, 0.0f, 1e-6f);
+  EXPECT_NEAR(v[1].x, 0.0f, 1e-6f);
+  EXPECT_NEAR(v[1].z, -3.0f, 1e-6f);
 }
 
 TEST(CrowdSteering, ReachingAGoalMovesOnToTheNext) {
   Scenario s = two_agents({0, 0}, {10, 10}, {0.5f, 0}, {10, -10});
   Steering steering(s, GaitSpeeds{.walk_mps = 1.0f, .run_mps = 1.0f, .max_mps = 1.0f});
-  const std::vector<float> x{0, 10}, z{0, 10};
-  std::vector<float> vx(2), vz(2);
-  steering.update(x, z, vx, vz);
+  const std::vector<glm::vec3> positions{{0, 0, 0}, {10, 0, 10}};
+  std::vector<glm::vec3> v(2);
+  steering.update(positions, v);
   EXPECT_EQ(steering.goal_index(0), 1u);
   EXPECT_EQ(steering.goals_reached(), 1u);
   // Now heading for (-9, -9).
-  EXPECT_LT(vx[0], 0.0f);
-  EXPECT_LT(vz[0], 0.0f);
+  EXPECT_LT(v[0].x, 0.0f);
+  EXPECT_LT(v[0].z, 0.0f);
 }
 
 TEST(CrowdSteering, NeighboursPushApartWithoutExceedingThePreferredSpeed) {
   // Two characters 0.4 m apart, both heading the same way along +x.
   Scenario s = two_agents({0, 0}, {0, 0.4f}, {50, 0}, {50, 0.4f});
   Steering steering(s, GaitSpeeds{.walk_mps = 1.0f, .run_mps = 1.0f, .max_mps = 1.0f});
-  const std::vector<float> x{0, 0}, z{0, 0.4f};
-  std::vector<float> vx(2), vz(2);
-  steering.update(x, z, vx, vz);
-  EXPECT_LT(vz[0], -0.1f);  // pushed toward -z, away from the other
-  EXPECT_GT(vz[1], 0.1f);
-  for (int i = 0; i < 2; ++i) EXPECT_LE(std::hypot(vx[i], vz[i]), 1.0f + 1e-5f);
+  const std::vector<glm::vec3> positions{{0, 0, 0}, {0, 0, 0.4f}};
+  std::vector<glm::vec3> v(2);
+  steering.update(positions, v);
+  EXPECT_LT(v[0].z, -0.1f);  // pushed toward -z, away from the other
+  EXPECT_GT(v[1].z, 0.1f);
+  for (int i = 0; i < 2; ++i) EXPECT_LE(std::hypot(v[i].x, v[i].z), 1.0f + 1e-5f);
   // Far apart: no push at all.
-  const std::vector<float> far_z{0, 5.0f};
-  steering.update(x, far_z, vx, vz);
-  EXPECT_NEAR(vz[0], 0.0f, 1e-5f);
+  const std::vector<glm::vec3> far{{0, 0, 0}, {0, 0, 5.0f}};
+  steering.update(far, v);
+  EXPECT_NEAR(v[0].z, 0.0f, 1e-5f);
 }
 
 }  // namespace

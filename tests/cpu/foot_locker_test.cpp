@@ -182,6 +182,16 @@ float angle_between(const glm::quat& a, const glm::quat& b) {
   return 2.0f * std::atan2(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), std::abs(d.w));
 }
 
+// FootLocker::update on a pose, with the forward kinematics of the pose as it
+// comes in, which the locker reads (the controller's one FK per tick).
+void update_locker(FootLocker& locker, const AnimationData& a, std::uint32_t b, float dt, std::uint8_t contacts,
+                   const glm::vec3& root, float yaw, std::span<glm::quat> rotations,
+                   std::span<glm::vec3> translations, std::span<glm::vec3> world) {
+  std::vector<glm::vec3> animated(a.joint_count());
+  forward_kinematics_batch(a.skeleton, rotations, translations, {&root, 1}, {&yaw, 1}, animated);
+  locker.update(b, dt, contacts, root, yaw, animated, rotations, translations, world);
+}
+
 glm::quat global_rotation(const AnimationData& a, const Pose& pose, int joint, float yaw) {
   glm::quat g(1.0f, 0.0f, 0.0f, 0.0f);
   for (int j = joint; j >= 0; j = a.skeleton.parents[static_cast<std::size_t>(j)]) {
@@ -224,7 +234,7 @@ WalkResult run_walk(float rate, float turn, bool toes = true, const FootIkParams
     float yaw;
     walk_root(t, turn, root, yaw);
     const std::vector<glm::vec3> animated = world_of(a, pose, root, yaw);
-    locker.update(0, i == 0 ? 0.0f : dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
+    update_locker(locker, a, 0, i == 0 ? 0.0f : dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
     for (const glm::vec3& p : world) EXPECT_TRUE(finite(p)) << "tick " << i;
     // The output pose and the world positions agree.
     const std::vector<glm::vec3> refk = world_of(a, pose, root, yaw);
@@ -343,7 +353,7 @@ TEST(FootLocker, FootKeepsItsAnimatedOrientationTurnedByTheYawCorrection) {
     glm::vec3 root;
     float yaw;
     walk_root(t, 0.4f, root, yaw);
-    locker->update(0, i == 0 ? 0.0f : dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
     for (std::size_t side = 0; side < 2; ++side) {
       const int foot = locker->legs()[side].foot;
       const float psi = locker->yaw_corrections()[side];
@@ -375,7 +385,7 @@ TEST(FootLocker, YawCorrectionStopsAtItsLimitAndTheFootPivotsInPlace) {
   for (int i = 0; i <= 60; ++i) {
     Pose pose = still;
     const float yaw = 1.2f * float(i) / 60.0f;
-    locker->update(0, i == 0 ? 0.0f : dt, kContactLeft | kContactLeftToe, glm::vec3(0.0f), yaw, pose.rotations,
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, kContactLeft | kContactLeftToe, glm::vec3(0.0f), yaw, pose.rotations,
                    pose.translations, world);
     const glm::vec3 toe = world[static_cast<std::size_t>(locker->legs()[0].toe)];
     if (i == 0) anchor = toe;
@@ -408,7 +418,7 @@ TEST(FootLocker, AFootPitchedThroughVerticalKeepsItsYawCorrection) {
     const float pitch = 1.45f * std::sin(3.14159265f * float(i) / 120.0f);
     pose_leg(a, 0, toe_at - glm::angleAxis(pitch, kX) * kToeOffset, pitch, pose);
     const float yaw = 0.2f * float(i) / 60.0f;
-    locker->update(0, i == 0 ? 0.0f : dt, kContactLeft | kContactLeftToe, glm::vec3(0.0f), yaw, pose.rotations,
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, kContactLeft | kContactLeftToe, glm::vec3(0.0f), yaw, pose.rotations,
                    pose.translations, world);
     const glm::vec3 toe = world[static_cast<std::size_t>(locker->legs()[0].toe)];
     if (i == 0) anchor = toe;
@@ -437,7 +447,7 @@ TEST(FootLocker, ReleaseDecaysTheCorrectionWithoutAJump) {
     Pose pose = still;
     pose.contacts = i < 30 ? kContactLeft | kContactLeftToe : 0;
     const glm::vec3 root(0.0f, 0.0f, 0.15f * std::min(float(i), 30.0f) / 30.0f);
-    locker->update(0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
     const glm::vec3 toe = world[static_cast<std::size_t>(locker->legs()[0].toe)];
     if (i == 0) anchor = toe;
     if (i < 30) {
@@ -472,10 +482,10 @@ TEST(FootLocker, ResetForgetsTheLocksAndOffLeavesThePose) {
     float yaw;
     walk_root(t, 0.0f, root, yaw);
     Pose pose = walk_pose(a, t);
-    locker->update(1, dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
+    update_locker(*locker, a, 1, dt, pose.contacts, root, yaw, pose.rotations, pose.translations, world);
     // Off: the pose is untouched, the world positions are its FK.
     Pose untouched = walk_pose(a, t);
-    disabled->update(1, dt, untouched.contacts, root, yaw, untouched.rotations, untouched.translations, world);
+    update_locker(*disabled, a, 1, dt, untouched.contacts, root, yaw, untouched.rotations, untouched.translations, world);
     const Pose animated = walk_pose(a, t);
     EXPECT_EQ(untouched.rotations, animated.rotations);
     EXPECT_EQ(untouched.translations, animated.translations);
@@ -494,12 +504,12 @@ TEST(FootLocker, ResetForgetsTheLocksAndOffLeavesThePose) {
   Pose pose = walk_pose(a, 0.3f);
   pose.contacts = 0;
   const Pose animated = pose;
-  locker->update(1, dt, 0, glm::vec3(5.0f, 0.0f, 5.0f), 1.0f, pose.rotations, pose.translations, world);
+  update_locker(*locker, a, 1, dt, 0, glm::vec3(5.0f, 0.0f, 5.0f), 1.0f, pose.rotations, pose.translations, world);
   EXPECT_EQ(pose.rotations, animated.rotations);
   EXPECT_EQ(pose.translations, animated.translations);
   // A teleport after the reset: planted feet lock afresh where they are.
   Pose planted = walk_pose(a, 0.3f);
-  locker->update(1, dt, planted.contacts, glm::vec3(50.0f, 0.0f, 0.0f), 0.0f, planted.rotations,
+  update_locker(*locker, a, 1, dt, planted.contacts, glm::vec3(50.0f, 0.0f, 0.0f), 0.0f, planted.rotations,
                  planted.translations, world);
   EXPECT_EQ(locker->corrections()[2], glm::vec3(0.0f));
   EXPECT_EQ(locker->locked()[2], 1);
@@ -536,7 +546,7 @@ DropResult run_hip_drop(float max_hip_drop, float max_hip_goal_rate = FootIkPara
   for (int i = 0; i < 120; ++i) {
     Pose pose = still;
     const glm::vec3 root(0.0f, 0.0f, 0.15f * std::min(float(i), 30.0f) / 30.0f);
-    locker->update(0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
     const float drop = locker->hip_drops()[0];
     EXPECT_LE(drop, max_hip_drop);
     EXPECT_NEAR(world[0].y, hips - drop, 1e-5f);  // the hips joint moved down by the drop
@@ -622,7 +632,7 @@ WobbleResult run_knee_wobble(float rate) {
     pose.contacts = kContactLeft | kContactRight;
     const float s = std::min(t / 1.5f, 1.0f);  // eased in and out: the hips' spring starts and stops smoothly
     const glm::vec3 root(0.0f, 0.0f, 0.45f * s * s * (3.0f - 2.0f * s));
-    locker->update(0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
     const glm::vec3 hip = world[static_cast<std::size_t>(leg.upper)];
     const glm::vec3 knee = world[static_cast<std::size_t>(leg.lower)] - hip;
     const glm::vec3 ankle = world[static_cast<std::size_t>(leg.foot)] - hip;
@@ -676,7 +686,7 @@ TEST(FootLocker, CharactersUpdateConcurrentlyAsSerially) {
         walk_root(t, 0.1f * float(b % 5), root, yaw);
         std::copy(pose.rotations.begin(), pose.rotations.end(), rotations.begin() + long(b * joints));
         std::copy(pose.translations.begin(), pose.translations.end(), translations.begin() + long(b * joints));
-        locker.update(static_cast<std::uint32_t>(b), dt, pose.contacts, root, yaw,
+        update_locker(locker, a, static_cast<std::uint32_t>(b), dt, pose.contacts, root, yaw,
                       std::span(rotations).subspan(b * joints, joints), std::span(translations).subspan(b * joints, joints),
                       std::span(world).subspan(b * joints, joints));
       }

@@ -42,11 +42,17 @@ TEST(Messages, UnknownTagListsTheKnownOnes) {
   EXPECT_EQ(mask.message(), "unknown tag 'jump': the database's tags are walk, run, fast (exact, case-sensitive)");
 }
 
-TEST(Messages, MissingAnimationNamesEveryCause) {
-  const std::string message = missing_animation_error("crowd controller").message;
+TEST(Messages, MissingAnimationNamesEveryCauseWhenTheFileDoesNotSay) {
+  const std::string message = missing_animation_error("crowd controller", "").message;
   EXPECT_TRUE(contains(message, "skeletons differ")) << message;
   EXPECT_TRUE(contains(message, "--no-animation")) << message;
   EXPECT_TRUE(contains(message, "format 1")) << message;
+}
+
+TEST(Messages, MissingAnimationGivesTheRecordedCauseAlone) {
+  const std::string message = missing_animation_error("crowd controller", "built with --no-animation").message;
+  EXPECT_EQ(message, "crowd controller: the database has no animation section: built with --no-animation; rebuild it "
+                     "with `mmvk build` from clips of one skeleton");
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "mmvk/database_io.hpp"
 #include "mmvk/manifest.hpp"
 #include "mmvk/pose_batch.hpp"
+#include "support/command.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {
@@ -235,6 +236,7 @@ TEST_F(AnimationData_, SurvivesTheFileAndLeavesFeaturesAlone) {
   Result<Database> plain = build_database(*manifest, options);
   ASSERT_TRUE(plain.ok()) << plain.message();
   EXPECT_EQ(plain->animation(), nullptr);
+  EXPECT_EQ(plain->no_animation_reason(), "built with --no-animation");
   EXPECT_EQ(plain->content_hash(), database_->content_hash());
   EXPECT_LT(serialize_database(*plain).size() + a.frame_count * a.bytes_per_frame_in_file(), bytes.size() + 1);
 }
@@ -257,6 +259,14 @@ TEST(AnimationBuild, MixedSkeletonsBuildWithoutTheSectionAndSayWhy) {
   EXPECT_NE(warning.find("Build each skeleton's clips into a database of its own"), std::string::npos) << warning;
   EXPECT_NE(warning.find("131_01.bvh"), std::string::npos) << warning;
   EXPECT_NE(warning.find("walk_normal_001.bvh"), std::string::npos) << warning;
+  // The database keeps the reason, so `inspect` and the crowd give it
+  // rather than guess.
+  const std::string& reason = db->no_animation_reason();
+  EXPECT_NE(reason.find("1 clip's hierarchy differs from"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("131_01.bvh"), std::string::npos) << reason;
+  Result<Database> loaded = deserialize_database(serialize_database(*db), "mixed.mmdb");
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  EXPECT_EQ(loaded->no_animation_reason(), reason);
 }
 
 int run(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()); }
@@ -298,7 +308,12 @@ TEST(AnimationCommandLine, BuildInspectExport) {
   EXPECT_EQ(inspect["animation"]["joints"][1]["name"], "Hips");
   EXPECT_EQ(inspect["animation"]["bytes_per_frame_file"], a.bytes_per_frame_in_file());
   ASSERT_EQ(std::system((mmvk + " inspect --json " + plain + " > " + (dir / "p.json").string()).c_str()), 0);
-  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "p.json"))["animation"]["present"], false);
+  const nlohmann::json plain_inspect = nlohmann::json::parse(std::ifstream(dir / "p.json"));
+  EXPECT_EQ(plain_inspect["animation"]["present"], false);
+  EXPECT_EQ(plain_inspect["animation"]["reason"], "built with --no-animation");
+  const auto text = test::run_command(mmvk + " inspect " + plain);
+  EXPECT_NE(text.output.find("animation: none, features only (built with --no-animation)\n"), std::string::npos)
+      << text.output;
 
   const std::string out = (dir / "anim.f32").string();
   ASSERT_EQ(run(mmvk + " export " + db + " --animation " + out), 0);

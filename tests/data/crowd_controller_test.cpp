@@ -1,11 +1,13 @@
 // The crowd controller on Bandai locomotion with the reference backend:
 // every search finds a candidate, the load is staggered, roots stay within
-// the correction bound, jumps are blended, the deferred path and batch
-// splitting behave, and a database without animation is refused clearly.
+// the correction bound, jumps are blended, the display follows the jumps, the
+// deferred path and batch splitting behave, and a database without animation
+// is refused clearly.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
+#include "mmvk/pose_batch.hpp"
 #include "mmvk/reference_search.hpp"
 #include "support/crowd_scenario.hpp"
 #include "support/test_data.hpp"
@@ -54,8 +56,9 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
     return glm::length((now[i] - now[b * joints]) - (before[i] - before[b * joints]));
   };
   auto observe = [&](const CrowdController& c, int tick) {
-    c.animated_world_positions(current, pool);
-    c.world_positions(shown, pool);
+    const auto animated = c.animated_world_positions(), displayed = c.world_positions();
+    current.assign(animated.begin(), animated.end());
+    shown.assign(displayed.begin(), displayed.end());
     if (tick > 0) {
       for (std::uint32_t b = 0; b < c.size(); ++b) {
         for (std::size_t j = 0; j < joints; ++j) {
@@ -84,15 +87,15 @@ TEST_F(CrowdControllerData, SearchesFindCandidatesOnAStaggeredLoad) {
   // searched() tells the kinds apart: every first search is forced (2), and
   // per tick its 1s and 2s add up to the tick's regular and forced counts.
   const std::uint32_t n = test::kCrowdCharacters;
-  for (std::uint32_t b = 0; b < n; ++b) EXPECT_EQ(run->searched[b], 2) << "character " << b;
+  for (std::uint32_t b = 0; b < n; ++b) EXPECT_EQ(run->searched[b], SearchKind::Forced) << "character " << b;
   std::uint32_t regular_seen = 0;
   for (std::size_t t = 0; t < run->ticks.size(); ++t) {
     std::uint32_t regular = 0, forced = 0;
     for (std::uint32_t b = 0; b < n; ++b) {
-      const std::uint8_t kind = run->searched[t * n + b];
-      ASSERT_LE(kind, 2) << "tick " << t << ", character " << b;
-      regular += kind == 1 ? 1u : 0u;
-      forced += kind == 2 ? 1u : 0u;
+      const SearchKind kind = run->searched[t * n + b];
+      ASSERT_LE(std::uint8_t(kind), 2) << "tick " << t << ", character " << b;
+      regular += kind == SearchKind::Regular ? 1u : 0u;
+      forced += kind == SearchKind::Forced ? 1u : 0u;
     }
     EXPECT_EQ(forced, run->ticks[t].forced) << "tick " << t;
     EXPECT_EQ(regular + forced, run->ticks[t].searches) << "tick " << t;
@@ -140,6 +143,56 @@ TEST_F(CrowdControllerData, DeferredAppliesTheSameSearchOneTickLater) {
   const test::CrowdRun deferred = run_with(true);
   EXPECT_EQ(deferred.totals.no_candidate, 0u);
   EXPECT_NE(deferred.frames, sync.frames);  // one tick of latency changes the choices
+}
+
+// The ticks' own order: the display comes after the jumps (step 8 after
+// step 7), so on the synchronous tick the pose shown, and the world positions
+// kept of the animated pose, are those of the pose after a jump, bit for bit;
+// and the applied pairs are the tick's own searches (the deferred tick's: the
+// previous tick's).
+TEST_F(CrowdControllerData, TheDisplayFollowsTheJumpsAndTheAppliedPairsTheSearches) {
+  ReferenceSearch reference(*database_);
+  ThreadPool pool(2);
+  for (const bool deferred : {false, true}) {
+    SCOPED_TRACE(deferred ? "deferred tick" : "synchronous tick");
+    ControllerParams params;
+    params.foot_ik.enabled = false;  // displayed = animated: world_positions() is the FK of local_rotations()
+    Result<CrowdController> controller = CrowdController::create(*database_, test::kCrowdCharacters, params);
+    ASSERT_TRUE(controller.ok()) << controller.message();
+    DeferredSearch later(reference, test::kCrowdCharacters);
+    const std::size_t joints = controller->animation().joint_count();
+    std::vector<glm::vec3> fk(test::kCrowdCharacters * joints), shown_fk(fk.size());
+    std::vector<std::uint32_t> searched_before;
+    std::uint32_t jumps = 0;
+    auto observe = [&](const CrowdController& c, int) {
+      forward_kinematics_batch(c.animation().skeleton, c.animated_rotations(), c.animated_translations(),
+                               c.root_positions(), c.root_yaws(), fk);
+      forward_kinematics_batch(c.animation().skeleton, c.local_rotations(), c.local_translations(),
+                               c.root_positions(), c.root_yaws(), shown_fk);
+      const auto animated = c.animated_world_positions(), shown = c.world_positions();
+      ASSERT_TRUE(std::equal(fk.begin(), fk.end(), animated.begin()));
+      ASSERT_TRUE(std::equal(shown_fk.begin(), shown_fk.end(), shown.begin()));
+      // Without foot IK the pose shown is the animated one, jumps included.
+      ASSERT_TRUE(std::equal(c.local_rotations().begin(), c.local_rotations().end(), c.animated_rotations().begin()));
+      std::vector<std::uint32_t> searched_now;
+      for (std::uint32_t b = 0; b < c.size(); ++b) {
+        if (c.searched()[b] != SearchKind::None) searched_now.push_back(b);
+      }
+      const std::vector<std::uint32_t> applied(c.applied_characters().begin(), c.applied_characters().end());
+      EXPECT_EQ(applied, deferred ? searched_before : searched_now);
+      EXPECT_EQ(c.applied_matches().size(), c.last_tick().applied);
+      searched_before = searched_now;
+      jumps += c.last_tick().jumps;
+    };
+    Result<test::CrowdRun> run = test::run_crowd(
+        *controller,
+        [&](CrowdController& c, const CrowdInput& in) {
+          return deferred ? c.tick(test::kCrowdDt, in, later, pool) : c.tick(test::kCrowdDt, in, reference, pool);
+        },
+        observe);
+    ASSERT_TRUE(run.ok()) << run.message();
+    EXPECT_GT(jumps, 50u);
+  }
 }
 
 TEST_F(CrowdControllerData, DatabaseWithoutAnimationIsRefusedWithTheFix) {

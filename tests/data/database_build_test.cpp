@@ -289,6 +289,9 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   EXPECT_NEAR(units["metres_per_unit"][0]["value"].get<double>(), 0.01, 1e-6);
   EXPECT_EQ(units["metres_per_unit"][0]["clips"], 4);
   EXPECT_EQ(units["metres_per_unit"][0]["name"], "centimetres");
+  ASSERT_EQ(units["units_from"].size(), 1u) << units.dump();
+  EXPECT_EQ(units["units_from"][0]["from"], "guessed from the skeleton's size");
+  EXPECT_EQ(units["axes_from"][0]["from"], "BVH files are read Y-up unless told");
   EXPECT_GT(units["standing_height_m"].get<double>(), 1.2) << units.dump();
   EXPECT_LT(units["standing_height_m"].get<double>(), 2.0) << units.dump();
   EXPECT_GT(units["body_up"].get<double>(), 0.9) << units.dump();  // upright along +Y
@@ -298,6 +301,9 @@ TEST(DatabaseBuild, CommandLineBuildInspectExport) {
   EXPECT_NE(units["run_note"].get<std::string>().find("no frame is tagged 'run'"), std::string::npos) << units.dump();
   const auto text = test::run_command(mmvk.string() + " inspect " + db);
   EXPECT_NE(text.output.find("units: 0.01 metres per file unit (centimetres)"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("units taken from: guessed from the skeleton's size\n"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("up axis taken from: BVH files are read Y-up unless told\n"), std::string::npos)
+      << text.output;
   EXPECT_NE(text.output.find("speeds: walk "), std::string::npos) << text.output;
   EXPECT_NE(text.output.find("up axis: +Y, upright (the feet-to-head direction's y is "), std::string::npos)
       << text.output;

@@ -80,7 +80,7 @@ Measured play_clips(const Database& db) {
       const float yaws[] = {yaw};
       forward_kinematics_batch(a.skeleton, rotations, translations, roots, yaws, played);
       const bool first = frame == clip.first_frame;
-      locker->update(0, first ? 0.0f : dt, a.contacts[frame], root, yaw, rotations, translations, shown);
+      locker->update(0, first ? 0.0f : dt, a.contacts[frame], root, yaw, played, rotations, translations, shown);
       for (const glm::vec3& p : shown) {
         EXPECT_TRUE(std::isfinite(p.x + p.y + p.z)) << clip.name << " " << frame;
       }

@@ -21,7 +21,9 @@
 
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>
+#define GLM_ENABLE_EXPERIMENTAL
 #include <glm/gtc/quaternion.hpp>
+#include <glm/gtx/euler_angles.hpp>
 #include <glm/mat4x4.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -281,17 +283,24 @@ float least_rotation_agreement(const mmvk::Database& a, const mmvk::Database& b)
   return least;
 }
 
+// The largest difference of two databases' features (normalized units);
+// they have the same frames and dims.
+float largest_feature_difference(const mmvk::Database& a, const mmvk::Database& b) {
+  EXPECT_EQ(a.frame_count(), b.frame_count());
+  EXPECT_EQ(a.dims(), b.dims());
+  const auto x = a.features(), y = b.features();
+  float worst = x.size() == y.size() ? 0.0f : INFINITY;
+  for (std::size_t i = 0; i < std::min(x.size(), y.size()); ++i) worst = std::max(worst, std::abs(x[i] - y[i]));
+  return worst;
+}
+
 TEST(SceneImport, GltfFromABvhClipGivesItsFeatures) {
   const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
   const fs::path dir = mmvk::test::make_temp_dir();
   const fs::path gltf = write_gltf(load_bvh_motion(bvh), dir, "walk", "walk_veer_left");
   const mmvk::Database from_bvh = build_one(bvh, dir);
   const mmvk::Database from_gltf = build_one(gltf, dir);
-  ASSERT_EQ(from_gltf.frame_count(), from_bvh.frame_count());
-  ASSERT_EQ(from_gltf.dims(), from_bvh.dims());
-  const auto a = from_bvh.features(), b = from_gltf.features();
-  float worst = 0.0f;
-  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  const float worst = largest_feature_difference(from_bvh, from_gltf);
   EXPECT_LT(worst, 1e-3f) << "largest feature difference (normalized units)";
   EXPECT_EQ(from_gltf.clips()[0].metres_per_unit, 1.0f);  // glTF is metres
   EXPECT_GT(least_rotation_agreement(from_bvh, from_gltf), 0.99999f) << "least |dot| of the stored rotations";
@@ -418,19 +427,119 @@ fs::path write_collada(const Motion& motion, const fs::path& dir, const std::str
   return dir / (stem + ".dae");
 }
 
-TEST(SceneImport, ColladaInCentimetresZUpFromABvhClipGivesItsFeatures) {
+// --- An FBX file written from a BVH clip -----------------------------------
+
+std::string fbx_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.9g", value);
+  return text;
+}
+
+std::string fbx_array(const std::string& name, const std::vector<std::string>& values) {
+  std::string text = "  " + name + ": *" + std::to_string(values.size()) + " {\n   a: ";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? "," : "") + values[i];
+  return text + "\n  }\n";
+}
+
+// Writes `motion` as an ASCII FBX 7.4 file, Z-up with -Y in front (as
+// Blender writes) and in centimetres (UnitScaleFactor 1), so that the
+// import's units and axes come from the file's GlobalSettings: each joint a
+// LimbNode model, animated by translation and Euler XYZ rotation curves with
+// a key per frame. (assimp 5.2's own FBX exporter cannot make it: its binary
+// output does not read back, and its ASCII output keeps 1 to 3 keys.)
+fs::path write_fbx(const Motion& motion, const fs::path& dir, const std::string& stem) {
+  const std::size_t joints = motion.joint_count(), frames = motion.frame_count;
+  // mmvk's Y-up to the file's Z-up: (x, y, z) -> (x, -z, y), as for COLLADA.
+  const glm::mat3 to_file(glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0));
+  constexpr double kTicksPerSecond = 46186158000.0;  // FBX KTime
+  std::vector<std::string> times;
+  for (std::size_t f = 0; f < frames; ++f) times.push_back(std::to_string(std::llround(f / motion.fps * kTicksPerSecond)));
+  std::string objects, connections;
+  long long next_id = 1000;
+  const long long stack = next_id++, layer = next_id++;
+  objects += " AnimationStack: " + std::to_string(stack) + ", \"AnimStack::" + stem + "\", \"\" {\n  Properties70:  {\n"
+             "   P: \"LocalStop\", \"KTime\", \"Time\", \"\"," + times.back() + "\n  }\n }\n"
+             " AnimationLayer: " + std::to_string(layer) + ", \"AnimLayer::BaseLayer\", \"\" {\n }\n";
+  connections += " C: \"OO\"," + std::to_string(layer) + "," + std::to_string(stack) + "\n";
+  std::vector<long long> model(joints);
+  for (long long& id : model) id = next_id++;
+  for (std::size_t j = 0; j < joints; ++j) {
+    // [T, R][x, y, z][frame]: centimetres and degrees in the file's axes.
+    std::vector<std::string> values[2][3];
+    for (std::size_t f = 0; f < frames; ++f) {
+      const std::size_t i = motion.index(std::uint32_t(f), j);
+      glm::mat3 rotation = glm::mat3_cast(motion.local_rotations[i]);
+      glm::vec3 translation = motion.local_positions[i] * 100.0f;
+      if (motion.skeleton.parents[j] < 0) rotation = to_file * rotation, translation = to_file * translation;
+      float z = 0, y = 0, x = 0;  // R = Rz * Ry * Rx: FBX's default rotation order, XYZ
+      glm::extractEulerAngleZYX(glm::mat4(rotation), z, y, x);
+      const glm::vec3 degrees = glm::degrees(glm::vec3(x, y, z));
+      for (int a = 0; a < 3; ++a) values[0][a].push_back(fbx_number(translation[a]));
+      for (int a = 0; a < 3; ++a) values[1][a].push_back(fbx_number(degrees[a]));
+    }
+    const std::string id = std::to_string(model[j]);
+    const char* property[2] = {"Lcl Translation", "Lcl Rotation"};
+    objects += " Model: " + id + ", \"Model::" + motion.skeleton.names[j] + "\", \"LimbNode\" {\n  Version: 232\n"
+               "  Properties70:  {\n";
+    for (int k = 0; k < 2; ++k) {
+      objects += "   P: \"" + std::string(property[k]) + "\", \"" + property[k] + "\", \"\", \"A\"," + values[k][0][0] +
+                 "," + values[k][1][0] + "," + values[k][2][0] + "\n";
+    }
+    objects += "  }\n }\n";
+    const int parent = motion.skeleton.parents[j];
+    connections += " C: \"OO\"," + id + "," + (parent < 0 ? std::string("0") : std::to_string(model[parent])) + "\n";
+    for (int k = 0; k < 2; ++k) {
+      const std::string node = std::to_string(next_id++);
+      objects += " AnimationCurveNode: " + node + ", \"AnimCurveNode::" + (k ? "R" : "T") + "\", \"\" {\n }\n";
+      connections += " C: \"OO\"," + node + "," + std::to_string(layer) + "\n C: \"OP\"," + node + "," + id + ", \"" +
+                     property[k] + "\"\n";
+      for (int a = 0; a < 3; ++a) {
+        const std::string curve = std::to_string(next_id++);
+        objects += " AnimationCurve: " + curve + ", \"AnimCurve::\", \"\" {\n  Default: 0\n  KeyVer: 4008\n" +
+                   fbx_array("KeyTime", times) + fbx_array("KeyValueFloat", values[k][a]) +
+                   fbx_array("KeyAttrFlags", {"4"}) + fbx_array("KeyAttrDataFloat", {"0", "0", "0", "0"}) +
+                   fbx_array("KeyAttrRefCount", {std::to_string(frames)}) + " }\n";
+        connections += " C: \"OP\"," + curve + "," + node + ", \"d|" + std::string(1, char('X' + a)) + "\"\n";
+      }
+    }
+  }
+  const fs::path path = dir / (stem + ".fbx");
+  std::ofstream(path) << "; FBX 7.4.0 project file\nFBXHeaderExtension:  {\n FBXHeaderVersion: 1003\n FBXVersion: 7400\n}\n"
+                         "GlobalSettings:  {\n Version: 1000\n Properties70:  {\n"
+                         "  P: \"UpAxis\", \"int\", \"Integer\", \"\",2\n  P: \"UpAxisSign\", \"int\", \"Integer\", \"\",1\n"
+                         "  P: \"FrontAxis\", \"int\", \"Integer\", \"\",1\n  P: \"FrontAxisSign\", \"int\", \"Integer\", \"\",-1\n"
+                         "  P: \"CoordAxis\", \"int\", \"Integer\", \"\",0\n  P: \"CoordAxisSign\", \"int\", \"Integer\", \"\",1\n"
+                         "  P: \"UnitScaleFactor\", \"double\", \"Number\", \"\",1\n }\n}\n"
+                      << "Objects:  {\n" << objects << "}\nConnections:  {\n" << connections << "}\n";
+  return path;
+}
+
+// The COLLADA and FBX files above: units and axes from the file.
+TEST(SceneImport, ColladaAndFbxInCentimetresZUpFromABvhClipGiveItsFeatures) {
   const fs::path bvh = mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh";
   const fs::path dir = mmvk::test::make_temp_dir();
-  const fs::path dae = write_collada(load_bvh_motion(bvh), dir, "walk");
+  const Motion walk = load_bvh_motion(bvh);
   const mmvk::Database from_bvh = build_one(bvh, dir);
-  const mmvk::Database from_dae = build_one(dae, dir);
-  ASSERT_EQ(from_dae.frame_count(), from_bvh.frame_count());
-  const auto a = from_bvh.features(), b = from_dae.features();
-  float worst = 0.0f;
-  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
-  // Matrices written with 6 decimals (std::to_string) in centimetres.
-  EXPECT_LT(worst, 2e-3f) << "largest feature difference (normalized units)";
-  EXPECT_GT(least_rotation_agreement(from_bvh, from_dae), 0.9999f) << "least |dot| of the stored rotations";
+  struct Written {
+    fs::path file;
+    float metres_per_unit;  // as the import records it: assimp scales COLLADA to metres itself
+    std::string units_from, axes_from;
+  };
+  const Written files[] = {
+      {write_collada(walk, dir, "walk"), 1.0f, "COLLADA <unit> (applied by assimp)", "COLLADA <up_axis> (applied by assimp)"},
+      {write_fbx(walk, dir, "walk"), 0.01f, "FBX UnitScaleFactor 1 (centimetres per unit)",
+       "FBX UpAxis 2 (0 = X, 1 = Y, 2 = Z), UpAxisSign 1"}};
+  for (const Written& written : files) {
+    SCOPED_TRACE(written.file.string());
+    const mmvk::Database from_file = build_one(written.file, dir);
+    // Values written with 6 decimals (COLLADA) or 9 digits (FBX) in
+    // centimetres; FBX's rotations as Euler angles.
+    EXPECT_LT(largest_feature_difference(from_bvh, from_file), 2e-3f) << "largest feature difference (normalized units)";
+    EXPECT_GT(least_rotation_agreement(from_bvh, from_file), 0.9999f) << "least |dot| of the stored rotations";
+    EXPECT_EQ(from_file.clips()[0].metres_per_unit, written.metres_per_unit);
+    EXPECT_EQ(from_file.clips()[0].units_from, written.units_from);
+    EXPECT_EQ(from_file.clips()[0].axes_from, written.axes_from);
+  }
 }
 
 TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {
@@ -445,6 +554,74 @@ TEST(SceneImport, CliBuildsAGltfFileAsABvhFile) {
   const auto inspected = mmvk::test::run_command(cli->string() + " inspect " + (dir / "walk.mmdb").string());
   ASSERT_EQ(inspected.exit_code, 0) << inspected.output;
   EXPECT_NE(inspected.output.find("walk"), std::string::npos) << inspected.output;
+}
+
+// --- assimp in a child process ---------------------------------------------
+
+TEST(SceneImport, TheChildProcessGivesTheSameImportAsThisProcess) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const Motion walk = load_bvh_motion(mmvk::test::test_source_dir() / "../host/crowd/data/cmu16/16_23.bvh");
+  const fs::path gltf = write_gltf(walk, dir, "walk", "walk");
+  mmvk::SceneImportOptions here;
+  here.isolate = false;
+  const auto child = mmvk::import_scene(gltf, {});
+  const auto local = mmvk::import_scene(gltf, here);
+  ASSERT_TRUE(child.ok()) << child.message();
+  ASSERT_TRUE(local.ok()) << local.message();
+  EXPECT_EQ(child->metres_per_unit, local->metres_per_unit);
+  EXPECT_EQ(child->units_from, local->units_from);
+  EXPECT_EQ(child->axes_from, local->axes_from);
+  ASSERT_EQ(child->animations.size(), local->animations.size());
+  for (std::size_t a = 0; a < local->animations.size(); ++a) {
+    const Motion &x = child->animations[a].motion, &y = local->animations[a].motion;
+    EXPECT_EQ(child->animations[a].name, local->animations[a].name);
+    EXPECT_EQ(x.fps, y.fps);
+    EXPECT_EQ(x.frame_count, y.frame_count);
+    EXPECT_EQ(x.skeleton.names, y.skeleton.names);
+    EXPECT_EQ(x.skeleton.parents, y.skeleton.parents);
+    EXPECT_EQ(x.skeleton.rest_offsets, y.skeleton.rest_offsets);
+    EXPECT_EQ(x.local_positions, y.local_positions);
+    EXPECT_EQ(x.local_rotations, y.local_rotations);
+  }
+  // A failed read's message comes back from the child unchanged.
+  std::ofstream(dir / "fake.fbx") << "not an fbx at all";
+  const auto fake_child = mmvk::import_scene(dir / "fake.fbx", {});
+  const auto fake_local = mmvk::import_scene(dir / "fake.fbx", here);
+  ASSERT_FALSE(fake_child.ok());
+  EXPECT_EQ(fake_child.message(), fake_local.message());
+}
+
+// A COLLADA triangle list with a stray letter in its indices ("2x"): assimp
+// 5.2.5 reads it allocating without bound (over 1 GB in 5 s). In the child
+// process that is an error naming the file, within the limits given.
+TEST(SceneImport, AFileOnWhichAssimpRunsAwayIsAnErrorNamingIt) {
+  const fs::path dir = mmvk::test::make_temp_dir();
+  const fs::path dae = dir / "runaway.dae";
+  std::ofstream(dae) << R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+<asset><unit meter="1"/><up_axis>Y_UP</up_axis></asset>
+<library_geometries><geometry id="g"><mesh>
+<source id="p"><float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array><technique_common>
+<accessor source="#pa" count="3" stride="3"><param name="X" type="float"/><param name="Y" type="float"/>
+<param name="Z" type="float"/></accessor></technique_common></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2x 1</p></triangles>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node></visual_scene>
+</library_visual_scenes><scene><instance_visual_scene url="#s"/></scene></COLLADA>
+)";
+  mmvk::SceneImportOptions options;
+  options.timeout_seconds = 3.0;
+  options.memory_budget_bytes = std::uint64_t{256} << 20;
+  const auto imported = mmvk::import_scene(dae, options);
+  ASSERT_FALSE(imported.ok());
+  EXPECT_EQ(imported.message().rfind(dae.string() + ": ", 0), 0u) << imported.message();
+  EXPECT_NE(imported.message().find("assimp"), std::string::npos) << imported.message();
+  options.timeout_seconds = 0.0;
+  const auto no_time = mmvk::import_scene(dae, options);
+  ASSERT_FALSE(no_time.ok());
+  EXPECT_NE(no_time.message().find("timeout_seconds and memory_budget_bytes must be positive"), std::string::npos)
+      << no_time.message();
 }
 
 TEST(SceneImport, ErrorsNameTheFile) {

@@ -39,7 +39,7 @@ inline glm::vec3 crowd_velocity(std::uint32_t b, int tick) {
 
 struct CrowdRun {
   std::vector<std::uint32_t> frames;  // [ticks x characters]
-  std::vector<std::uint8_t> searched;  // [ticks x characters]
+  std::vector<SearchKind> searched;  // [ticks x characters]
   std::vector<TickStats> ticks;
   TickStats totals;
   float worst_root_gap = 0.0f;  // largest animated-to-simulated root distance, metres

@@ -92,15 +92,19 @@ class ViewerChromium : public ::testing::Test {
   // Runs headless Chromium on `page` with one mode flag (--dump-dom or
   // --screenshot=...); returns its stdout. The virtual time budget lets the
   // page's asynchronous decoding finish before the DOM or the pixels are
-  // taken.
+  // taken. `webgl`: with WebGL on SwiftShader, Chromium's software GL (the
+  // 3D view), instead of no GPU at all.
   std::string run_chromium(const fs::path& page, const std::string& mode, const std::string& tag,
-                           const std::string& query = kQuery) {
+                           const std::string& query = kQuery, bool webgl = false) {
     const fs::path profile = *dir_ / ("profile-" + tag);
     fs::remove_all(profile);
     fs::create_directories(profile);
     const fs::path out = *dir_ / (tag + ".out"), err = *dir_ / (tag + ".err");
     const std::string command = "timeout 120 '" + chromium_->string() +
-                                "' --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
+                                "' --headless --no-sandbox" +
+                                (webgl ? " --use-angle=swiftshader --enable-unsafe-swiftshader --ignore-gpu-blocklist"
+                                       : " --disable-gpu") +
+                                " --disable-quic --no-first-run"
                                 " --disable-background-networking --disable-component-update --disable-sync"
                                 " --hide-scrollbars --window-size=1280,800 --virtual-time-budget=10000"
                                 " --user-data-dir='" + profile.string() + "' " + mode + " 'file://" +
@@ -329,6 +333,81 @@ TEST_F(ViewerChromium, ZoomedOnTheFeetShowsWhereTheyAreLocked) {
   EXPECT_GE(crowd, 150u);
   EXPECT_GE(skeleton, 25u);
   EXPECT_GE(timeline, 100u);
+}
+
+// The numbers a status attribute holds, comma-separated ("" when absent).
+std::vector<double> status_numbers(const std::string& status, const std::string& attribute) {
+  std::smatch match;
+  const std::regex pattern(attribute + "=\"([^\"]*)\"");
+  std::vector<double> v;
+  if (!std::regex_search(status, match, pattern)) return v;
+  std::stringstream fields(match[1].str());
+  for (std::string field; std::getline(fields, field, ',');) v.push_back(std::stod(field));
+  return v;
+}
+
+// The 3D view (viewer3d.js: three.js on WebGL): around the selected
+// character's hips, the page differs from the same view of the empty ground
+// (?characters=0), and the ground itself was drawn (not the clear colour).
+TEST_F(ViewerChromium, ThreeDViewShowsCharactersWhereTheyStand) {
+  SyntheticRecordingParams params;
+  params.agents = 40;
+  params.seconds = 6.0f;
+  const fs::path page = *dir_ / "small.html";
+  ASSERT_TRUE(write_viewer_html(page, make_synthetic_recording(params)).ok());
+  const std::string query = "?t=3&agent=3&paused=1&view=3d&cam=5,0.6,0.3";
+  const std::string status = status_of(run_chromium(page, "--dump-dom", "3d-dom", query, true));
+  ASSERT_NE(status.find("data-state=\"ready\""), std::string::npos) << status;
+  EXPECT_NE(status.find("data-view=\"3d\""), std::string::npos) << status;
+  const std::vector<double> at = status_numbers(status, "data-projected");
+  ASSERT_EQ(at.size(), 2u) << status;
+  const fs::path with = *dir_ / "3d.png", without = *dir_ / "3d-empty.png";
+  run_chromium(page, "--screenshot=" + with.string(), "3d", query, true);
+  run_chromium(page, "--screenshot=" + without.string(), "3d-empty", query + "&characters=0", true);
+  const auto a = test::read_png(with), b = test::read_png(without);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.message() << b.message();
+  ASSERT_EQ(a->width, b->width);
+  ASSERT_EQ(a->height, b->height);
+  const auto x = std::uint32_t(std::lround(at[0])), y = std::uint32_t(std::lround(at[1]));
+  ASSERT_TRUE(x >= 8 && y >= 8 && x + 8 < a->width && y + 8 < a->height) << x << "," << y;
+  std::size_t differ = 0;
+  for (std::uint32_t py = y - 8; py <= y + 8; ++py) {
+    for (std::uint32_t px = x - 8; px <= x + 8; ++px) {
+      const uint8_t *p = a->pixel(px, py), *q = b->pixel(px, py);
+      differ += std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) > 40;
+    }
+  }
+  // The empty ground: drawn by WebGL, so not the page's clear colour.
+  const std::size_t ground = count_pixels(*b, 10, 80, 820, 610, [](Rgb p) { return !near(p, {0x14, 0x17, 0x1c}); });
+  std::cout << "[ viewer ] 3D: hips at " << x << "," << y << ", " << differ << " of 289 pixels around them differ "
+            << "from the empty ground; " << ground << " ground pixels\n";
+  EXPECT_GE(differ, 72u);
+  EXPECT_GE(ground, 810u * 530u / 3);
+}
+
+// Why this frame: a search opened from the URL (as a click on the timeline
+// opens it) shows the recorded explanation, within its quantization
+// (frames exact, costs to 1e-5 each); a character whose searches are not
+// explained opens none.
+TEST_F(ViewerChromium, WhyPanelShowsTheRecordedExplanation) {
+  const Recording& r = *recording_;
+  ASSERT_GT(r.detail_agents, 3u);
+  const Recording::SearchWhy& why = r.why[3][7];
+  ASSERT_EQ(why.search, 7u);
+  const std::vector<double> v =
+      status_numbers(status_of(run_chromium(*dir_ / "crowd.html", "--dump-dom", "why", "?t=4&agent=3&paused=1&why=7")),
+                     "data-why");
+  ASSERT_EQ(v.size(), 5u);
+  EXPECT_EQ(v[0], double(why.chosen.frame));
+  EXPECT_EQ(v[1], double(why.continuing.frame));
+  EXPECT_NEAR(v[2], why.chosen.cost, 1e-5);
+  EXPECT_NEAR(v[3], why.continuing.cost, 1e-5);
+  double sum = 0.0;
+  for (float c : why.chosen.weighted) sum += c;
+  EXPECT_NEAR(v[4], sum, 1e-5 * double(why.chosen.weighted.size()));
+  const std::string none = status_of(run_chromium(*dir_ / "crowd.html", "--dump-dom", "why-none",
+                                                  "?t=4&agent=" + std::to_string(r.detail_agents) + "&paused=1&why=2"));
+  EXPECT_NE(none.find("data-why=\"\""), std::string::npos) << none;
 }
 
 }  // namespace

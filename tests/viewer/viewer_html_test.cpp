@@ -93,6 +93,41 @@ TEST(ViewerRecording, ErrorsNameTheField) {
   expect_error(r, "facing[5]");
 }
 
+TEST(ViewerRecording, WholePoseAndExplanationErrorsNameTheField) {
+  Recording r = small_recording();
+  ASSERT_GT(r.detail_agents, 0u);
+  r.detail_positions.pop_back();
+  expect_error(r, "detail_positions");
+
+  r = small_recording();
+  r.detail_agents = r.agent_count + 1;
+  expect_error(r, "detail_agents");
+
+  r = small_recording();
+  r.detail_positions[10] = std::nanf("");
+  expect_error(r, "detail_positions[10]");
+
+  r = small_recording();
+  r.why[1][3].chosen.clip = 9;
+  expect_error(r, "why[1][3].chosen.clip");
+
+  r = small_recording();
+  r.why[1][3].continuing.weighted.pop_back();
+  expect_error(r, "why[1][3].continuing.weighted");
+
+  r = small_recording();
+  r.why[2][1].search = r.why[2][0].search;
+  expect_error(r, "why[2][1].search");
+
+  r = small_recording();
+  r.why[0][0].continuing.exclusion = 7;
+  expect_error(r, "why[0][0].continuing.exclusion");
+
+  r = small_recording();
+  r.why.pop_back();
+  expect_error(r, "why");
+}
+
 TEST(ViewerPage, IsSelfContained) {
   Recording r = small_recording();
   r.title = "a </script> title";
@@ -100,16 +135,36 @@ TEST(ViewerPage, IsSelfContained) {
   ASSERT_TRUE(page.ok()) << page.message();
   const std::string& html = page->html;
   EXPECT_EQ(html.find("@MMVK_"), std::string::npos) << "a placeholder was left in the page";
-  // The only "</script" are the page's own three closing tags: the title
+  // The only "</script" are the page's own six closing tags (the meta, the
+  // data, three.js, viewer3d.js, viewer_why.js, viewer.js): the title
   // cannot end a script block early.
   std::size_t closings = 0;
   for (std::size_t at = html.find("</script"); at != std::string::npos; at = html.find("</script", at + 1)) ++closings;
-  EXPECT_EQ(closings, 3u);
+  EXPECT_EQ(closings, 6u);
   EXPECT_NE(html.find("a \\u003c/script> title"), std::string::npos);
-  // No network: nothing is fetched from elsewhere.
-  EXPECT_EQ(html.find("http://"), std::string::npos);
-  EXPECT_EQ(html.find("https://"), std::string::npos);
-  EXPECT_EQ(html.find("src="), std::string::npos);
+  // No network: nothing is fetched from elsewhere. three.js, the block after
+  // the data, names two URLs it never fetches (the XHTML namespace and a
+  // paper it cites) and has an image loader the page never calls; the rest
+  // of the page names none.
+  const std::size_t three_at = html.find("<script>", html.find("id=\"mmvk-data\""));
+  const std::size_t three_end = html.find("</script>", three_at);
+  ASSERT_NE(three_end, std::string::npos);
+  const std::string three = html.substr(three_at, three_end - three_at);
+  EXPECT_NE(three.find("THREE"), std::string::npos) << "the block after the data is not three.js";
+  const std::string rest = html.substr(0, three_at) + html.substr(three_end);
+  EXPECT_EQ(rest.find("http://"), std::string::npos);
+  EXPECT_EQ(rest.find("https://"), std::string::npos);
+  EXPECT_EQ(rest.find("src="), std::string::npos);
+  std::size_t urls = 0;
+  for (std::size_t at = three.find("http"); at != std::string::npos; at = three.find("http", at + 1)) {
+    const std::string url = three.substr(at, 32);
+    if (url.starts_with("http://") || url.starts_with("https://")) {
+      ++urls;
+      EXPECT_TRUE(url.starts_with("http://www.w3.org/1999/xhtml") || url.starts_with("https://graphics.stanford.edu/"))
+          << url;
+    }
+  }
+  EXPECT_EQ(urls, 5u);
   EXPECT_NE(html.find("\"agent_count\":7"), std::string::npos);
 }
 

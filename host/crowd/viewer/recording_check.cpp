@@ -1,5 +1,6 @@
 #include "viewer/recording_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -131,6 +132,61 @@ Status check_feet(const Recording& r) {
   return {};
 }
 
+Status check_detail(const Recording& r) {
+  if (r.detail_agents > r.agent_count) {
+    return make_error("recording: detail_agents = " + std::to_string(r.detail_agents) + " is over agent_count = " +
+                      std::to_string(r.agent_count));
+  }
+  if (r.detail_agents > 0 && (!std::isfinite(r.detail_rate_hz) || r.detail_rate_hz <= 0.0f)) {
+    return make_error("recording: detail_rate_hz = " + std::to_string(r.detail_rate_hz) + " must be positive");
+  }
+  MMVK_TRY(check_size("detail_positions", r.detail_positions.size(),
+                      r.detail_sample_count * r.detail_agents * r.joint_count() * 3,
+                      "detail_sample_count x detail_agents x joints x 3"));
+  return check_finite("detail_positions", r.detail_positions);
+}
+
+Status check_frame_why(const Recording& r, const Recording::FrameWhy& f, const std::string& where) {
+  if (f.frame < 0) return {};
+  if (f.clip >= r.clip_names.size()) {
+    return make_error("recording: " + where + ".clip = " + std::to_string(f.clip) + " is not an index into clip_names (" +
+                      std::to_string(r.clip_names.size()) + ")");
+  }
+  MMVK_TRY(check_size((where + ".weighted").c_str(), f.weighted.size(), r.channel_names.size(),
+                      "one per channel_names entry"));
+  for (float v : f.weighted) {
+    if (!std::isfinite(v)) return make_error("recording: " + where + ".weighted is not finite");
+  }
+  if (f.exclusion >= std::max<std::size_t>(r.exclusion_names.size(), 1)) {
+    return make_error("recording: " + where + ".exclusion = " + std::to_string(f.exclusion) +
+                      " is not an index into exclusion_names (" + std::to_string(r.exclusion_names.size()) + ")");
+  }
+  if (!std::isfinite(f.cost) || !std::isfinite(f.bias) || !std::isfinite(f.multiplier)) {
+    return make_error("recording: " + where + ": cost, bias or multiplier is not finite");
+  }
+  return {};
+}
+
+Status check_why(const Recording& r) {
+  if (r.why.empty()) return {};
+  MMVK_TRY(check_size("why", r.why.size(), r.agent_count, "one list per agent, or none"));
+  for (std::size_t a = 0; a < r.agent_count; ++a) {
+    for (std::size_t e = 0; e < r.why[a].size(); ++e) {
+      const Recording::SearchWhy& why = r.why[a][e];
+      const std::string where = "why[" + std::to_string(a) + "][" + std::to_string(e) + "]";
+      if (why.search >= r.searches[a].size() || (e > 0 && why.search <= r.why[a][e - 1].search)) {
+        return make_error("recording: " + where + ".search = " + std::to_string(why.search) +
+                          " is not an index into searches[" + std::to_string(a) + "], or not ascending");
+      }
+      MMVK_TRY(check_size((where + ".weights").c_str(), why.weights.size(), r.channel_names.size(),
+                          "one per channel_names entry"));
+      MMVK_TRY(check_frame_why(r, why.chosen, where + ".chosen"));
+      MMVK_TRY(check_frame_why(r, why.continuing, where + ".continuing"));
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Status validate_recording(const Recording& r) {
@@ -154,7 +210,9 @@ Status validate_recording(const Recording& r) {
   MMVK_TRY(check_trajectories(r));
   MMVK_TRY(check_agents(r));
   MMVK_TRY(check_skeleton(r));
-  return check_feet(r);
+  MMVK_TRY(check_feet(r));
+  MMVK_TRY(check_detail(r));
+  return check_why(r);
 }
 
 }  // namespace mmvk::crowd

@@ -220,6 +220,71 @@ void simulate_agent(Recording& r, const SyntheticRecordingParams& params, const 
   }
 }
 
+// The first agents' whole pose at the simulation rate: each 10 Hz sample's
+// played pose in world space, held until the next sample, its arms lifted
+// by a few centimetres (as the displayed pose differs from the played one).
+void add_detail(Recording& r, const SyntheticRecordingParams& params) {
+  r.detail_agents = std::min<std::size_t>(params.detail_agents, r.agent_count);
+  r.detail_rate_hz = params.simulation_rate_hz;
+  r.detail_sample_count = static_cast<std::size_t>(std::floor(params.seconds * params.simulation_rate_hz)) + 1;
+  const std::size_t joints = r.joint_count();
+  for (std::size_t k = 0; k < r.detail_sample_count; ++k) {
+    const float t = static_cast<float>(k) / r.detail_rate_hz;
+    const std::size_t sample = std::min(r.sample_count - 1, static_cast<std::size_t>(t * r.sample_rate_hz + 1e-3f));
+    for (std::size_t a = 0; a < r.detail_agents; ++a) {
+      const std::size_t i = r.sample_index(sample, a);
+      const auto pose = std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]) - r.pose_frames.begin();
+      const float c = std::cos(r.facing[i]), s = std::sin(r.facing[i]);
+      for (std::size_t j = 0; j < joints; ++j) {
+        const float* p = r.pose_positions.data() + r.pose_index(static_cast<std::size_t>(pose), j);
+        const float lift = p[1] > 1.0f ? 0.03f : 0.0f;
+        r.detail_positions.insert(r.detail_positions.end(),
+                                  {r.root_x[i] + c * p[0] + s * p[2], p[1] + lift, r.root_z[i] - s * p[0] + c * p[2]});
+      }
+    }
+  }
+}
+
+Recording::FrameWhy synthetic_frame_why(int32_t frame, const std::vector<float>& weights, Rng& rng) {
+  Recording::FrameWhy f;
+  f.frame = frame;
+  f.clip = frame >= kRun.first ? 1 : 0;
+  f.clip_time_s = static_cast<float>(frame - (f.clip ? kRun.first : kWalk.first)) / 30.0f;
+  float sum = 0.0f;
+  for (float w : weights) {
+    f.weighted.push_back(w * (0.01f + unit(rng)));
+    sum += f.weighted.back();
+  }
+  f.multiplier = 1.0f;
+  f.bias = f.clip ? 0.05f : 0.0f;
+  f.cost = f.multiplier * sum + f.bias;
+  return f;
+}
+
+// Every search of the detailed agents explained: made-up channel costs of
+// the chosen and the continuing frame (the next one, the played frame's).
+void add_why(Recording& r, Rng& rng) {
+  r.channel_names = {"trajectory_position", "trajectory_direction", "left_foot_position", "hip_velocity"};
+  r.clip_names = {"synthetic walk", "synthetic run"};
+  r.exclusion_names = {"candidate", "excluded"};
+  r.why.assign(r.agent_count, {});
+  const std::vector<float> weights = {1.0f, 1.5f, 0.75f, 1.0f};
+  for (std::size_t a = 0; a < r.detail_agents; ++a) {
+    for (std::size_t e = 0; e < r.searches[a].size(); ++e) {
+      const SearchEvent& event = r.searches[a][e];
+      Recording::SearchWhy why;
+      why.search = e;
+      why.weights = weights;
+      why.continuing_bias = -0.1f;
+      why.continuing_multiplier = 0.9f;
+      if (event.to_frame >= 0) why.chosen = synthetic_frame_why(event.to_frame, weights, rng);
+      why.continuing = synthetic_frame_why(event.from_frame + 1, weights, rng);
+      why.continuing.cost = why.continuing.cost * why.continuing_multiplier + why.continuing_bias;
+      r.why[a].push_back(std::move(why));
+    }
+  }
+}
+
 }  // namespace
 
 Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
@@ -244,6 +309,8 @@ Recording make_synthetic_recording(const SyntheticRecordingParams& params) {
   r.goals.resize(n), r.searches.resize(n);
   for (std::size_t a = 0; a < n; ++a) simulate_agent(r, params, agents[a], a, rng);
   add_feet(r);
+  add_detail(r, params);
+  add_why(r, rng);
   return r;
 }
 

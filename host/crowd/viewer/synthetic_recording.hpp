@@ -2,7 +2,9 @@
 // without a simulation: agents walk (a few run) circles around their own
 // centres, with a procedural 19-joint walk cycle, staggered searches every
 // 0.1 s and a jump about once a second; its legs are recorded as displayed
-// and each planted foot is locked where its toe touched down.
+// and each planted foot is locked where its toe touched down; the first
+// agents also have their whole pose at the simulation rate and made-up
+// explanations of their searches.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +20,9 @@ struct SyntheticRecordingParams {
   float sample_rate_hz = 10.0f;
   float simulation_rate_hz = 30.0f;  // also the fps of the synthetic "database"
   float search_interval_s = 0.1f;
+  // Agents recorded with their whole pose at the simulation rate, and whose
+  // searches are explained (Recording::detail_agents, Recording::why).
+  std::size_t detail_agents = 8;
   uint32_t seed = 1234;
 };
 

@@ -1,6 +1,7 @@
 // The mmvk crowd viewer: decodes the recording embedded in the page (see
-// viewer_payload.cpp for the layout) and draws four views of it. Plain
-// JavaScript and 2-D canvas, no libraries, no network.
+// viewer_payload.cpp for the layout) and draws four views of it: 2-D
+// canvas, and the crowd in 3D through viewer3d.js (three.js); the "why this
+// frame" panel is viewer_why.js. Everything is embedded, no network.
 //
 // Conventions (as in recording.hpp): world Y-up, metres, ground XZ; a facing
 // f looks along (sin f, 0, cos f); character space has +Z forward and the
@@ -213,13 +214,44 @@
       }
       r.finish();
     }
+    decodeDetail(meta, readers, d);
+    d.channelNames = meta.why ? meta.why.channel_names : [];
+    d.clipNames = meta.why ? meta.why.clip_names : [];
+    d.exclusionNames = meta.why ? meta.why.exclusion_names : [];
+    if (meta.why) d.why = window.MmvkWhy.decode(readers.why, N, d.channelNames.length);
     return d;
+  }
+
+  // The whole displayed pose of the first detail_agents characters at the
+  // tick rate, world metres: [agent][sample][joint][xyz] in d.detail.
+  function decodeDetail(meta, readers, d) {
+    d.detailAgents = meta.detail.agents;
+    d.detailS = meta.detail.sample_count;
+    d.detailRate = meta.detail.rate_hz;
+    if (d.detailAgents === 0) return;
+    const r = readers.detail, J = d.J, prev = new Float64Array(J * 3), before = new Float64Array(J * 3);
+    d.detail = new Float32Array(d.detailAgents * d.detailS * J * 3);
+    for (let a = 0; a < d.detailAgents; a++) {
+      for (let s = 0; s < d.detailS; s++) {
+        const base = (a * d.detailS + s) * J * 3;
+        // Residuals of the linear prediction (viewer_payload.cpp, "detail").
+        for (let c = 0; c < J * 3; c++) {
+          const predicted = s === 0 ? 0 : s === 1 ? prev[c] : 2 * prev[c] - before[c];
+          before[c] = prev[c];
+          prev[c] = predicted + r.z();
+        }
+        for (let j = 0; j < J; j++) {
+          for (let k = 0; k < 3; k++) d.detail[base + 3 * j + k] = (prev[3 * j + k] + (j > 0 ? prev[k] : 0)) / 1000;
+        }
+      }
+    }
+    r.finish();
   }
 
   // ---- state and sampling ------------------------------------------------
 
   let D = null;  // the decoded recording
-  const state = { t: 0, playing: true, speed: 1, selected: 0, view: null, yaw: -Math.PI / 2 + 0.6, dirty: true,
+  const state = { t: 0, whyIndex: -1, view3d: false, playing: true, speed: 1, selected: 0, view: null, yaw: -Math.PI / 2 + 0.6, dirty: true,
                   follow: false, hover: -1 };
 
   // Position of agent a at time t, interpolated between samples.
@@ -235,12 +267,50 @@
              f: D.facing[i0] + w * df, s0, s1, w };
   }
 
+  // A detailed agent's whole displayed pose at time t, world [J*3],
+  // interpolated between its ticks; null for an agent not detailed.
+  function detailPoseAt(a, t) {
+    if (a >= D.detailAgents || D.detailS === 0) return null;
+    const u = Math.min(Math.max(t * D.detailRate, 0), D.detailS - 1), s0 = Math.floor(u);
+    const s1 = Math.min(s0 + 1, D.detailS - 1), w = u - s0, n = D.J * 3, out = new Float32Array(n);
+    const b0 = (a * D.detailS + s0) * n, b1 = (a * D.detailS + s1) * n;
+    for (let c = 0; c < n; c++) out[c] = D.detail[b0 + c] + w * (D.detail[b1 + c] - D.detail[b0 + c]);
+    return out;
+  }
+
+  // Agent a's displayed pose at time t in world space ([J*3]): the whole
+  // pose at the tick rate for a detailed agent, else its played frame with
+  // the legs as displayed (poseAt) at the 10 Hz samples.
+  function worldPoseAt(a, t) {
+    const detail = detailPoseAt(a, t);
+    if (detail) return detail;
+    const now = poseAt(a, t);
+    if (!now) return null;
+    const p = sampleAt(a, t), c = Math.cos(p.f), s = Math.sin(p.f), q = now.pose, out = new Float32Array(D.J * 3);
+    for (let j = 0; j < D.J; j++) {
+      const x = q[3 * j], z = q[3 * j + 2];
+      out[3 * j] = p.x + c * x + s * z; out[3 * j + 1] = q[3 * j + 1]; out[3 * j + 2] = p.z - s * x + c * z;
+    }
+    return out;
+  }
+
   // The pose of agent a at time t in character space ([J*3]), blending the
-  // two neighbouring samples when they play nearby frames of one clip.
+  // two neighbouring samples when they play nearby frames of one clip; a
+  // detailed agent's is its whole displayed pose, brought into the
+  // character space of the interpolated root.
   function poseAt(a, t) {
     const p = sampleAt(a, t);
     const slot0 = D.slot[a * D.S + p.s0], slot1 = D.slot[a * D.S + p.s1];
     if (slot0 < 0) return null;
+    const detail = detailPoseAt(a, t);
+    if (detail) {
+      const c = Math.cos(p.f), sn = Math.sin(p.f), out = new Float32Array(D.J * 3);
+      for (let j = 0; j < D.J; j++) {
+        const dx = detail[3 * j] - p.x, dz = detail[3 * j + 2] - p.z;
+        out[3 * j] = c * dx - sn * dz; out[3 * j + 1] = detail[3 * j + 1]; out[3 * j + 2] = sn * dx + c * dz;
+      }
+      return { pose: out, frame: D.poseFrames[slot0], whole: true };
+    }
     const n = D.J * 3, out = new Float32Array(n);
     const blend = slot1 >= 0 && Math.abs(D.poseFrames[slot1] - D.poseFrames[slot0]) <= 12 ? p.w : 0;
     for (let c = 0; c < n; c++) {
@@ -575,7 +645,8 @@
     polyline(ctx, [project(0, 0, 0), project(0, 0, 0.8)], '#55606f', 2);  // forward
     const now = poseAt(a, state.t), p = sampleAt(a, state.t);
     label.textContent = 'agent ' + a + (now ? ' \u00b7 frame ' + now.frame : '') + ' \u00b7 facing ' +
-      Math.round(p.f * 180 / Math.PI) + '\u00b0 \u00b7 drag to turn';
+      Math.round(p.f * 180 / Math.PI) + '\u00b0 \u00b7 ' + (now && now.whole ? 'whole pose as displayed, ' +
+      Number(D.detailRate.toPrecision(4)) + ' Hz' : 'legs as displayed') + ' \u00b7 drag to turn';
     if (!now) {
       ctx.fillStyle = colors.dim; ctx.fillText('no pose recorded for this frame', 10, 40);
       return;
@@ -773,8 +844,41 @@
   function setTime(t) { state.t = Math.min(Math.max(t, 0), D.duration); state.dirty = true; }
   function setPlaying(on) { state.playing = on; playButton.textContent = on ? 'Pause' : 'Play'; }
 
+  // The 3D view, made on first use (?view=3d or the view selector).
+  let view3d = null;
+  const crowd3dCanvas = document.getElementById('crowd3d');
+  function select(a) { state.selected = a; state.whyIndex = -1; whyPanel.hidden = true; state.dirty = true; }
+  function use3d(on) {
+    state.view3d = on;
+    document.getElementById('view').value = on ? '3d' : 'top';
+    crowdCanvas.hidden = on; crowd3dCanvas.hidden = !on;
+    document.getElementById('crowd-label').textContent = on
+      ? 'crowd in 3D: click a character to select it; drag to orbit, right drag to pan, wheel to zoom; follow: the follow camera'
+      : 'crowd, from above: click a character to select it; drag to pan, wheel to zoom';
+    if (on && !view3d) {
+      if (!window.THREE) throw new Error('three.js is missing from the page');
+      view3d = window.MmvkView3d.create(crowd3dCanvas, { D, state, worldPose: worldPoseAt, sampleAt, feetAt, hue, colors, select });
+    }
+    state.dirty = true;
+  }
+
+  // The "why this frame" panel for the selected character's search i.
+  const whyPanel = document.getElementById('why');
+  function openWhy(i) {
+    const a = state.selected;
+    if (a < 0 || i < 0 || i >= D.searches[a].t.length) { whyPanel.hidden = true; state.whyIndex = -1; return; }
+    state.whyIndex = i;
+    statusEl.dataset.why = window.MmvkWhy.show(whyPanel, D, a, i, () => { whyPanel.hidden = true; state.whyIndex = -1; });
+  }
+
   function render() {
-    drawCrowd(); drawSkeleton(); drawTrajectory(); drawTimeline();
+    if (state.view3d) {
+      const counts = view3d.draw();
+      state.drawn3d = counts;
+    } else {
+      drawCrowd();
+    }
+    drawSkeleton(); drawTrajectory(); drawTimeline();
     slider.value = D.duration > 0 ? state.t / D.duration : 0;
     clock.textContent = state.t.toFixed(2) + ' / ' + D.duration.toFixed(2) + ' s';
     state.dirty = false;
@@ -797,7 +901,11 @@
     playButton.onclick = () => setPlaying(!state.playing);
     document.getElementById('speed').onchange = (e) => { state.speed = parseFloat(e.target.value); };
     const follow = document.getElementById('follow');
-    follow.onchange = () => { state.follow = follow.checked; state.dirty = true; };
+    follow.onchange = () => {
+      state.follow = follow.checked; state.dirty = true;
+      if (!state.follow && view3d) view3d.lookAtSelected();
+    };
+    document.getElementById('view').onchange = (e) => use3d(e.target.value === '3d');
     slider.oninput = () => { setPlaying(false); setTime(parseFloat(slider.value) * D.duration); };
     window.addEventListener('keydown', (e) => {
       if (e.target.tagName === 'SELECT') return;
@@ -812,7 +920,7 @@
     window.addEventListener('mouseup', (e) => {
       if (drag && !drag.moved && e.target === crowdCanvas) {
         const a = pickAgent(e.offsetX, e.offsetY);
-        if (a >= 0) { state.selected = a; state.dirty = true; }
+        if (a >= 0) select(a);
       }
       drag = null;
     });
@@ -844,7 +952,11 @@
     // Timeline: click or drag seeks.
     let seeking = false;
     const seek = (e) => { setPlaying(false); setTime(xToTime(e.offsetX, timelineCanvas.clientWidth)); };
-    timelineCanvas.addEventListener('mousedown', (e) => { seeking = true; seek(e); });
+    // A click on a search opens why it chose its frame.
+    timelineCanvas.addEventListener('mousedown', (e) => {
+      if (state.hover >= 0) { openWhy(state.hover); setPlaying(false); setTime(D.searches[state.selected].t[state.hover]); return; }
+      seeking = true; seek(e);
+    });
     timelineCanvas.addEventListener('mousemove', (e) => {
       if (seeking) { seek(e); return; }
       // Hovering names the search under the pointer.
@@ -864,7 +976,10 @@
   }
 
   // URL options, so a page can be opened (or screenshotted) at a known
-  // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE&follow=1
+  // state: ?t=SECONDS&agent=INDEX&paused=1&zoom=PX_PER_METRE&follow=1, and
+  // view=3d&cam=DIST,YAW,PITCH[,HEIGHT] (metres, radians) for the 3D view
+  // (characters=0: the empty ground), why=I to open the selected
+  // character's search I (0-based).
   function applyQuery() {
     const q = new URLSearchParams(window.location.search);
     if (q.has('zoom')) state.zoom = parseFloat(q.get('zoom')) > 0 ? clampScale(parseFloat(q.get('zoom'))) : 0;
@@ -876,6 +991,16 @@
       state.selected = a >= 0 && a < D.N ? a : -1;
     }
     setPlaying(!(q.get('paused') === '1'));
+    if (q.get('view') === '3d') {
+      use3d(true);
+      // A camera named looks at the selected character; else the whole crowd.
+      if (q.has('cam')) {
+        view3d.setCamera(...q.get('cam').split(',').map(parseFloat));
+        view3d.lookAtSelected();
+      }
+      if (q.get('characters') === '0') view3d.showCharacters(false);
+    }
+    if (q.has('why')) openWhy(parseInt(q.get('why'), 10));
   }
 
   // What the page decoded for the selected character at the current sample,
@@ -916,7 +1041,15 @@
     statusEl.dataset.drawn = String(state.drawn);
     statusEl.dataset.decodeMs = String(ms);
     statusEl.dataset.probe = probe();
-    statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + Number(D.rate.toPrecision(4)) + ' Hz, ' + D.P + ' poses; loaded in ' + ms + ' ms';
+    statusEl.dataset.view = state.view3d ? '3d' : 'top';
+    if (state.view3d && state.selected >= 0) {
+      // The selected character's hips on the page, CSS px, for a test.
+      const [x, y] = view3d.project(state.selected), box = crowd3dCanvas.getBoundingClientRect();
+      statusEl.dataset.projected = Math.round(box.left + x) + ',' + Math.round(box.top + y);
+    }
+    statusEl.dataset.detailAgents = String(D.detailAgents);
+    statusEl.textContent = 'ready: ' + D.N + ' agents, ' + D.S + ' samples at ' + Number(D.rate.toPrecision(4)) + ' Hz, ' + D.P + ' poses' +
+      (D.detailAgents ? ', ' + D.detailAgents + ' whole poses at ' + Number(D.detailRate.toPrecision(4)) + ' Hz' : '') + '; loaded in ' + ms + ' ms';
     document.title = 'mmvk crowd viewer: ' + (meta.title || 'ready');
     requestAnimationFrame(frame);
   }

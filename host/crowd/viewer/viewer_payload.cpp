@@ -24,6 +24,21 @@
 //             z dt_ms, state, and for each locked foot (bits 2, 3 of state):
 //             z dx_mm, z dy_mm, z dz_mm (delta against that foot's previous
 //             anchor, world)
+//   detail    present when meta.detail.agents > 0: for detail agent, for
+//             detail sample, for joint, axis: z, in mm, of joint 0's world
+//             position and of every other joint's position less joint 0's
+//             (the body moves less than the world between ticks), less its
+//             linear prediction from the agent's two previous samples
+//             (2 v[s-1] - v[s-2]; v[s-1] at the second sample, 0 at the
+//             first): smooth motion at the tick rate leaves residuals of a
+//             few mm
+//   why       present when meta.why is not null: for agent: count, then for
+//             explained search: z d_search (against the previous one), for
+//             channel: z weight_milli; z continuing_bias_1e5,
+//             z continuing_multiplier_milli; then the chosen and the
+//             continuing frame: u present, and when present: u frame,
+//             u clip, z clip_time_ms, z multiplier_milli, z bias_1e5,
+//             z cost_1e5, u exclusion, for channel: z weighted_1e5
 #include "viewer/viewer_payload.hpp"
 
 #include <algorithm>
@@ -64,6 +79,8 @@ constexpr double kMm = 1000.0;
 constexpr double kMilli = 1000.0;
 constexpr int64_t kTurn = 4096;
 constexpr int64_t kLegStepMm = 2;
+// Channel costs are often well under a thousandth.
+constexpr double kCost = 1e5;
 
 // Appends one section and records its size in the header.
 template <class Fill>
@@ -204,6 +221,56 @@ void write_feet(VarintWriter& out, const Recording& r) {
   }
 }
 
+void write_detail(VarintWriter& out, const Recording& r) {
+  const std::size_t joints = r.joint_count();
+  std::vector<int64_t> previous(joints * 3), before(joints * 3);
+  for (std::size_t a = 0; a < r.detail_agents; ++a) {
+    for (std::size_t s = 0; s < r.detail_sample_count; ++s) {
+      const float* root = r.detail_positions.data() + r.detail_index(s, a, 0);
+      for (std::size_t j = 0; j < joints; ++j) {
+        const float* p = r.detail_positions.data() + r.detail_index(s, a, j);
+        for (std::size_t k = 0; k < 3; ++k) {
+          const std::size_t c = 3 * j + k;
+          const int64_t mm = j == 0 ? quantize(p[k], kMm) : quantize(p[k], kMm) - quantize(root[k], kMm);
+          const int64_t predicted = s == 0 ? 0 : s == 1 ? previous[c] : 2 * previous[c] - before[c];
+          out.z(mm - predicted);
+          before[c] = previous[c];
+          previous[c] = mm;
+        }
+      }
+    }
+  }
+}
+
+void write_frame_why(VarintWriter& out, const Recording::FrameWhy& f) {
+  out.u(f.frame >= 0 ? 1u : 0u);
+  if (f.frame < 0) return;
+  out.u(std::uint64_t(f.frame));
+  out.u(f.clip);
+  out.z(quantize(f.clip_time_s, kMilli));
+  out.z(quantize(f.multiplier, kMilli));
+  out.z(quantize(f.bias, kCost));
+  out.z(quantize(f.cost, kCost));
+  out.u(f.exclusion);
+  for (float v : f.weighted) out.z(quantize(v, kCost));
+}
+
+void write_why(VarintWriter& out, const Recording& r) {
+  for (const auto& explained : r.why) {
+    out.u(explained.size());
+    int64_t previous = 0;
+    for (const Recording::SearchWhy& why : explained) {
+      out.z(int64_t(why.search) - previous);
+      previous = int64_t(why.search);
+      for (float w : why.weights) out.z(quantize(w, kMilli));
+      out.z(quantize(why.continuing_bias, kCost));
+      out.z(quantize(why.continuing_multiplier, kMilli));
+      write_frame_why(out, why.chosen);
+      write_frame_why(out, why.continuing);
+    }
+  }
+}
+
 nlohmann::json bounds_of(const Recording& r) {
   float min_x = INFINITY, min_z = INFINITY, max_x = -INFINITY, max_z = -INFINITY;
   auto grow = [&](float x, float z) {
@@ -317,6 +384,11 @@ std::string meta_json(const Recording& r, const PoseSlots& slots, const nlohmann
       {"pose_count", slots.poses.size()},
       {"leg_joints", r.leg_joints},
       {"has_feet", !r.foot_events.empty()},
+      {"detail", {{"agents", r.detail_agents}, {"sample_count", r.detail_sample_count}, {"rate_hz", r.detail_rate_hz}}},
+      {"why", r.why.empty() ? nlohmann::json(nullptr)
+                            : nlohmann::json{{"channel_names", r.channel_names},
+                                                              {"clip_names", r.clip_names},
+                                                              {"exclusion_names", r.exclusion_names}}},
       {"bounds", bounds_of(r)},
       {"sections", sections},
       {"raw_bytes", raw_bytes},
@@ -357,6 +429,8 @@ Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
   add_section(sections, raw, "poses", [&](VarintWriter& out) { write_poses(out, r, slots); });
   if (!r.leg_joints.empty()) add_section(sections, raw, "legs", [&](VarintWriter& out) { write_legs(out, r, slots); });
   if (!r.foot_events.empty()) add_section(sections, raw, "feet", [&](VarintWriter& out) { write_feet(out, r); });
+  if (r.detail_agents > 0) add_section(sections, raw, "detail", [&](VarintWriter& out) { write_detail(out, r); });
+  if (!r.why.empty()) add_section(sections, raw, "why", [&](VarintWriter& out) { write_why(out, r); });
 
   MMVK_ASSIGN_OR_RETURN(payload.compressed, deflate_bytes(raw));
   payload.meta_json = meta_json(r, slots, sections, raw.size());

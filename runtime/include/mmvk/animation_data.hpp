@@ -75,9 +75,13 @@ struct AnimationData {
   Status validate(std::uint32_t frames) const;
 };
 
-// The clear error for a database without animation, naming `mmvk build`
-// (without --no-animation) as the fix. `what` names the caller ("crowd controller").
-Error missing_animation_error(std::string_view what);
+// The clear error for a database without animation. `what` names the
+// caller ("crowd controller"); `reason` is the database's own record of why
+// (Database::no_animation_reason). Without one (older files) the error lists
+// the possible causes rather than blame a flag the user never passed.
+Error missing_animation_error(std::string_view what, std::string_view reason);
+// The reason alone, for reports: `reason`, or the possible causes.
+std::string no_animation_explanation(std::string_view reason);
 
 // The pose of one database frame in character space: local rotations [joints]
 // and local translations [joints] (rest offsets, or the frame's translation

@@ -1,41 +1,49 @@
 // CrowdController: motion matching for B characters at once. It owns every
-// character's state in arrays (playback frame, search timer, spring
-// simulation, inertialization offsets, animated root) and runs the standard
-// controller loop once per tick, batched: one search per tick for all the
-// characters that are due. docs/animation.md describes the loop in prose.
+// character's state in arrays, grouped by stage (playback, roots, search
+// schedule, poses, the batch), and runs the standard controller loop once per
+// tick as one pass per stage over all characters: one search per tick for
+// all the characters that are due. docs/animation.md describes the loop in
+// prose, with the same numbers.
 //
 // One tick (dt seconds), synchronous form tick(dt, input, backend, pool):
-//   1. simulate: each simulated root moves toward its desired velocity and
-//      facing (critically damped springs, trajectory.hpp);
-//   2. play: each character's continuous time in its clip advances by
-//      dt * fps frames (playback.hpp: a looping clip wraps to its first
-//      frame; a non-looping clip holds its last frame); its pose is
-//      interpolated between the two neighbouring frames, plus the decaying
-//      inertialization offsets; its animated root moves along the clip's root
-//      path plus the inertialization's root offset, then is corrected toward
-//      the simulated root (step 7); its root path is recorded (RootHistory);
-//   3. decide: a character is due when its search timer runs out (timers
+//   1. simulate and play: each simulated root moves toward its desired
+//      velocity and facing (critically damped springs, trajectory.hpp); each
+//      character's continuous time in its clip advances by dt * fps frames
+//      (playback.hpp: a looping clip wraps to its first frame; a non-looping
+//      clip holds its last frame);
+//   2. blend: its pose is interpolated between the two neighbouring frames,
+//      plus the decaying inertialization offsets (pose_batch.hpp), and its
+//      animated root moves along the clip's root path plus the
+//      inertialization's root offset;
+//   3. correct: the animated root is pulled toward the simulated root with a
+//      bounded correction (ControllerParams); its path is recorded
+//      (RootHistory), and the animated pose is measured: one forward
+//      kinematics in the world per character, from which the queries' joint
+//      positions (character space) and velocities come and which the foot
+//      locker reads;
+//   4. decide: a character is due when its search timer runs out (timers
 //      are staggered over the interval so the load per tick is flat), or a
 //      search is forced: first tick, the end of a non-looping clip, a
 //      do_not_use frame, entering a block_transition range, or a desired
 //      velocity or facing that changed sharply since its last search;
-//   4. assemble: one normalized query per due character into a [due x dims]
-//      batch (query_assembly.hpp): pose channels measured on the pose it
-//      shows (after blending, before foot IK), past trajectory from its
-//      recorded root path, future trajectory from its prediction;
-//   5. search: the batch on the backend, in one call (every backend takes
+//   5. assemble: its trajectory is predicted and one normalized query per
+//      due character goes into a [due x dims] batch (query_assembly.hpp):
+//      pose channels measured on the animated pose (after blending, before
+//      foot IK), past trajectory from its recorded root path, future
+//      trajectory from its prediction;
+//   6. search: the batch on the backend, in one call (every backend takes
 //      any batch up to kMaxBatch);
-//   6. apply: a character jumps only when its match is neither the
+//   7. apply: a character jumps only when its match is neither the
 //      continuing frame (the frame nearest its time) nor within
 //      same_location_window of its time in the same clip; a jump plays on
 //      from the matched frame and starts an inertialization (pose_batch.hpp);
-//   7. correct: the animated root is pulled toward the simulated root with a
-//      bounded correction (ControllerParams); then foot locking holds planted
-//      feet on the ground through two-bone IK (foot_locker.hpp): the
-//      displayed pose.
-// Deferred form tick(dt, input, async, pool): steps 5-6 split: the batch is
-// submitted in step 5 and its results are applied at the start of the next
-// tick (one tick of latency), so a GPU search overlaps the caller's work.
+//   8. display: foot locking holds planted feet on the ground through
+//      two-bone IK (foot_locker.hpp) on the animated pose, jumps of step 7
+//      included: the displayed pose and its world joint positions.
+// Deferred form tick(dt, input, async, pool): step 6 is split: the batch is
+// submitted in step 6 and its results are applied (step 7) at the start of
+// the next tick, before step 1 (one tick of latency), so a GPU search
+// overlaps the caller's work.
 //
 // No global state, no threads of its own (it uses the caller's ThreadPool),
 // no allocation per tick. Not thread-safe. The Database must outlive it.
@@ -115,6 +123,16 @@ struct TickStats {
   std::uint32_t jumps = 0;         // results that were jumped to
   std::uint32_t same_location = 0; // results not jumped to: within same_location_window of the character's time
   std::uint32_t no_candidate = 0;  // results with no frame (kept playing)
+  // Seconds the tick waited on its search: the backend's search(), or the
+  // AsyncSearch's submit() and collect() (wall clock).
+  double search_seconds = 0.0;
+};
+
+// What a character's search was this tick (CrowdController::searched()).
+enum class SearchKind : std::uint8_t {
+  None = 0,     // no search
+  Regular = 1,  // its timer ran out
+  Forced = 2,   // placement, a clip's end, a sharp change of the desired velocity or yaw (force_search_*)
 };
 
 class CrowdController {
@@ -136,9 +154,6 @@ class CrowdController {
   // Deferred tick: apply the previous tick's results, then submit this one's.
   Status tick(float dt, const CrowdInput& input, AsyncSearch& search, ThreadPool& pool);
 
-  // World joint positions of every character into out [B x joints].
-  void world_positions(std::span<glm::vec3> out, ThreadPool& pool) const;
-
   std::uint32_t size() const { return characters_; }
   const Database& database() const { return *database_; }
   const AnimationData& animation() const { return *animation_; }
@@ -149,40 +164,53 @@ class CrowdController {
 
   // Per-character query options (tags, weights); the controller overwrites
   // continuing_frame, continuing_bias, continuing_multiplier and exclusion_window.
-  std::span<QueryParams> query_params() { return query_params_; }
+  std::span<QueryParams> query_params() { return schedule_.query_params; }
+
+  // The results the last tick applied, in the order they were searched:
+  // character applied_characters()[i] got applied_matches()[i] (the same
+  // tick's batch for the synchronous tick, the previous tick's for the
+  // deferred one; empty when none came back).
+  std::span<const std::uint32_t> applied_characters() const {
+    return std::span<const std::uint32_t>(applied_.characters).first(applied_.count);
+  }
+  std::span<const Match> applied_matches() const { return std::span<const Match>(applied_.matches).first(applied_.count); }
+  // The batch the last tick searched (for the deferred tick, the one it
+  // submitted): its characters, ascending, and its queries, row i for
+  // character submitted_characters()[i]; views of the controller's buffers,
+  // valid until its next tick.
+  std::span<const std::uint32_t> submitted_characters() const {
+    return std::span<const std::uint32_t>(batch_.characters).first(batch_.count);
+  }
+  QueryBatch submitted_batch() const { return batch_queries(); }
 
   // Per-character output, [B] unless noted.
-  std::span<const std::uint32_t> frames() const { return frames_; }          // database frame played
-  std::span<const float> frame_fractions() const { return fractions_; }    // of the way to the next frame, [0, 1)
-  std::span<const glm::vec3> root_positions() const { return root_pos_; }   // animated root, world, y = 0
-  std::span<const float> root_yaws() const { return root_yaw_; }
-  std::span<const SimulationState> simulation() const { return sim_; }      // simulated root
-  // This tick's search of each character: 0 none, 1 a regular one (its
-  // timer ran out), 2 a forced one (placement, a clip's end, a sharp change
-  // of the desired velocity or yaw; ControllerParams' force_search_*).
-  std::span<const std::uint8_t> searched() const { return searched_; }
-  std::span<const std::uint8_t> jumped() const { return jumped_; }          // 1: jumped this tick
-  std::span<const float> match_costs() const { return match_cost_; }        // last applied match (inf: none)
-  std::span<const std::uint8_t> contacts() const { return contacts_; }      // FootContact bits of the nearest frame
+  std::span<const std::uint32_t> frames() const { return playback_.frames; }       // database frame played
+  std::span<const float> frame_fractions() const { return playback_.fractions; }  // of the way to the next frame, [0, 1)
+  std::span<const glm::vec3> root_positions() const { return roots_.position; }   // animated root, world, y = 0
+  std::span<const float> root_yaws() const { return roots_.yaw; }
+  std::span<const SimulationState> simulation() const { return roots_.simulated; }  // simulated root
+  std::span<const SearchKind> searched() const { return schedule_.searched; }       // this tick's search of each
+  std::span<const std::uint8_t> jumped() const { return outcome_.jumped; }          // 1: jumped this tick
+  std::span<const float> match_costs() const { return outcome_.match_cost; }        // last applied match (inf: none)
+  std::span<const std::uint8_t> contacts() const { return playback_.contacts; }     // FootContact bits of the nearest frame
   // The trajectory of each character's last search: [B x T] world positions
-  // and yaws, T = trajectory_offsets().size().
+  // and yaws, T = trajectory_offsets().size(), predicted at that search's
+  // tick (searched() != None) for the times trajectory_offsets() after it.
   std::span<const float> trajectory_offsets() const { return assembler_.trajectory_offsets(); }
-  std::span<const glm::vec3> predicted_positions() const { return pred_pos_; }
-  std::span<const float> predicted_yaws() const { return pred_yaw_; }
+  std::span<const glm::vec3> predicted_positions() const { return schedule_.predicted_positions; }
+  std::span<const float> predicted_yaws() const { return schedule_.predicted_yaws; }
   // The output pose, character space: [B x joints] each.
-  std::span<const glm::quat> local_rotations() const { return rotations_; }
-  std::span<const glm::vec3> local_translations() const { return translations_; }
+  std::span<const glm::quat> local_rotations() const { return poses_.rotations; }
+  std::span<const glm::vec3> local_translations() const { return poses_.translations; }
+  // Its world joint positions, [B x joints] metres (step 8 writes them).
+  std::span<const glm::vec3> world_positions() const { return poses_.world; }
   // The animated pose before foot IK (what queries measure), character
-  // space, [B x joints] each, and its world joint positions into out.
-  std::span<const glm::quat> animated_rotations() const { return anim_rotations_; }
-  std::span<const glm::vec3> animated_translations() const { return anim_translations_; }
-  void animated_world_positions(std::span<glm::vec3> out, ThreadPool& pool) const;
-  // The same positions as the last display saw them, [B x joints], kept at no
-  // cost (the foot locker's FK): after a tick that took the previous tick's
-  // matches (the AsyncSearch tick) they equal animated_world_positions() bit
-  // for bit; after the synchronous tick a character that jumped shows here
-  // its pose before the jump.
-  std::span<const glm::vec3> displayed_animated_world() const { return anim_world_; }
+  // space, [B x joints] each, and its world joint positions [B x joints]
+  // (the tick's one forward kinematics; after step 7's jumps, so always the
+  // world positions of animated_rotations() and animated_translations()).
+  std::span<const glm::quat> animated_rotations() const { return poses_.animated_rotations; }
+  std::span<const glm::vec3> animated_translations() const { return poses_.animated_translations; }
+  std::span<const glm::vec3> animated_world_positions() const { return poses_.animated_world; }
   // Foot locking (ControllerParams::foot_ik), per character and foot
   // (left, right), [B x 2]: 1 while the foot is held where it was planted;
   // the world position it is held at (metres); 1 when the leg could not
@@ -195,31 +223,114 @@ class CrowdController {
   const FootLocker* foot_locker() const { return locker_ ? &*locker_ : nullptr; }
 
  private:
+  // Where each character is in its clip, [B].
+  struct Playback {
+    std::vector<std::uint32_t> frames;
+    std::vector<float> fractions;            // of the way from frames to the next frame, [0, 1)
+    std::vector<std::uint8_t> held;          // on a non-looping clip's last frame
+    std::vector<std::uint8_t> contacts;      // FootContact bits of the nearest frame
+    std::vector<glm::vec3> played_velocity;  // root velocity of the played frames, character space, m/s
+    std::vector<float> played_yaw_rate;      // rad/s
+    // This tick's step along the clip's root path (character space, metres;
+    // radians), which step 2 moves the root by.
+    std::vector<glm::vec3> step_translation;
+    std::vector<float> step_yaw;
+  };
+  // The animated root, the simulated root it is corrected toward, [B], and
+  // the animated root's recorded path.
+  struct Roots {
+    std::vector<glm::vec3> position;  // world, y = 0
+    std::vector<float> yaw;
+    std::vector<float> start_yaw;     // the yaw at the tick's start
+    std::vector<float> yaw_rate;      // the animated root's turning rate, rad/s
+    std::vector<SimulationState> simulated;
+    RootHistory history;
+  };
+  // When each character searches and with what, [B] unless noted.
+  struct Schedule {
+    std::vector<float> timer;                // seconds to the next regular search
+    std::vector<std::uint8_t> force;         // forced search pending (placed, first tick)
+    std::vector<std::uint8_t> was_blocked;   // the nearest frame before this tick's play was in a block_transition range
+    std::vector<SearchKind> due, searched;   // this tick's decision; what searched() reports
+    std::vector<glm::vec3> desired_velocity, searched_velocity;
+    std::vector<float> desired_yaw, searched_yaw;
+    std::vector<QueryParams> query_params;
+    std::vector<glm::vec3> predicted_positions;  // [B x T]
+    std::vector<float> predicted_yaws;           // [B x T]
+  };
+  // What the applied results did, [B].
+  struct Outcome {
+    std::vector<std::uint8_t> jumped, suppressed;  // suppressed: within same_location_window
+    std::vector<float> match_cost;
+  };
+  // Poses, [B x joints] unless noted.
+  struct Poses {
+    std::vector<glm::quat> animated_rotations;   // character space, before foot IK
+    std::vector<glm::vec3> animated_translations;
+    std::vector<glm::vec3> animated_world;       // their world joint positions (the one FK)
+    std::vector<glm::quat> rotations;            // displayed
+    std::vector<glm::vec3> translations;
+    std::vector<glm::vec3> world;
+    std::vector<glm::vec3> velocity_world;       // [B x V] last world positions of the assembler's velocity joints
+    std::vector<glm::vec3> joint_velocities;     // [B x V] their velocities, character space
+    std::vector<std::uint8_t> fresh;             // [B] placed since the last tick: no velocities yet
+  };
+  // The queries of one tick's due characters, [B] capacity (x dims, x past offsets).
+  struct Batch {
+    std::vector<std::uint32_t> characters;  // ascending
+    std::vector<std::uint32_t> continuing;  // their continuing frames
+    std::vector<QueryFrame> frames;
+    std::vector<float> queries;
+    std::vector<glm::vec3> past_positions;
+    std::vector<float> past_yaws;
+    std::vector<QueryParams> params;
+    std::uint32_t count = 0;
+  };
+  // A searched batch's characters and the frames they continued, [B]
+  // capacity: the deferred batch in flight.
+  struct InFlight {
+    std::vector<std::uint32_t> characters, continuing;
+    std::uint32_t count = 0;
+  };
+  // The results applied by the last tick, [B] capacity.
+  struct Applied {
+    std::vector<std::uint32_t> characters;
+    std::vector<Match> matches;
+    std::uint32_t count = 0;
+  };
+  // Per pool thread: a destination pose and velocities for jumps, and a
+  // character-space copy of a pose's joint positions for its query.
+  struct ThreadScratch {
+    std::vector<glm::quat> rotations;
+    std::vector<glm::vec3> translations, angular, velocities, source_angular, source_velocities, joint_positions;
+  };
+
   CrowdController() = default;
+  void size_state(std::uint32_t characters);
   Status check_input(float dt, const CrowdInput& input) const;
-  // Steps 1-3 and the blend, for every character; fills due_.
-  void begin(float dt, const CrowdInput& input, ThreadPool& pool);
-  // Step 4 for due_.
+  void start_tick(ThreadPool& pool);
+  void finish_tick();
+  // Steps 1-4 over every character; fills the batch's characters.
+  void advance(float dt, const CrowdInput& input, ThreadPool& pool);
+  // The steps of advance() for characters [begin, end).
+  void simulate_and_play(std::size_t begin, std::size_t end, float dt, const CrowdInput& input);
+  void blend(std::size_t begin, std::size_t end, float dt);
+  void correct(std::size_t begin, std::size_t end, float dt, float fraction);
+  void decide(std::size_t begin, std::size_t end, float dt);
+  // The one forward kinematics of b's animated pose, and the velocities of
+  // the joints queries read; `fresh`: no previous tick.
+  void measure(std::uint32_t b, float dt, bool fresh);
+  // Step 5 for the batch's characters.
   void assemble(ThreadPool& pool);
-  // The assembled queries of due_ as one batch (views into the scratch).
-  QueryBatch due_batch() const;
-  // Step 6: matches [count] for characters[count] whose queries continued
-  // continuing[count]; updates last_.
-  void apply(std::span<const Match> matches, std::span<const std::uint32_t> characters,
-             std::span<const std::uint32_t> continuing, ThreadPool& pool);
-  // Steps 1-3 and the blend for character b.
-  void play(std::uint32_t b, float dt, const CrowdInput& input, float correction);
-  // The measurements of b's animated pose that queries read: its joint
-  // positions, joint velocities and yaw rate; `fresh`: no previous tick.
-  void measure_shown(std::uint32_t b, float dt, bool fresh);
-  // b's displayed pose: the animated one with its feet locked (foot IK),
-  // and its world joint positions.
-  void display(std::uint32_t b, float dt);
-  // Pulls b's animated root toward its simulated root (step 7).
-  void correct_root(std::uint32_t b, float dt, float correction);
-  // b's match `to` is close enough to its time to play on instead.
+  QueryBatch batch_queries() const;
+  // Step 7: applied_'s matches, whose queries continued continuing[count].
+  void apply(std::span<const std::uint32_t> continuing, ThreadPool& pool);
   bool same_location(std::uint32_t b, std::uint32_t to) const;
-  void jump(std::uint32_t b, std::uint32_t to, unsigned thread);
+  void jump(std::uint32_t b, std::uint32_t to, ThreadScratch& scratch);
+  // Step 8 for every character; `after_jumps`: step 7 ran after step 3, so
+  // the characters that jumped are measured again.
+  void display(float dt, bool after_jumps, ThreadPool& pool);
+  void display(std::uint32_t b, float dt);
   void ensure_scratch(unsigned threads);
 
   const Database* database_ = nullptr;
@@ -233,60 +344,18 @@ class CrowdController {
   std::uint64_t ticks_ = 0;
   TickStats last_, totals_;
 
-  // Per character, [B].
-  std::vector<std::uint32_t> frames_;
-  std::vector<float> fractions_;         // of the way from frames_ to the next frame, [0, 1)
-  std::vector<float> search_timer_;      // seconds to the next regular search
-  std::vector<std::uint8_t> force_;      // forced search pending (placed, first tick)
-  std::vector<std::uint8_t> due_flag_;   // 0 no search, 1 regular, 2 forced
-  std::vector<std::uint8_t> searched_, jumped_, suppressed_, contacts_;
-  std::vector<float> match_cost_;
-  std::vector<glm::vec3> root_pos_;
-  std::vector<float> root_yaw_;
-  std::vector<float> yaw_rate_;             // the animated root's turning rate, rad/s
-  RootHistory history_;
-  std::vector<glm::vec3> played_velocity_;  // root velocity of the played frames, character space, m/s
-  std::vector<float> played_yaw_rate_;      // rad/s
-  std::vector<SimulationState> sim_;
-  std::vector<glm::vec3> desired_velocity_, searched_velocity_;
-  std::vector<float> desired_yaw_, searched_yaw_;
-  std::vector<QueryParams> query_params_;
-  std::vector<glm::vec3> pred_pos_;      // [B x T]
-  std::vector<float> pred_yaw_;          // [B x T]
-  std::vector<glm::quat> rotations_;     // [B x joints] displayed
-  std::vector<glm::vec3> translations_;  // [B x joints] displayed
-  std::vector<glm::quat> anim_rotations_;     // [B x joints] animated, before IK
-  std::vector<glm::vec3> anim_translations_;  // [B x joints]
-  std::vector<glm::vec3> joint_positions_;    // [B x joints] character space, of the animated pose
-  std::vector<glm::vec3> velocity_world_;     // [B x V] world positions of the assembler's velocity joints
-  std::vector<glm::vec3> joint_velocities_;   // [B x V] their velocities, character space
-  std::vector<std::uint8_t> fresh_;           // [B] placed since the last tick: no velocities yet
-  std::vector<std::uint8_t> held_;            // [B] on a non-looping clip's last frame
+  Playback playback_;
+  Roots roots_;
+  Schedule schedule_;
+  Outcome outcome_;
+  Poses poses_;
+  Batch batch_;
+  InFlight in_flight_;
+  Applied applied_;
   std::optional<FootLocker> locker_;
-  std::vector<glm::vec3> world_;              // [B x joints] displayed world joint positions
-  std::vector<glm::vec3> anim_world_;         // [B x joints] the same before foot IK
-  std::vector<std::uint8_t> no_feet_flags_;   // [B x 2] zeros, without a locker
-  std::vector<glm::vec3> no_feet_anchors_;    // [B x 2]
-
-  // The batch, [B] capacity.
-  std::vector<std::uint32_t> due_;       // characters in the batch, ascending
-  std::vector<std::uint32_t> continuing_;  // their continuing frames
-  std::vector<QueryFrame> due_refs_;
-  std::vector<float> queries_;           // [B x dims]
-  std::vector<glm::vec3> past_pos_;      // [B x past offsets] of the batch
-  std::vector<float> past_yaw_;
-  std::vector<QueryParams> batch_params_;
-  std::vector<Match> matches_;
-  std::uint32_t due_count_ = 0;
-  // Deferred: the batch in flight (copies of due_ and continuing_).
-  std::vector<std::uint32_t> pending_, pending_continuing_;
-  std::uint32_t pending_count_ = 0;
-  // Per pool thread: a destination pose and velocities for jumps.
-  struct JumpScratch {
-    std::vector<glm::quat> rotations;
-    std::vector<glm::vec3> translations, angular, velocities, source_angular, source_velocities;
-  };
-  std::vector<JumpScratch> scratch_;
+  std::vector<std::uint8_t> no_feet_flags_;  // [B x 2] zeros, without a locker
+  std::vector<glm::vec3> no_feet_anchors_;   // [B x 2]
+  std::vector<ThreadScratch> scratch_;
 };
 
 }  // namespace mmvk

@@ -41,6 +41,11 @@ struct Clip {
   // the manifest or guessed); 0 = not recorded (clips made in code, files
   // before format 4).
   float metres_per_unit = 0.0f;
+  // Where the import took the units and the up axis from ("the manifest's
+  // import.metres_per_unit", "guessed from the skeleton's size", "FBX
+  // UnitScaleFactor 1", ...); empty = not recorded (before format 7).
+  std::string units_from;
+  std::string axes_from;
 };
 
 // Everything a Database is made of; Database::create validates it.
@@ -66,6 +71,10 @@ struct DatabaseParts {
   // The manifest's "crowd" block as JSON text (a crowd host's tuned settings
   // for this data), or empty; not part of content_hash().
   std::string crowd_settings;
+  // Why `animation` is absent, as the build saw it ("built with
+  // --no-animation", or the clips whose skeletons differ); empty when it is
+  // present or the file does not say (before format 7).
+  std::string no_animation_reason;
 };
 
 class Database {
@@ -90,6 +99,8 @@ class Database {
   const AnimationData* animation() const { return parts_.animation ? &*parts_.animation : nullptr; }
   // DatabaseParts::crowd_settings: JSON text of an object, or empty.
   const std::string& crowd_settings() const { return parts_.crowd_settings; }
+  // DatabaseParts::no_animation_reason.
+  const std::string& no_animation_reason() const { return parts_.no_animation_reason; }
 
   // Per-frame metadata, [frame_count] each (the clip's values repeated, or
   // DatabaseParts' per-frame values, so backends index them by frame without

@@ -74,13 +74,15 @@ namespace mmvk {
 // tags and cost modifiers, version 4 the clips' import units, version 5 the
 // contact labels of foot_contacts.hpp (toe and heel bits, hysteresis and
 // minimum durations on horizontal speed), version 6 the manifest's crowd
-// settings. A file gets the oldest version that holds it: 6 with crowd
-// settings, else 5 with animation, else 4 with import units, else 3 with
-// per-frame modifiers, else 2. Versions 1 to 5 still load (version 1:
+// settings, version 7 the record of the import (each clip's units_from and
+// axes_from, the no_animation_reason). A file gets the oldest version that
+// holds it: 7 with an import record, else 6 with crowd settings, else 5 with animation, else 4 with import units, else 3 with
+// per-frame modifiers, else 2. Versions 1 to 6 still load (version 1:
 // features only, Database::animation() null; before 4: Clip::metres_per_unit
 // 0; before 5: the planted bits gain the bit of the point they were detected
-// on, and AnimationData::legacy_contacts is set).
-inline constexpr std::uint32_t kDatabaseFormatVersion = 6;
+// on, and AnimationData::legacy_contacts is set; before 7: the import record
+// empty).
+inline constexpr std::uint32_t kDatabaseFormatVersion = 7;
 inline constexpr std::size_t kDatabaseHeaderBytes = 24;
 
 // The file's bytes.

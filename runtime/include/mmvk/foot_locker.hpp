@@ -62,7 +62,7 @@
 namespace mmvk {
 
 struct FootIkParams {
-  // Off: update() leaves the pose untouched and only writes the world joint
+  // Off: update() leaves the pose untouched and only copies the world joint
   // positions; the lock state is cleared.
   bool enabled = true;
   // Fraction of a leg's length (upper + lower bone) from which its reach is
@@ -134,19 +134,19 @@ class FootLocker {
   //   dt: seconds since its last update (>= 0; 0 moves no spring).
   //   contacts: FootContact bits of the pose shown (AnimationData::contacts).
   //   root_position, root_yaw: the character root, world (metres, radians).
+  //   animated_world [joints]: the world joint positions of the pose as it
+  //     comes in, world = root + R_y(yaw) * fk(pose) (forward_kinematics_batch;
+  //     the controller's one FK per tick, which the locker reads rather than
+  //     runs again).
   //   local_rotations, local_translations [joints]: in, the animated pose in
   //     character space (as sample_pose writes it, after inertialization);
   //     out, the pose with IK applied (upper leg, lower leg and foot
   //     rotations, and the hips' translation when lowered).
   //   world_positions [joints]: out, the world joint positions of the output
-  //     pose, world = root + R_y(yaw) * fk(pose) (as forward_kinematics_batch).
-  //   animated_world [joints] or empty: out, the world joint positions of the
-  //     pose as it came in, before IK (the same bits forward_kinematics_batch
-  //     gives; update computes them anyway, so a caller that wants both need
-  //     not run FK again).
+  //     pose (animated_world where IK changed nothing).
   void update(std::uint32_t b, float dt, std::uint8_t contacts, const glm::vec3& root_position, float root_yaw,
-              std::span<glm::quat> local_rotations, std::span<glm::vec3> local_translations,
-              std::span<glm::vec3> world_positions, std::span<glm::vec3> animated_world = {});
+              std::span<const glm::vec3> animated_world, std::span<glm::quat> local_rotations,
+              std::span<glm::vec3> local_translations, std::span<glm::vec3> world_positions);
 
   // Forgets character b's locks, corrections and hip drop (a teleport: the
   // controller's place()). Its next update locks planted feet afresh.
@@ -221,6 +221,7 @@ class FootLocker {
   std::array<glm::vec3, 2> heading_{};             // per side: the foot's forward direction in its own frame
   std::vector<std::uint8_t> below_hips_;           // [joints] 1: the hips or under them
   std::array<std::vector<int>, 2> leg_joints_;     // per side: the upper leg and its descendants, ascending
+  std::vector<int> rotated_joints_;                // the legs and their ancestors (the hips' too), ascending
   std::vector<glm::quat> wide_scratch_;            // [B x joints], only for skeletons over kStackJoints
 
   // Per foot [B x 2].

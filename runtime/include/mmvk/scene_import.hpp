@@ -64,6 +64,16 @@ struct SceneImportOptions {
   std::string animation;
   // The most samples (frames x joints) of one animation; more is an error.
   std::uint64_t max_samples = kMaxSceneSamples;
+  // import_scene() runs assimp in a child process (fork), so that a damaged
+  // file on which assimp crashes, hangs or allocates without bound ends in
+  // an error naming the file instead of ending the caller; false reads it in
+  // this process (an application that must not fork).
+  bool isolate = true;
+  // With isolate: the child's time limit (seconds), and the address space it
+  // may map beyond what the process maps when it starts (not enforced in an
+  // AddressSanitizer build, whose shadow memory a limit would refuse).
+  double timeout_seconds = 600.0;
+  std::uint64_t memory_budget_bytes = std::uint64_t{8} << 30;
 };
 
 struct SceneAnimation {
@@ -82,7 +92,8 @@ struct SceneImport {
 // one is at fault: not a regular file or over kMaxSceneFileBytes, assimp's
 // own parse error, no animation (or none named options.animation, listing
 // the names), no skeleton, a key or transform that is not finite, too many
-// samples.
+// samples; with options.isolate, assimp crashing, or running past the time
+// or memory limit.
 Result<SceneImport> import_scene(const std::filesystem::path& path, const SceneImportOptions& options);
 
 // A scene the caller has read with assimp itself (an application that

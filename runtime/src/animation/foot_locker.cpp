@@ -14,6 +14,7 @@
 #include "mmvk/character.hpp"
 #include "mmvk/foot_ik.hpp"
 #include "mmvk/spring.hpp"
+#include "yaw.hpp"
 
 namespace mmvk {
 
@@ -54,7 +55,7 @@ constexpr float kBentFrom = 0.02f;
 constexpr float kBentAt = 0.1f;
 constexpr float kKneeFollowTime = 1.0f / 30.0f;
 
-glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
+using detail::yaw_rotation;
 
 glm::vec3 horizontal(const glm::vec3& v) { return {v.x, 0.0f, v.z}; }
 
@@ -207,10 +208,14 @@ Result<FootLocker> FootLocker::create(const AnimationData& animation, std::uint3
   for (std::size_t j = 0; j < joints; ++j) {
     const int joint = static_cast<int>(j);
     locker.below_hips_[j] = joint == locker.hips_ || descends(skeleton.parents, locker.hips_, joint);
+    bool rotated = joint == locker.hips_ || descends(skeleton.parents, joint, locker.hips_);
     for (std::size_t side = 0; side < 2; ++side) {
       const int upper = locker.legs_[side].upper;
       if (joint == upper || descends(skeleton.parents, upper, joint)) locker.leg_joints_[side].push_back(joint);
+      rotated = rotated || joint == upper || descends(skeleton.parents, joint, upper) ||
+                descends(skeleton.parents, upper, joint);
     }
+    if (rotated) locker.rotated_joints_.push_back(joint);
   }
   if (joints > kStackJoints) locker.wide_scratch_.resize(std::size_t{characters} * joints);
   const std::size_t feet = std::size_t{characters} * 2;
@@ -253,34 +258,27 @@ void FootLocker::reset(std::uint32_t b) {
 }
 
 void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const glm::vec3& root_position,
-                        float root_yaw, std::span<glm::quat> local_rotations,
-                        std::span<glm::vec3> local_translations, std::span<glm::vec3> world_positions,
-                        std::span<glm::vec3> animated_world) {
+                        float root_yaw, std::span<const glm::vec3> animated_world,
+                        std::span<glm::quat> local_rotations, std::span<glm::vec3> local_translations,
+                        std::span<glm::vec3> world_positions) {
   const std::size_t joints = parents_.size();
   assert(b < characters_ && local_rotations.size() >= joints && local_translations.size() >= joints &&
-         world_positions.size() >= joints && (animated_world.empty() || animated_world.size() >= joints) &&
-         dt >= 0.0f);
+         world_positions.size() >= joints && animated_world.size() >= joints && dt >= 0.0f);
   glm::quat stack[kStackJoints];
   glm::quat* global = joints <= kStackJoints ? stack : wide_scratch_.data() + std::size_t{b} * joints;
   glm::quat* rotations = local_rotations.data();
   glm::vec3* translations = local_translations.data();
   glm::vec3* world = world_positions.data();
 
-  // The animated pose in the world (world = root + R_y(yaw) * fk(pose)),
-  // with global rotations kept for the legs.
+  // The animated pose's world positions come in (the caller's forward
+  // kinematics); the legs need the global rotations of their chains only.
+  std::copy(animated_world.begin(), animated_world.begin() + std::ptrdiff_t(joints), world);
   const glm::quat root = yaw_rotation(root_yaw);
-  for (std::size_t j = 0; j < joints; ++j) {
+  for (const int joint : rotated_joints_) {
+    const std::size_t j = static_cast<std::size_t>(joint);
     const int parent = parents_[j];
-    if (parent < 0) {
-      global[j] = root * rotations[j];
-      world[j] = root_position + root * translations[j];
-    } else {
-      const std::size_t p = static_cast<std::size_t>(parent);
-      world[j] = world[p] + global[p] * translations[j];
-      global[j] = global[p] * rotations[j];
-    }
+    global[j] = (parent < 0 ? root : global[static_cast<std::size_t>(parent)]) * rotations[j];
   }
-  if (!animated_world.empty()) std::copy(world, world + joints, animated_world.begin());
   if (!params_.enabled) {
     clear(b);
     return;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "mmvk/spring.hpp"
+#include "yaw.hpp"
 
 namespace mmvk {
 
@@ -16,12 +17,7 @@ const Clip& clip_of(const Database& database, std::uint32_t frame) {
 
 std::uint32_t last_frame(const Clip& clip) { return clip.first_frame + clip.frame_count - 1; }
 
-// Rotates a character-space vector by yaw (R_y(yaw) * v).
-glm::vec3 yaw_rotate(const glm::vec3& v, float yaw) {
-  const float c = std::cos(yaw);
-  const float s = std::sin(yaw);
-  return {v.x * c + v.z * s, v.y, -v.x * s + v.z * c};
-}
+using detail::yaw_rotate;
 
 // The largest float below 1: a fraction that rounding pushed to 1 stays in [0, 1).
 constexpr float kBelowOne = 0.99999994f;

@@ -6,14 +6,13 @@
 #include "mmvk/animation_data.hpp"
 #include "mmvk/pose_batch.hpp"
 #include "mmvk/spring.hpp"
+#include "yaw.hpp"
 
 namespace mmvk {
 
 namespace {
 
-const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
-
-glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
+using detail::yaw_rotation;
 
 }  // namespace
 
@@ -34,11 +33,9 @@ void sample_pose(const AnimationData& animation, std::uint32_t frame, std::span<
 RootDelta root_delta(const AnimationData& animation, std::uint32_t from, std::uint32_t to) {
   const float yaw = animation.root_yaws[from];
   const glm::vec3 world = animation.root_positions[to] - animation.root_positions[from];
-  const float c = std::cos(yaw);
-  const float s = std::sin(yaw);
   // The inverse yaw rotation of the world displacement: character space of `from`.
   RootDelta delta;
-  delta.translation = glm::vec3(world.x * c - world.z * s, 0.0f, world.x * s + world.z * c);
+  delta.translation = detail::YawTurn(yaw).undo(glm::vec3(world.x, 0.0f, world.z));
   delta.yaw = wrap_angle(animation.root_yaws[to] - yaw);
   return delta;
 }

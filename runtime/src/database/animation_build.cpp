@@ -165,7 +165,7 @@ Status check_one_skeleton(std::span<const ClipAnimation> clips) {
   }
   if (differing == 0) return {};
   if (differing > kNamed) named += "; and " + std::to_string(differing - kNamed) + " more";
-  return make_error("no animation section: the section holds one skeleton, and " + std::to_string(differing) +
+  return make_error("the animation section holds one skeleton, and " + std::to_string(differing) +
                     " clip" + (differing == 1 ? "'s hierarchy differs" : "s' hierarchies differ") + " from " +
                     first.source + "'s (" + std::to_string(first.skeleton.size()) + " joints): " + named +
                     ". Build each skeleton's clips into a database of its own (or retarget them to one "

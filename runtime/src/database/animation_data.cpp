@@ -95,11 +95,15 @@ Status AnimationData::validate(std::uint32_t frames) const {
   return {};
 }
 
-Error missing_animation_error(std::string_view what) {
-  return make_error(std::string(what) +
-                    ": the database has no animation section: its clips' skeletons differ (the build warned, "
-                    "naming them: build one skeleton per database), it was built with --no-animation, or it is "
-                    "a format 1 file; rebuild it with `mmvk build` from clips of one skeleton");
+std::string no_animation_explanation(std::string_view reason) {
+  if (!reason.empty()) return std::string(reason);
+  return "the file does not record why (it predates format 7): its clips' skeletons differ (the build warned, "
+         "naming them: build one skeleton per database), it was built with --no-animation, or it is a format 1 file";
+}
+
+Error missing_animation_error(std::string_view what, std::string_view reason) {
+  return make_error(std::string(what) + ": the database has no animation section: " +
+                    no_animation_explanation(reason) + "; rebuild it with `mmvk build` from clips of one skeleton");
 }
 
 }  // namespace mmvk

@@ -205,16 +205,20 @@ void keep_frames(Motion& motion, std::vector<std::vector<float>>& custom, std::u
 void add_animation(std::vector<ProcessedClip>& clips, const FootContactParams& contacts,
                    const AnimationBuildOptions& animation, std::span<const BonePair> mirror_bones,
                    const std::string& source, DatabaseParts& parts) {
-  if (!animation.enabled) return;
+  if (!animation.enabled) {
+    parts.no_animation_reason = "built with --no-animation";
+    return;
+  }
   std::vector<detail::ClipAnimation> animations;
   animations.reserve(clips.size());
   for (ProcessedClip& clip : clips) animations.push_back(std::move(clip.animation));
   Result<AnimationData> data = detail::assemble_animation(animations, contacts, animation.encoding, mirror_bones);
   if (data.ok()) {
     parts.animation = std::move(*data);
-  } else if (animation.warning) {
-    animation.warning(source + ": " + data.message());
+    return;
   }
+  parts.no_animation_reason = data.message();
+  if (animation.warning) animation.warning(source + ": no animation section: " + data.message());
 }
 
 // A clip's per-frame tags and costs. They are stored only when some clip has
@@ -341,6 +345,7 @@ struct SourceMotion {
   std::string animation;  // the scene animation's name; empty for BVH
   Motion motion;
   float metres_per_unit = 0.0f;
+  std::string units_from, axes_from;  // ImportContext's, kept on the clip for `mmvk inspect`
 };
 
 // The motions of a manifest clip's file: one for a BVH; one per animation
@@ -358,7 +363,8 @@ Result<std::vector<SourceMotion>> import_clip_file(const Manifest& manifest, con
       const ImportContext context{meta.file.string() + " (animation '" + animation.name + "')", scene.metres_per_unit,
                                   scene.units_from, manifest.import.up_axis, scene.axes_from, tagged_walk(meta)};
       MMVK_TRY(check_plausible_import(manifest, animation.motion, context));
-      motions.push_back({std::move(animation.name), std::move(animation.motion), scene.metres_per_unit});
+      motions.push_back({std::move(animation.name), std::move(animation.motion), scene.metres_per_unit,
+                         scene.units_from, scene.axes_from});
     }
     return motions;
   }
@@ -381,8 +387,15 @@ Result<std::vector<SourceMotion>> import_clip_file(const Manifest& manifest, con
       given_axis ? std::string("the manifest's import.up_axis") : std::string("BVH files are read Y-up unless told"),
       tagged_walk(meta)};
   MMVK_TRY(check_plausible_import(manifest, *motion, context));
-  motions.push_back({"", std::move(*motion), units});
+  motions.push_back({"", std::move(*motion), units, context.units_from, context.axes_from});
   return motions;
+}
+
+// What the import of `source` used, recorded on its clip.
+void record_import(const SourceMotion& source, Clip& clip) {
+  clip.metres_per_unit = source.metres_per_unit;
+  clip.units_from = source.units_from;
+  clip.axes_from = source.axes_from;
 }
 
 // The clip of one motion of the file (and its mirror) appended to `out`.
@@ -427,7 +440,7 @@ Status load_motion(const Manifest& manifest, const ManifestClip& meta, SourceMot
   const MotionBuildSettings settings{manifest.schema, manifest.character_root, manifest.edge_rule, animation,
                                      manifest.contacts};
   MMVK_ASSIGN_OR_RETURN(ProcessedClip processed, process_motion(meta, *motion, custom, false, settings));
-  processed.clip.metres_per_unit = source.metres_per_unit;
+  record_import(source, processed.clip);
   out.clips.push_back(std::move(processed));
   if (!meta.mirror) return {};
   Result<Motion> mirrored = mirror(*motion, manifest.mirror_bones);
@@ -437,7 +450,7 @@ Status load_motion(const Manifest& manifest, const ManifestClip& meta, SourceMot
   }
   mirror_sidecars(manifest, custom);
   MMVK_ASSIGN_OR_RETURN(ProcessedClip processed_mirror, process_motion(meta, *mirrored, custom, true, settings));
-  processed_mirror.clip.metres_per_unit = source.metres_per_unit;
+  record_import(source, processed_mirror.clip);
   out.clips.push_back(std::move(processed_mirror));
   return {};
 }

@@ -13,101 +13,16 @@
 #include "mmvk/character.hpp"
 #include "mmvk/file_io.hpp"
 #include "mmvk/hash.hpp"
+#include "common/byte_codec.hpp"
 
 namespace mmvk {
 
 namespace {
 
+using detail::Reader;
+using detail::Writer;
+
 constexpr char kMagic[8] = {'M', 'M', 'V', 'K', 'D', 'B', '\n', '\0'};
-
-// Little-endian encoding independent of the host's byte order.
-class Writer {
- public:
-  void u8(std::uint8_t v) { bytes_.push_back(static_cast<char>(v)); }
-  void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
-  }
-  void u64(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
-  }
-  void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
-  void i16(std::int16_t v) {
-    const auto bits = static_cast<std::uint16_t>(v);
-    bytes_.push_back(static_cast<char>(bits & 0xFF));
-    bytes_.push_back(static_cast<char>(bits >> 8));
-  }
-  void str(std::string_view s) {
-    u32(static_cast<std::uint32_t>(s.size()));
-    bytes_.append(s);
-  }
-  void raw(std::string_view s) { bytes_.append(s); }
-  // Bulk form of f32 for the feature matrix (the bulk of the file).
-  void f32_array(std::span<const float> values) { append_f32_le(bytes_, values); }
-  std::string& bytes() { return bytes_; }
-
- private:
-  std::string bytes_;
-};
-
-// Bounds-checked reads: every size read from the file is compared with what
-// is left before it is used.
-class Reader {
- public:
-  Reader(std::string_view bytes, std::size_t start, std::size_t end) : bytes_(bytes), pos_(start), end_(end) {}
-
-  std::size_t left() const { return end_ - pos_; }
-  std::size_t position() const { return pos_; }
-
-  bool u8(std::uint8_t& v) {
-    if (left() < 1) return false;
-    v = static_cast<std::uint8_t>(bytes_[pos_++]);
-    return true;
-  }
-  bool u32(std::uint32_t& v) { return little_endian(v); }
-  bool u64(std::uint64_t& v) { return little_endian(v); }
-  bool f32(float& v) {
-    std::uint32_t bits = 0;
-    if (!u32(bits)) return false;
-    v = std::bit_cast<float>(bits);
-    return true;
-  }
-  bool i16(std::int16_t& v) {
-    if (left() < 2) return false;
-    const auto lo = static_cast<std::uint8_t>(bytes_[pos_]);
-    const auto hi = static_cast<std::uint8_t>(bytes_[pos_ + 1]);
-    v = static_cast<std::int16_t>(static_cast<std::uint16_t>(lo | (hi << 8)));
-    pos_ += 2;
-    return true;
-  }
-  // Precondition: 4 * values.size() <= left().
-  void f32_array(std::span<float> values) {
-    decode_f32_le(bytes_.substr(pos_), values);
-    pos_ += values.size_bytes();
-  }
-  bool str(std::string& s) {
-    std::uint32_t size = 0;
-    if (!u32(size) || size > left()) return false;
-    s.assign(bytes_.data() + pos_, size);
-    pos_ += size;
-    return true;
-  }
-
- private:
-  template <class Unsigned>
-  bool little_endian(Unsigned& v) {
-    if (left() < sizeof(Unsigned)) return false;
-    v = 0;
-    for (std::size_t i = 0; i < sizeof(Unsigned); ++i) {
-      v |= Unsigned{static_cast<std::uint8_t>(bytes_[pos_ + i])} << (8 * i);
-    }
-    pos_ += sizeof(Unsigned);
-    return true;
-  }
-
-  std::string_view bytes_;
-  std::size_t pos_;
-  std::size_t end_;
-};
 
 std::uint64_t read_u64_at(std::string_view bytes, std::size_t at) {
   std::uint64_t v = 0;
@@ -306,6 +221,22 @@ std::string read_animation(Reader& in, std::uint32_t version, AnimationData& a) 
   return {};
 }
 
+// Format 7's record of the import: where each clip's units and up axis
+// came from, and why the animation section is absent.
+bool has_import_record(const DatabaseParts& parts) {
+  return !parts.no_animation_reason.empty() ||
+         std::any_of(parts.clips.begin(), parts.clips.end(),
+                     [](const Clip& clip) { return !clip.units_from.empty() || !clip.axes_from.empty(); });
+}
+
+void write_import_record(Writer& file, const DatabaseParts& parts) {
+  for (const Clip& clip : parts.clips) {
+    file.str(clip.units_from);
+    file.str(clip.axes_from);
+  }
+  file.str(parts.no_animation_reason);
+}
+
 }  // namespace
 
 std::string serialize_database(const Database& database) {
@@ -315,13 +246,13 @@ std::string serialize_database(const Database& database) {
   file.bytes().reserve(kDatabaseHeaderBytes + 4096 + parts.features.size() * 4 + parts.frame_flags.size() * 4);
   file.raw(std::string_view(kMagic, sizeof(kMagic)));
   // The oldest version that holds the database, so that older builds read
-  // what they can: 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
+  // what they can: 7 with a record of the import, 6 with crowd settings, else 5 with an animation section (its contact layout), else 4
   // with import units, else 3 with per-frame modifiers, else 2.
   const bool per_frame = !parts.frame_tags.empty() || !parts.frame_multiplier.empty() || !parts.frame_bias.empty();
   const bool units = std::any_of(parts.clips.begin(), parts.clips.end(),
                                  [](const Clip& clip) { return clip.metres_per_unit > 0.0f; });
   const std::uint32_t version =
-      !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
+      has_import_record(parts) ? 7u : !parts.crowd_settings.empty() ? 6u : parts.animation ? 5u : units ? 4u : per_frame ? 3u : 2u;
   file.u32(version);
   file.u32(0);
   file.u64(0);
@@ -362,6 +293,7 @@ std::string serialize_database(const Database& database) {
     for (const Clip& clip : parts.clips) file.f32(clip.metres_per_unit);
   }
   if (version >= 6) file.str(parts.crowd_settings);
+  if (version >= 7) write_import_record(file, parts);
   file.u8(parts.animation ? 1 : 0);
   if (parts.animation) write_animation(file, *parts.animation);
 
@@ -524,6 +456,12 @@ class PayloadReader {
       }
     }
     if (version_ >= 6 && !in_.str(parts.crowd_settings)) return corrupt("crowd settings");
+    if (version_ >= 7) {
+      for (Clip& clip : parts.clips) {
+        if (!in_.str(clip.units_from) || !in_.str(clip.axes_from)) return corrupt("import record of clip '" + clip.name + "'");
+      }
+      if (!in_.str(parts.no_animation_reason)) return corrupt("import record's animation note");
+    }
     if (version_ >= 2) {
       std::uint8_t has_animation = 0;
       if (!in_.u8(has_animation) || has_animation > 1) return corrupt("animation presence byte");

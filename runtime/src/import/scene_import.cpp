@@ -16,6 +16,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat3x3.hpp>
 
+#include "import/scene_import_child.hpp"
 #include "import/scene_nodes.hpp"
 
 namespace mmvk {
@@ -214,6 +215,15 @@ void configure(Assimp::Importer& importer) {
 
 constexpr unsigned kPostProcess = aiProcess_ValidateDataStructure;
 
+// assimp's read of a checked file, in this process.
+Result<SceneImport> read_scene_here(const std::filesystem::path& path, const SceneImportOptions& options) {
+  const std::string source = path.string();
+  Assimp::Importer importer;
+  configure(importer);
+  const aiScene* scene = importer.ReadFile(source, kPostProcess);
+  return import_loaded(scene, lower_extension(path), source, options, importer.GetErrorString());
+}
+
 }  // namespace
 
 bool is_scene_path(const std::filesystem::path& path) {
@@ -234,10 +244,7 @@ Result<SceneImport> import_scene(const std::filesystem::path& path, const SceneI
   if (error || size > kMaxSceneFileBytes) {
     return make_error(source + ": larger than the limit of " + std::to_string(kMaxSceneFileBytes) + " bytes");
   }
-  Assimp::Importer importer;
-  configure(importer);
-  const aiScene* scene = importer.ReadFile(source, kPostProcess);
-  return import_loaded(scene, lower_extension(path), source, options, importer.GetErrorString());
+  return options.isolate ? detail::read_scene_in_child(path, options, read_scene_here) : read_scene_here(path, options);
 }
 
 Result<SceneImport> import_assimp_scene(const aiScene& scene, std::string_view format, std::string_view source,

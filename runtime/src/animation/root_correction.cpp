@@ -1,0 +1,36 @@
+// Root correction (root_correction.hpp).
+#include "root_correction.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "mmvk/spring.hpp"
+
+namespace mmvk::detail {
+
+void correct_root(const ControllerParams& params, float dt, float fraction, const SimulationState& simulated,
+                  glm::vec3& position, float& yaw) {
+  glm::vec3 gap = simulated.position - position;
+  gap.y = 0.0f;
+  glm::vec3 step = gap * fraction;
+  const float step_length = glm::length(step);
+  const float max_step = params.max_correction_speed * dt;
+  if (step_length > max_step) step *= max_step / step_length;
+  position += step;
+  gap = simulated.position - position;
+  gap.y = 0.0f;
+  const float distance = glm::length(gap);
+  if (distance > params.max_correction_distance) position += gap * (1.0f - params.max_correction_distance / distance);
+  float yaw_gap = wrap_angle(simulated.yaw - yaw);
+  const float yaw_step =
+      std::clamp(yaw_gap * fraction, -params.max_correction_yaw_rate * dt, params.max_correction_yaw_rate * dt);
+  yaw = wrap_angle(yaw + yaw_step);
+  yaw_gap = wrap_angle(simulated.yaw - yaw);
+  if (std::abs(yaw_gap) > params.max_correction_yaw) {
+    yaw = wrap_angle(simulated.yaw - std::copysign(params.max_correction_yaw, yaw_gap));
+  }
+}
+
+}  // namespace mmvk::detail

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -57,14 +58,14 @@ mmvk::Status walk(mmvk::SearchBackend& backend, const mmvk::Database& db, mmvk::
     const float heading = 0.5f * float(b);  // radians from +z
     velocity[b] = 0.6f * glm::vec3(std::sin(heading), 0.0f, std::cos(heading));
   }
+  // The world joint positions, [characters x joints], are those of the last
+  // tick's displayed poses: the start is taken after a first tick.
   const std::size_t joints = crowd.animation().joint_count();
-  std::vector<glm::vec3> start(kCharacters * joints);
-  std::vector<glm::vec3> now(kCharacters * joints);
-  crowd.world_positions(start, pool);
-  for (int tick = 0; tick < kTicks; ++tick) {
-    MMVK_TRY(crowd.tick(1.0f / kRateHz, mmvk::CrowdInput{velocity, {}}, backend, pool));
-  }
-  crowd.world_positions(now, pool);
+  const float dt = 1.0f / kRateHz;
+  MMVK_TRY(crowd.tick(dt, mmvk::CrowdInput{velocity, {}}, backend, pool));
+  const std::vector<glm::vec3> start(crowd.world_positions().begin(), crowd.world_positions().end());
+  for (int tick = 0; tick < kTicks; ++tick) MMVK_TRY(crowd.tick(dt, mmvk::CrowdInput{velocity, {}}, backend, pool));
+  const std::span<const glm::vec3> now = crowd.world_positions();
   // The root joint's (the hips') way over the ground, against the velocity asked for.
   for (std::uint32_t b = 0; b < kCharacters; ++b) {
     glm::vec3 moved = now[b * joints] - start[b * joints];

@@ -25,6 +25,7 @@ class StubSearch final : public SearchBackend {
  public:
   explicit StubSearch(const Database& database) : database_(database) {}
   std::string_view name() const override { return "stub"; }
+  std::string device() const override { return cpu_device_text(1); }
   const Database& database() const override { return database_; }
   Status search(const QueryBatch& batch, std::uint32_t, std::span<Match> out) override {
     for (std::size_t i = 0; i < batch.size; ++i) {

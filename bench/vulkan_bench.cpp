@@ -24,12 +24,12 @@
 #include <vector>
 
 #include "bench_data.hpp"
+#include "host_backends.hpp"
 #include "mmvk/backends.hpp"
 #include "mmvk/database.hpp"
 #include "mmvk/thread_pool.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #endif
 
@@ -148,41 +148,23 @@ void BM_FastBrute(benchmark::State& state) {
 }
 
 #if defined(MMVK_HAS_VULKAN)
-struct VulkanState {
-  std::unique_ptr<vulkan::Context> context;
-  std::string error;
-};
-
-VulkanState& vulkan_state() {
-  static VulkanState state = [] {
-    VulkanState s;
-    Result<std::unique_ptr<vulkan::Context>> context = vulkan::Context::create();
-    if (context) {
-      s.context = std::move(context).value();
-    } else {
-      s.error = context.message();
-    }
-    return s;
-  }();
-  return state;
+// The benchmark's backends, made where the hosts make theirs, on one
+// Vulkan context for every row (a process-wide object is fine in a
+// benchmark's main program, never in the library).
+crowd::HostBackends& host_backends() {
+  static crowd::HostBackends backends;
+  return backends;
 }
 
 // kernel_time: report the timestamp-query kernel time as the iteration time
 // (UseManualTime); else wall time from submit to results in host memory.
 void run_vulkan(benchmark::State& state, const Database& db, std::size_t batch, std::uint32_t max_tile,
                 bool kernel_time) {
-  VulkanState& vk = vulkan_state();
-  if (!vk.context) {
-    state.SkipWithError(("no Vulkan device: " + vk.error).c_str());
-    return;
-  }
-  BackendRegistry registry;
-  if (Status added = vulkan::add_backends(registry, *vk.context); !added) {
-    state.SkipWithError(added.message().c_str());
-    return;
-  }
-  const BackendSpec spec{.name = "vulkan-brute", .max_batch = std::uint32_t(batch), .max_k = 1, .max_tile = max_tile};
-  Result<std::unique_ptr<SearchBackend>> made = registry.make(spec, db);
+  crowd::DeviceSearchLimits limits;
+  limits.max_batch = std::uint32_t(batch);
+  limits.max_k = 1;
+  limits.max_tile = max_tile;
+  Result<std::unique_ptr<SearchBackend>> made = host_backends().make(BackendSpec{.name = "vulkan-brute"}, db, limits);
   if (!made) {
     state.SkipWithError(made.message().c_str());
     return;

@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "bench_data.hpp"
+#include "host_backends.hpp"
 #include "mmvk/backends.hpp"
 #include "mmvk/thread_pool.hpp"
-#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "query_streams.hpp"
 
@@ -56,19 +56,12 @@ constexpr Variant kVariants[] = {{"fast-brute", "fast-brute"},
                                  {"vulkan-clusters", "vulkan-clusters"},
                                  {"vulkan-nprobe4", "vulkan-nprobe", 4}, {"vulkan-nprobe16", "vulkan-nprobe", 16}};
 
-vulkan::Context* shared_context() {
-  static std::unique_ptr<vulkan::Context> context;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    Result<std::unique_ptr<vulkan::Context>> created = vulkan::Context::create();
-    if (created.ok()) {
-      context = std::move(created).value();
-    } else {
-      std::fprintf(stderr, "vulkan_cluster_bench: %s\n", created.message().c_str());
-    }
-  }
-  return context.get();
+// The benchmark's backends, made where the hosts make theirs, on one
+// Vulkan context for every row (a process-wide object is fine in a
+// benchmark's main program, never in the library).
+crowd::HostBackends& host_backends() {
+  static crowd::HostBackends backends;
+  return backends;
 }
 
 // One database's table, backends, query streams and exact answers; the
@@ -84,9 +77,9 @@ struct Setup {
 
 Setup* setup_for(DataSet set) {
   // Statics are destroyed in reverse order of construction: creating the
-  // context first makes it outlive the Vulkan backends in the cache (the
-  // other order aborted at exit).
-  (void)shared_context();
+  // backends' owner first makes its context outlive the Vulkan backends in
+  // the cache (the other order aborted at exit).
+  (void)host_backends();
   static std::map<DataSet, std::unique_ptr<Setup>> cache;
   std::unique_ptr<Setup>& slot = cache[set];
   if (slot) return slot->db ? slot.get() : nullptr;
@@ -113,16 +106,14 @@ Setup* setup_for(DataSet set) {
 }
 
 Result<std::unique_ptr<SearchBackend>> make_variant(Setup& s, const Variant& variant) {
-  BackendRegistry registry = cpu_backends();
-  vulkan::Context* context = shared_context();
-  if (context != nullptr) MMVK_TRY(vulkan::add_backends(registry, *context));
   BackendSpec spec{.name = variant.backend, .pool = &s.pool, .clusters = &s.table};
   spec.nprobe = variant.nprobe;
   spec.fast.kernels = variant.kernels;
-  spec.max_batch = kQueries;
-  spec.max_k = 1;
-  spec.max_tile = variant.max_tile;
-  return registry.make(spec, *s.db);
+  crowd::DeviceSearchLimits limits;
+  limits.max_batch = kQueries;
+  limits.max_k = 1;
+  limits.max_tile = variant.max_tile;
+  return host_backends().make(spec, *s.db, limits);
 }
 
 void run(benchmark::State& state, DataSet set, QueryStream stream, const Variant& variant, std::uint32_t batch) {

@@ -39,6 +39,8 @@ HEADER_LAYERS = {
     "async_search": "search",
     "pose_batch": "animation",
     "spring": "animation",
+    # The start-here header includes the whole public API, up to the top layer.
+    "mmvk": "animation",
 }
 
 # Tests that read a target's private headers on purpose, through an include

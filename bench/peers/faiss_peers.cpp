@@ -153,6 +153,7 @@ class FaissFlat final : public PeerBackend {
   std::size_t index_bytes() const override { return index_.codes.size(); }
   bool exact() const override { return false; }
   std::string settings() const override { return record_; }
+  std::string device() const override { return cpu_device_text(unsigned(settings_.threads)); }
 
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override {
     MMVK_TRY(check_plain_batch(database_, batch, k, out, name()));
@@ -205,6 +206,7 @@ class FaissIvf final : public PeerBackend {
 
   bool exact() const override { return false; }
   std::string settings() const override { return record_; }
+  std::string device() const override { return cpu_device_text(unsigned(settings_.threads)); }
   std::size_t index_bytes() const override {
     const faiss::IndexIVFFlat& ivf = *index_->ivf;
     // The stored rows and their ids, plus the centroids.

@@ -27,6 +27,8 @@ namespace mmvk::peers {
 class PeerBackend : public SearchBackend {
  public:
   std::string_view name() const override { return name_; }
+  // One thread; the FAISS peers say how many OpenMP threads they chose.
+  std::string device() const override { return cpu_device_text(1); }
   const Database& database() const override { return database_; }
   SearchStats stats() const override { return stats_; }
   void reset_stats() override { stats_ = {}; }

@@ -18,7 +18,6 @@
 #include "pca_kdtree.hpp"
 #endif
 #if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #endif
 #include "suite_vulkan.hpp"
@@ -104,7 +103,6 @@ struct SuiteMethodFactory::Shared {
   const Database& db;
   ThreadPool& pool;
   std::string stem;
-  BackendRegistry registry = cpu_backends();
   std::optional<ClusterTable> table;
   double table_s = 0.0;
 #if defined(MMVK_HAS_FAISS)
@@ -138,11 +136,12 @@ struct SuiteMethodFactory::Shared {
   }
 
   Result<SuiteMethod> make_registered(const std::string& backend, std::uint32_t nprobe) {
-    const BackendEntry* entry = registry.find(backend);
+    const BackendEntry* entry = suite_backends().registry().find(backend);
     if (entry == nullptr) return make_error(backend + ": not in this build's registry");
     BackendSpec spec{.name = backend, .pool = &pool};
     spec.nprobe = nprobe;
-    spec.max_batch = 8192;
+    crowd::DeviceSearchLimits limits;
+    limits.max_batch = 8192;
     SuiteMethod method;
     method.exact = !entry->uses_nprobe;
     if (entry->uses_cluster_table) {
@@ -151,10 +150,10 @@ struct SuiteMethodFactory::Shared {
       method.index_bytes += cluster_table_bytes(*table);
     }
     const auto start = std::chrono::steady_clock::now();
-    MMVK_ASSIGN_OR_RETURN(method.backend, registry.make(spec, db));
+    MMVK_ASSIGN_OR_RETURN(method.backend, suite_backends().make(spec, db, limits));
     method.build_s += seconds_since(start);
-    const bool device = backend.rfind("vulkan-", 0) == 0;
-    if (device) {
+    note_vulkan_device(*method.backend);
+    if (!crowd::HostBackends::on_cpu(backend)) {
       method.vulkan = as_vulkan_search(*method.backend);
       // What the backend allocated (VulkanSearch::device_bytes): the
       // database, a cluster mode's table and rows in cluster order, and
@@ -212,9 +211,7 @@ struct SuiteMethodFactory::Shared {
 };
 
 SuiteMethodFactory::SuiteMethodFactory(const Database& database, ThreadPool& pool, std::string cache_stem)
-    : shared_(std::make_unique<Shared>(database, pool, std::move(cache_stem))) {
-  add_vulkan_backends(shared_->registry);
-}
+    : shared_(std::make_unique<Shared>(database, pool, std::move(cache_stem))) {}
 
 SuiteMethodFactory::~SuiteMethodFactory() = default;
 

@@ -1,9 +1,12 @@
-// The suite's Vulkan side: one Context per process, created only when a
-// Vulkan cell runs (a CPU-only filter never touches the driver). Without
-// Vulkan in the build these do nothing and the vulkan-* cells are absent.
+// The suite's backends and its Vulkan side: one HostBackends per process
+// (host/crowd/host_backends.hpp, where the hosts make theirs), whose
+// Vulkan context is created only when a Vulkan cell runs (a CPU-only filter
+// never touches the driver). Without Vulkan in the build the vulkan-* cells
+// are absent.
 #pragma once
 
-#include "mmvk/backends.hpp"
+#include "host_backends.hpp"
+#include "mmvk/search.hpp"
 
 namespace mmvk::vulkan {
 class VulkanSearch;
@@ -11,15 +14,16 @@ class VulkanSearch;
 
 namespace mmvk::bench {
 
-// Constructs the (empty) holder of the context. Call it before creating
-// anything that may own Vulkan backends, so the context is destroyed after
-// them at exit.
+// Constructs the suite's backends (their context is made later). Call it
+// before creating anything that may own Vulkan backends, so the context is
+// destroyed after them at exit.
 void prepare_vulkan_context();
 
-// Adds vulkan-brute, vulkan-clusters and vulkan-nprobe on the shared
-// context (created on the first make()); a failure is printed and the
-// registry keeps its CPU entries.
-void add_vulkan_backends(BackendRegistry& registry);
+// The suite's backends; the first Vulkan backend made prints its device.
+crowd::HostBackends& suite_backends();
+
+// Says which device the suite's Vulkan cells run on, once per process.
+void note_vulkan_device(const SearchBackend& backend);
 
 // The backend as a VulkanSearch, or nullptr.
 vulkan::VulkanSearch* as_vulkan_search(SearchBackend& backend);

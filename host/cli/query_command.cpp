@@ -14,7 +14,7 @@
 #include "cli_args.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
-#include "driver_cache.hpp"
+#include "host_backends.hpp"
 #include "mmvk/backends.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/database_io.hpp"
@@ -23,11 +23,7 @@
 #include "mmvk/pose_query.hpp"
 #include "mmvk/query_builder.hpp"
 #include "mmvk/thread_pool.hpp"
-
-#if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/lazy_context.hpp"
 #include "user_cache_dir.hpp"
-#endif
 
 namespace mmvk::cli {
 
@@ -83,58 +79,29 @@ struct QueryArgs {
   std::vector<std::pair<std::string, float>> weights;
 };
 
-// The Vulkan context, made when a Vulkan backend is (so that listing the
-// backends for --help needs no device). Its pipeline cache is kept between
-// runs in the user's cache directory: loaded when the context is made, saved
-// after the search; a missing directory, or a damaged or foreign file, is a
-// note, never an error.
-#if defined(MMVK_HAS_VULKAN)
-struct ContextHolder {
-  vulkan::LazyContext lazy{{.context = {}, .cache_directory = user_cache_directory().value_or("")}};
-};
-#else
-struct ContextHolder {};
-#endif
-
 // Everything a backend borrows, declared before it so that it outlives it.
+// The Vulkan context is made when a Vulkan backend is (listing the backends
+// for --help needs no device); its pipeline cache is kept between runs in
+// the user's cache directory: loaded when the context is made, saved after
+// the search; a missing directory, or a damaged or foreign file, is a note,
+// never an error.
 struct BackendHolder {
   std::unique_ptr<ThreadPool> pool;
   std::optional<ClusterTable> table;
-  ContextHolder context;  // created when a Vulkan backend is made
+  crowd::HostBackends backends{{.application_name = "mmvk", .device = std::nullopt, .device_option = "--device",
+                                .cache_directory = user_cache_directory().value_or("")}};
   std::unique_ptr<SearchBackend> backend;
 };
 
-#if defined(MMVK_HAS_VULKAN)
-void report_pipeline_cache_note(const ContextHolder& context) {
-  const std::string& note = context.lazy.pipeline_cache_note();
+void print_note(const std::string& note) {
   if (!note.empty()) std::fprintf(stderr, "mmvk query: note: %s\n", note.c_str());
-}
-
-void save_pipeline_cache(const ContextHolder& context) {
-  if (const Status saved = context.lazy.save_pipeline_cache(); !saved) {
-    std::fprintf(stderr, "mmvk query: note: the pipeline cache was not saved: %s\n", saved.message().c_str());
-  }
-}
-#endif
-
-// The CPU backends, and the Vulkan ones when built with Vulkan, on
-// `context`.
-BackendRegistry query_backends([[maybe_unused]] ContextHolder& context) {
-  BackendRegistry registry = cpu_backends();
-#if defined(MMVK_HAS_VULKAN)
-  const Status added = context.lazy.add_backends(registry);
-  // The CPU and Vulkan names are distinct; a clash is a bug in mmvk itself.
-  if (!added) std::fprintf(stderr, "mmvk query: %s\n", added.message().c_str());
-#endif
-  return registry;
 }
 
 // The sections after the options: the backends (the registry's own list),
 // the output format and the pipeline cache.
 std::string query_footer() {
-  ContextHolder unused;
-  return "backends (--backend NAME):\n" + query_backends(unused).help() + "  (default " + BackendSpec{}.name +
-         ")\n\n" + kQueryOutput;
+  return "backends (--backend NAME):\n" + crowd::HostBackends().registry().help() + "  (default " +
+         BackendSpec{}.name + ")\n\n" + kQueryOutput;
 }
 
 void declare_search(CommandLine& cli, QueryArgs& out) {
@@ -186,17 +153,17 @@ std::optional<int> parse_query_args(Args args, QueryArgs& out) {
 
 Status make_backend(BackendHolder& holder, const Database& db, const QueryArgs& args, std::size_t batch) {
   const std::string& name = args.backend;
-  const BackendRegistry registry = query_backends(holder.context);
   BackendSpec spec;
   spec.name = name;
   spec.pool = holder.pool.get();
-  spec.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
-  spec.max_k = args.k;
+  if (args.nprobe) spec.nprobe = *args.nprobe;
+  crowd::DeviceSearchLimits limits;
+  limits.max_batch = static_cast<std::uint32_t>(std::max<std::size_t>(batch, 1));
+  limits.max_k = args.k;
   // One search per run: warming up every kernel variant would compile (on
   // lavapipe, for seconds) kernels this run never uses.
-  spec.warm_up = false;
-  if (args.nprobe) spec.nprobe = *args.nprobe;
-  const BackendEntry* entry = registry.find(name);
+  limits.warm_up = false;
+  const BackendEntry* entry = holder.backends.registry().find(name);
   // An option the chosen backend would ignore is a mistake worth naming
   // (the user believes a table or a probe count is in effect).
   if (entry != nullptr && !entry->uses_cluster_table && args.clusters) {
@@ -215,17 +182,9 @@ Status make_backend(BackendHolder& holder, const Database& db, const QueryArgs& 
                  stderr);
     }
   }
-  // Before the first Vulkan context (driver_cache.hpp): a full disk under
-  // the driver's shader cache would crash the driver.
-  if (name.starts_with("vulkan")) {
-    if (const std::string note = crowd::guard_driver_shader_cache(); !note.empty()) {
-      std::fprintf(stderr, "mmvk query: note: %s\n", note.c_str());
-    }
-  }
-  MMVK_ASSIGN_OR_RETURN(holder.backend, registry.make(spec, db));
-#if defined(MMVK_HAS_VULKAN)
-  report_pipeline_cache_note(holder.context);
-#endif
+  MMVK_ASSIGN_OR_RETURN(holder.backend, holder.backends.make(spec, db, limits));
+  print_note(holder.backends.driver_cache_note());
+  print_note(holder.backends.pipeline_cache_note());
   return {};
 }
 
@@ -283,8 +242,8 @@ Status check_paths(const QueryArgs& args) {
 // A mistyped backend is reported before the database loads (seconds for a
 // large one), in the words the registry would use.
 Status check_backend_name(const std::string& name) {
-  ContextHolder unused;
-  const BackendRegistry registry = query_backends(unused);
+  const crowd::HostBackends backends;
+  const BackendRegistry& registry = backends.registry();
   if (registry.find(name) == nullptr) return make_error("unknown backend '" + name + "' (known: " + registry.names() + ")");
   return {};
 }
@@ -404,11 +363,11 @@ Result<std::vector<Match>> search(BackendHolder& holder, const Database& db, con
   const auto start = std::chrono::steady_clock::now();
   MMVK_TRY(holder.backend->search(QueryBatch{queries.features, params, queries.count}, args.k, results));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-#if defined(MMVK_HAS_VULKAN)
-  save_pipeline_cache(holder.context);
-#endif
-  std::fprintf(stderr, "mmvk query: %zu queries, backend %s, %.3f ms (%.0f queries/s), %.2f%% of rows evaluated\n",
-               queries.count, std::string(holder.backend->name()).c_str(), seconds * 1e3,
+  if (const Status saved = holder.backends.save_pipeline_cache(); !saved) {
+    print_note("the pipeline cache was not saved: " + saved.message());
+  }
+  std::fprintf(stderr, "mmvk query: %zu queries, backend %s on %s, %.3f ms (%.0f queries/s), %.2f%% of rows evaluated\n",
+               queries.count, std::string(holder.backend->name()).c_str(), holder.backend->device().c_str(), seconds * 1e3,
                double(queries.count) / seconds, 100.0 * holder.backend->stats().rows_fraction(db.frame_count()));
   return results;
 }

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "host_backends.hpp"
 #include "mmvk/async_search.hpp"
 #include "mmvk/database.hpp"
 #include "mmvk/search.hpp"
@@ -20,21 +21,11 @@
 
 namespace mmvk::crowd {
 
-// The Vulkan context when the build has Vulkan (crowd_backend.cpp defines
-// it): opaque here, so that this struct's layout is the same in every target
-// that includes it, whether or not that target is built with Vulkan.
-struct CrowdDevice;
-
 struct CrowdSearch {
-  CrowdSearch();
-  ~CrowdSearch();
-  CrowdSearch(CrowdSearch&&) noexcept;
-  CrowdSearch& operator=(CrowdSearch&&) noexcept;
-
-  std::unique_ptr<CrowdDevice> vulkan;       // declared first: outlives the backend
+  HostBackends backends;                     // declared first: outlives the backend
   std::unique_ptr<SearchBackend> backend;
   std::unique_ptr<AsyncSearch> deferred;     // on `backend`
-  std::string device;                        // "llvmpipe (...), Vulkan device 0, cpu" or "cpu, 2 threads"
+  std::string device;                        // backend->device(): "llvmpipe (...) (Vulkan device 0, ...)", "cpu, 2 threads"
   std::string pipeline_cache_note;           // why a pipeline cache file was not used, or ""
   // What "auto" picked and why ("auto: no GPU, ..."); empty for a backend named.
   std::string choice;
@@ -51,8 +42,8 @@ inline constexpr std::uint32_t kAutoClusterFrames = 50'000;
 // The Vulkan backend "auto" picks on a GPU.
 inline constexpr const char* kAutoGpuBackend = "vulkan-brute";
 
-// The backends `mmvk crowd --backend` accepts (the library's registry), one
-// line each with its description, for --help.
+// The backends `mmvk crowd --backend` accepts ("auto", then HostBackends'),
+// one line each with its description, for --help.
 std::string crowd_backend_help();
 
 // "auto", or `name` as given: a Vulkan backend (kAutoGpuBackend) where a
@@ -63,7 +54,7 @@ std::string crowd_backend_help();
 std::string resolve_backend(const std::string& name, std::optional<std::uint32_t> device, std::uint32_t frames,
                             std::string& reason);
 
-// Makes `name` ("auto": resolve_backend) from the library's backend registry on `database` for up to
+// Makes `name` ("auto": resolve_backend) from HostBackends on `database` for up to
 // `agents` queries per tick. `device` picks the Vulkan device (none: the
 // best one). A Vulkan context starts from the pipeline cache file in
 // `cache_dir` (none when empty); save_crowd_pipeline_cache keeps it.

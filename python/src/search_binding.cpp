@@ -16,18 +16,13 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
-#include "driver_cache.hpp"
 #include "errors.hpp"
+#include "host_backends.hpp"
 #include "mmvk/backends.hpp"
 #include "mmvk/cluster_table.hpp"
 #include "mmvk/query_builder.hpp"
 #include "mmvk/search.hpp"
 #include "mmvk/thread_pool.hpp"
-
-#if defined(MMVK_HAS_VULKAN)
-#include "mmvk/vulkan/backends.hpp"
-#include "mmvk/vulkan/context.hpp"
-#endif
 
 namespace mmvk::python {
 
@@ -36,8 +31,8 @@ namespace py = pybind11;
 namespace {
 
 // A backend and everything it needs, in the order they must be destroyed
-// last (the database, the pool, the table and the Vulkan context outlive
-// the backend).
+// last (the database, the pool, the table and the backends' Vulkan context
+// outlive the backend).
 class PySearch {
  public:
   PySearch(std::shared_ptr<Database> database, const std::string& backend, const py::object& device,
@@ -61,38 +56,12 @@ class PySearch {
   std::shared_ptr<Database> database_;
   std::unique_ptr<ThreadPool> pool_;
   std::optional<ClusterTable> table_;
-#if defined(MMVK_HAS_VULKAN)
-  std::unique_ptr<vulkan::Context> context_;
-#endif
+  crowd::HostBackends backends_;
   std::unique_ptr<SearchBackend> backend_;
   std::string device_;
   // A backend is not thread-safe: two Python threads on one Search take turns.
   std::mutex mutex_;
 };
-
-// The CPU backends, and the Vulkan ones made on a context created (into
-// `context`, on `device`) only when one of them is made.
-BackendRegistry registry([[maybe_unused]] void* context, [[maybe_unused]] std::optional<std::uint32_t> device) {
-  BackendRegistry r = cpu_backends();
-#if defined(MMVK_HAS_VULKAN)
-  if (context == nullptr) {
-    // Listing names only: a source that is never called.
-    (void)vulkan::add_backends(r, []() -> Result<vulkan::Context*> { return make_error("no context"); });
-    return r;
-  }
-  auto* owned = static_cast<std::unique_ptr<vulkan::Context>*>(context);
-  (void)vulkan::add_backends(r, [owned, device]() -> Result<vulkan::Context*> {
-    if (!*owned) {
-      vulkan::ContextOptions options;
-      options.device_index = device;
-      options.application_name = "mmvk (Python)";
-      MMVK_ASSIGN_OR_RETURN(*owned, vulkan::Context::create(options));
-    }
-    return owned->get();
-  });
-#endif
-  return r;
-}
 
 // An option taken out of `options` (what is left is unknown), checked with
 // its name in errors.
@@ -136,11 +105,12 @@ PySearch::PySearch(std::shared_ptr<Database> database, const std::string& backen
   spec.kmeans.clusters = option<std::uint32_t>(options, "kmeans_clusters", spec.kmeans.clusters);
   spec.kmeans.iterations = option<std::uint32_t>(options, "kmeans_iterations", spec.kmeans.iterations);
   spec.kmeans.seed = option<std::uint64_t>(options, "kmeans_seed", spec.kmeans.seed);
-  spec.max_batch = option<std::uint32_t>(options, "max_batch", spec.max_batch);
-  spec.max_k = option<std::uint32_t>(options, "max_k", spec.max_k);
-  spec.max_tile = option<std::uint32_t>(options, "max_tile", spec.max_tile);
+  crowd::DeviceSearchLimits limits;
+  limits.max_batch = option<std::uint32_t>(options, "max_batch", limits.max_batch);
+  limits.max_k = option<std::uint32_t>(options, "max_k", limits.max_k);
+  limits.max_tile = option<std::uint32_t>(options, "max_tile", limits.max_tile);
   // Compiling every kernel variant up front costs seconds on lavapipe.
-  spec.warm_up = option<bool>(options, "warm_up", false);
+  limits.warm_up = option<bool>(options, "warm_up", false);
   if (options.contains("clusters")) {
     const std::filesystem::path path = to_path(options["clusters"], "clusters");
     PyDict_DelItemString(options.ptr(), "clusters");
@@ -152,36 +122,22 @@ PySearch::PySearch(std::shared_ptr<Database> database, const std::string& backen
           "' (known: threads, nprobe, clusters, kmeans_clusters, kmeans_iterations, kmeans_seed, max_batch, max_k, "
           "max_tile, warm_up)");
   }
-  std::optional<std::uint32_t> device_index;
-  if (!device.is_none()) device_index = integer_as<std::uint32_t>(device, "device");
-  void* context = nullptr;
-#if defined(MMVK_HAS_VULKAN)
-  context = &context_;
-#endif
-  const BackendRegistry backends = registry(context, device_index);
-  // Before the first Vulkan context (host/crowd/driver_cache.hpp): a full
-  // disk under the driver's shader cache would crash the driver.
-  if (backend.starts_with("vulkan")) {
-    if (const std::string note = crowd::guard_driver_shader_cache(); !note.empty()) {
-      if (PyErr_WarnEx(PyExc_RuntimeWarning, note.c_str(), 1) != 0) throw py::error_already_set();
-    }
-  }
+  crowd::HostBackendOptions host;
+  host.application_name = "mmvk (Python)";
+  if (!device.is_none()) host.device = integer_as<std::uint32_t>(device, "device");
+  host.device_option = "device";
+  backends_ = crowd::HostBackends(std::move(host));
   Result<std::unique_ptr<SearchBackend>> made = make_error("");
   {
     py::gil_scoped_release released;  // k-means training and kernel compiles take a while
-    made = backends.make(spec, *database_);
+    made = backends_.make(spec, *database_, limits);
   }
   backend_ = take(std::move(made));
-#if defined(MMVK_HAS_VULKAN)
-  if (context_) {
-    device_ = context_->device_name();
-    return;
+  device_ = backend_->device();
+  // Set before the first Vulkan context (host/crowd/driver_cache.hpp).
+  if (const std::string& note = backends_.driver_cache_note(); !note.empty()) {
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, note.c_str(), 1) != 0) throw py::error_already_set();
   }
-#endif
-  if (device_index) raise("device picks a Vulkan device; backend '" + backend + "' runs on the CPU");
-  device_ = backend == "reference" ? std::string("cpu, 1 thread")
-                                   : "cpu, " + std::to_string(pool_->thread_count()) +
-                                         (pool_->thread_count() == 1 ? " thread" : " threads");
 }
 
 py::tuple PySearch::search(const py::object& queries, std::uint32_t k, const py::object& continuing,
@@ -280,8 +236,8 @@ void bind_search(py::module_& m) {
       "backends",
       []() {
         std::vector<std::string> names;
-        const BackendRegistry listed = registry(nullptr, std::nullopt);
-        for (const BackendEntry& e : listed.entries()) names.push_back(e.name);
+        const crowd::HostBackends listed;
+        for (const BackendEntry& e : listed.registry().entries()) names.push_back(e.name);
         return names;
       },
       "The search backends by name: the CPU ones (reference, fast-brute, fast-box, clusters, clusters-nprobe) and, "
@@ -310,7 +266,7 @@ void bind_search(py::module_& m) {
            "Seconds per call of `calls` searches of `queries` (default params) made in a C++ loop: the same backend "
            "call as search() without Python around it. For bench/python_overhead.py.")
       .def_property_readonly("name", &PySearch::name, "The backend's name.")
-      .def_property_readonly("device", &PySearch::device, "Where it runs: the Vulkan device's name, or 'cpu, N threads'.")
+      .def_property_readonly("device", &PySearch::device, "Where it runs, as the backend reports it (the same text as mmvk.Crowd.device and `mmvk query`): 'cpu, N threads', or the Vulkan device's name, index and type.")
       .def_property_readonly("database", &PySearch::database, "The Database searched.")
       .def("__repr__", [](const PySearch& s) { return "<mmvk.Search: " + s.name() + " on " + s.device() + ">"; });
 }

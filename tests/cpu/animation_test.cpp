@@ -376,6 +376,7 @@ class ContinuingSearch final : public SearchBackend {
  public:
   explicit ContinuingSearch(const Database& database) : database_(database) {}
   std::string_view name() const override { return "continuing"; }
+  std::string device() const override { return cpu_device_text(1); }
   const Database& database() const override { return database_; }
   Status search(const QueryBatch& batch, std::uint32_t, std::span<Match> out) override {
     for (std::size_t i = 0; i < batch.size; ++i) {

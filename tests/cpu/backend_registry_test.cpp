@@ -1,7 +1,7 @@
 // The backend registry (mmvk/backends.hpp): every CPU name makes a backend
 // whose name() is that name, an unknown name lists the known ones, and the
 // spec's mistakes (no pool, nprobe 0, a table of another database, a
-// duplicate entry) are errors, not crashes.
+// duplicate entry) are errors, not crashes; each backend reports its device.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -47,6 +47,27 @@ TEST(BackendRegistry, EveryCpuNameRoundTripsThroughName) {
   EXPECT_EQ(std::count(help.begin(), help.end(), '\n'), 5);
   EXPECT_EQ(help.find("  reference        " + registry.find("reference")->description + "\n"), 0u) << help;
   EXPECT_NE(help.find("\n  clusters-nprobe  "), std::string::npos) << help;
+}
+
+// Each backend says where it runs itself: the reference on one thread, the
+// others on their pool's threads.
+TEST(BackendRegistry, EveryCpuBackendReportsItsOwnDevice) {
+  const Database db = synthetic_database({.frames = 300, .seed = 5});
+  ThreadPool one(1);
+  ThreadPool three(3);
+  const BackendRegistry registry = cpu_backends();
+  for (const BackendEntry& entry : registry.entries()) {
+    SCOPED_TRACE(entry.name);
+    for (ThreadPool* pool : {&one, &three}) {
+      BackendSpec spec{.name = entry.name, .pool = pool};
+      spec.kmeans.iterations = 3;
+      Result<std::unique_ptr<SearchBackend>> backend = registry.make(spec, db);
+      ASSERT_TRUE(backend.ok()) << backend.message();
+      const bool single = entry.name == "reference" || pool == &one;
+      EXPECT_EQ((*backend)->device(), single ? "cpu, 1 thread" : "cpu, 3 threads");
+    }
+  }
+  EXPECT_EQ(cpu_device_text(8), "cpu, 8 threads");
 }
 
 TEST(BackendRegistry, UnknownNameListsTheKnownOnes) {

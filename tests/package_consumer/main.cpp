@@ -1,8 +1,9 @@
 // Builds a two-frame database through the public API and searches it: proves
-// the installed headers and libraries are complete and usable.
+// the installed headers and libraries are complete and usable, the
+// start-here header (mmvk/mmvk.hpp) with them.
 #include <cstdio>
 
-#include "mmvk/database.hpp"
+#include "mmvk/mmvk.hpp"
 #include "mmvk/reference_search.hpp"
 
 int main() {

@@ -25,7 +25,7 @@ TEST(VulkanBackendRegistry, EveryNameRoundTripsThroughName) {
   ASSERT_TRUE(table.ok()) << table.message();
   BackendRegistry registry = cpu_backends();
   const std::size_t cpu_count = registry.entries().size();
-  ASSERT_TRUE(vulkan::add_backends(registry, *context).ok());
+  ASSERT_TRUE(vulkan::add_backends(registry, *context, search_options(16, 2, 4, false)).ok());
   EXPECT_EQ(registry.entries().size(), cpu_count + 3);
   std::set<std::string> vulkan_names;
   for (const BackendEntry& entry : registry.entries()) {
@@ -33,11 +33,14 @@ TEST(VulkanBackendRegistry, EveryNameRoundTripsThroughName) {
     SCOPED_TRACE(entry.name);
     vulkan_names.insert(entry.name);
     EXPECT_EQ(entry.uses_cluster_table, entry.name != "vulkan-brute");
-    BackendSpec spec{.name = entry.name, .clusters = *table, .max_batch = 16, .max_k = 2, .max_tile = 4, .warm_up = false};
+    BackendSpec spec{.name = entry.name, .clusters = *table};
     Result<std::unique_ptr<SearchBackend>> backend = registry.make(spec, db);
     ASSERT_TRUE(backend.ok()) << backend.message();
     EXPECT_EQ((*backend)->name(), entry.name);
+    // The device text is the context's, which names the device, its index and type.
+    EXPECT_EQ((*backend)->device(), context->description());
   }
+  EXPECT_EQ(context->description().rfind(context->device_name() + " (Vulkan device ", 0), 0u) << context->description();
   EXPECT_EQ(vulkan_names, (std::set<std::string>{"vulkan-brute", "vulkan-clusters", "vulkan-nprobe"}));
   // Adding them twice clashes.
   EXPECT_FALSE(vulkan::add_backends(registry, *context).ok());
@@ -67,14 +70,14 @@ TEST(VulkanBackendRegistry, SpecMistakesAreErrors) {
   Result<const ClusterTable*> table = tables.table_for(db);
   ASSERT_TRUE(table.ok()) << table.message();
   BackendRegistry registry;
-  ASSERT_TRUE(vulkan::add_backends(registry, *context).ok());
+  ASSERT_TRUE(vulkan::add_backends(registry, *context, search_options(1024, kMaxK, 16, false)).ok());
   for (const char* name : {"vulkan-clusters", "vulkan-nprobe"}) {
     Result<std::unique_ptr<SearchBackend>> mismatched =
-        registry.make(BackendSpec{.name = name, .clusters = *table, .warm_up = false}, other);
+        registry.make(BackendSpec{.name = name, .clusters = *table}, other);
     ASSERT_FALSE(mismatched.ok()) << name;
     EXPECT_NE(mismatched.message().find("cluster table"), std::string::npos) << mismatched.message();
   }
-  BackendSpec zero{.name = "vulkan-nprobe", .clusters = *table, .warm_up = false};
+  BackendSpec zero{.name = "vulkan-nprobe", .clusters = *table};
   zero.nprobe = 0;
   Result<std::unique_ptr<SearchBackend>> zero_probe = registry.make(zero, db);
   ASSERT_FALSE(zero_probe.ok());

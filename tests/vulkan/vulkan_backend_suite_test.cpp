@@ -30,8 +30,7 @@ struct VulkanFactory : VulkanRegistryFactory {
 
   Result<std::unique_ptr<SearchBackend>> make(const Database& db) {
     if (!context) return make_error(error);
-    // warm_up off: compile only the variants a test uses.
-    return registry.make(BackendSpec{.name = "vulkan-brute", .warm_up = false}, db);
+    return registry.make(BackendSpec{.name = "vulkan-brute"}, db);  // warm_up off (VulkanRegistryFactory)
   }
 };
 

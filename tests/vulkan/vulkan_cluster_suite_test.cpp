@@ -34,7 +34,6 @@ struct VulkanClusterFactory : VulkanRegistryFactory {
     BackendSpec spec{.name = Exact ? "vulkan-clusters" : "vulkan-nprobe"};
     MMVK_ASSIGN_OR_RETURN(spec.clusters, tables.table_for(db));
     spec.nprobe = NProbe;
-    spec.warm_up = false;  // compile only the variants a test uses
     return registry.make(spec, db);
   }
 };

@@ -23,12 +23,11 @@ using vulkan::LazyContextOptions;
 BackendSpec small_spec(const char* name) {
   BackendSpec spec;
   spec.name = name;
-  spec.max_batch = 4;
-  spec.max_k = 1;
-  spec.max_tile = 1;
-  spec.warm_up = false;
   return spec;
 }
+
+// The searches small_spec's backends are made with.
+const vulkan::VulkanSearchOptions kSmall = search_options(4, 1, 1, false);
 
 bool empty_dir(const std::filesystem::path& dir) {
   std::error_code error;
@@ -63,7 +62,7 @@ TEST(LazyContext, MakesOneContextAndKeepsItsPipelineCacheForTheNextRun) {
   {
     LazyContext lazy(LazyContextOptions{.context = {}, .cache_directory = dir});
     BackendRegistry registry = cpu_backends();
-    ASSERT_TRUE(lazy.add_backends(registry).ok());
+    ASSERT_TRUE(lazy.add_backends(registry, kSmall).ok());
     Result<std::unique_ptr<SearchBackend>> first = registry.make(small_spec("vulkan-brute"), db);
     ASSERT_TRUE(first.ok()) << first.message();
     vulkan::Context* context = lazy.created();
@@ -96,7 +95,7 @@ TEST(LazyContext, KeepsAFailureAndReportsItAgain) {
   EXPECT_EQ(lazy.created(), nullptr);
   // A backend made on it fails with the same message, and saving is a no-op.
   BackendRegistry registry = cpu_backends();
-  ASSERT_TRUE(lazy.add_backends(registry).ok());
+  ASSERT_TRUE(lazy.add_backends(registry, kSmall).ok());
   const Database db = synthetic_database({.frames = 16, .seed = 6});
   Result<std::unique_ptr<SearchBackend>> made = registry.make(small_spec("vulkan-brute"), db);
   ASSERT_FALSE(made.ok());

@@ -305,6 +305,7 @@ TEST(VulkanContext, ExplicitIndexAndAdoption) {
   EXPECT_FALSE(Context::create(index_options(static_cast<std::uint32_t>(devices->size()))).ok());
   Result<std::unique_ptr<Context>> first = Context::create(index_options(0));
   ASSERT_TRUE(first.ok()) << first.message();
+  EXPECT_NE((*first)->description().find("(Vulkan device 0, "), std::string::npos) << (*first)->description();
 
   // A second Context on the application's own handles; it destroys none.
   const Database db = synthetic_database({.frames = 2000, .seed = 117});
@@ -314,6 +315,8 @@ TEST(VulkanContext, ExplicitIndexAndAdoption) {
         owner->instance(), owner->physical_device(), owner->device(), owner->queue_family(), owner->queue()});
     ASSERT_TRUE(adopted.ok()) << adopted.message();
     EXPECT_FALSE((*adopted)->owns_device());
+    // An adopted device is described as the one it is, with its index.
+    EXPECT_EQ((*adopted)->description(), owner->description());
     std::unique_ptr<VulkanSearch> search =
         make_search(**adopted, db, search_options(6, 2, 16, false));
     ASSERT_NE(search, nullptr);

@@ -39,10 +39,23 @@ inline std::unique_ptr<vulkan::Context> make_test_context(std::string& reason,
   return nullptr;
 }
 
+// VulkanSearch options without designated initializers (GCC warns about
+// the members they leave out).
+inline vulkan::VulkanSearchOptions search_options(std::uint32_t max_batch, std::uint32_t max_k,
+                                                  std::uint32_t max_tile = 16, bool warm_up = true) {
+  vulkan::VulkanSearchOptions options;
+  options.max_batch = max_batch;
+  options.max_k = max_k;
+  options.max_tile = max_tile;
+  options.warm_up = warm_up;
+  return options;
+}
+
 // The Vulkan backends in a registry over one test Context, for the typed
 // backend suites' factories: `error` says why there is no context (or why
 // the backends could not be added); skip_reason() turns that into a skip,
-// or a failure when MMVK_REQUIRE_VULKAN is set.
+// or a failure when MMVK_REQUIRE_VULKAN is set. warm_up is off: compile
+// only the variants a test uses.
 struct VulkanRegistryFactory {
   std::unique_ptr<vulkan::Context> context;
   BackendRegistry registry;
@@ -51,7 +64,8 @@ struct VulkanRegistryFactory {
   explicit VulkanRegistryFactory(const vulkan::ContextOptions& options = {}) {
     context = make_test_context(error, options);
     if (context) {
-      if (Status added = vulkan::add_backends(registry, *context); !added) error = added.message();
+      const vulkan::VulkanSearchOptions search = search_options(1024, kMaxK, 16, false);
+      if (Status added = vulkan::add_backends(registry, *context, search); !added) error = added.message();
     }
   }
 
@@ -64,18 +78,6 @@ struct VulkanRegistryFactory {
     return error;
   }
 };
-
-// VulkanSearch options without designated initializers (GCC warns about
-// the members they leave out).
-inline vulkan::VulkanSearchOptions search_options(std::uint32_t max_batch, std::uint32_t max_k,
-                                                  std::uint32_t max_tile = 16, bool warm_up = true) {
-  vulkan::VulkanSearchOptions options;
-  options.max_batch = max_batch;
-  options.max_k = max_k;
-  options.max_tile = max_tile;
-  options.warm_up = warm_up;
-  return options;
-}
 
 }  // namespace mmvk::test
 

@@ -16,8 +16,8 @@ TEST(VulkanTimeRanges, EveryExactBackendMatchesTheReference) {
   Result<Database> db = build_ranged_database(data);
   ASSERT_TRUE(db.ok()) << db.message();
   BackendRegistry registry;
-  ASSERT_TRUE(vulkan::add_backends(registry, *context).ok());
-  BackendSpec spec{.max_batch = 64, .max_k = 4, .warm_up = false};
+  ASSERT_TRUE(vulkan::add_backends(registry, *context, search_options(64, 4, 16, false)).ok());
+  BackendSpec spec;
   spec.kmeans.clusters = 16;
   spec.nprobe = 1u << 20;  // every cluster: exact
   const char* const names[] = {"vulkan-brute", "vulkan-clusters", "vulkan-nprobe"};

@@ -3,8 +3,9 @@
 // tests and the hosts alike. A backend's name() is its key.
 //
 // The registry is a value, not global state: cpu_backends() returns the CPU
-// entries, and mmvk::vulkan::add_backends(registry, context) adds the GPU
-// ones, so mmvk::runtime has no Vulkan dependency.
+// entries, and mmvk::vulkan::add_backends(registry, context, options) adds
+// the GPU ones, so mmvk::runtime has no Vulkan dependency. A made backend
+// says where it runs itself (SearchBackend::device()).
 //
 //   mmvk::ThreadPool pool;
 //   mmvk::BackendSpec spec{.name = "clusters", .pool = &pool};
@@ -49,13 +50,9 @@ struct BackendSpec {
   // clusters, clusters-nprobe: the pruning bounds; nprobe is set from the
   // name and `nprobe` above.
   ClusterSearchOptions cluster = {};
-  // Device backends (vulkan-*): the largest batch and k one search may ask
-  // for, the largest query tile held in registers (1, 4, 16 or 32), and
-  // whether every kernel variant is compiled at creation.
-  std::uint32_t max_batch = 1024;
-  std::uint32_t max_k = kMaxK;
-  std::uint32_t max_tile = 16;
-  bool warm_up = true;
+  // A device backend's own options (the Vulkan ones' largest batch and k,
+  // query tile, warm-up) are not here: they are given where its entries
+  // are added (mmvk::vulkan::add_backends), so this library knows no device.
 };
 
 using BackendFactory =

@@ -116,6 +116,7 @@ class ClusterSearch final : public SearchBackend {
   ~ClusterSearch() override;
 
   std::string_view name() const override { return options_.nprobe == 0 ? "clusters" : "clusters-nprobe"; }
+  std::string device() const override { return cpu_device_text(pool_->thread_count()); }
   const Database& database() const override { return *database_; }
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
   SearchStats stats() const override { return stats_; }

@@ -53,6 +53,7 @@ class FastSearch final : public SearchBackend {
   ~FastSearch() override;
 
   std::string_view name() const override { return options_.prune ? "fast-box" : "fast-brute"; }
+  std::string device() const override { return cpu_device_text(pool_->thread_count()); }
   const Database& database() const override { return *database_; }
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
   SearchStats stats() const override;

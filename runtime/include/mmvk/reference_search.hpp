@@ -19,6 +19,7 @@ class ReferenceSearch final : public SearchBackend {
   }
 
   std::string_view name() const override { return "reference"; }
+  std::string device() const override { return cpu_device_text(1); }
   const Database& database() const override { return *database_; }
   Status search(const QueryBatch& batch, std::uint32_t k, std::span<Match> out) override;
   SearchStats stats() const override { return stats_; }

@@ -19,6 +19,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "mmvk/database.hpp"
@@ -101,6 +102,11 @@ class SearchBackend {
  public:
   virtual ~SearchBackend() = default;
   virtual std::string_view name() const = 0;
+  // Where it runs, for a host to show: "cpu, 8 threads" (cpu_device_text),
+  // or the device's own text ("llvmpipe (...) (Vulkan device 0, CPU,
+  // software Vulkan)"). Every host shows this text as it is, so one backend
+  // reads the same in the CLI, the crowd and Python.
+  virtual std::string device() const = 0;
   virtual const Database& database() const = 0;
   // Writes B*k matches, query b's best k at out[b*k .. b*k+k), sorted by
   // (cost, frame); slots beyond the number of candidates are Match{} (none).
@@ -113,6 +119,10 @@ class SearchBackend {
   // (VulkanSearch). The backend must outlive it.
   virtual std::unique_ptr<AsyncSearch> make_async(std::uint32_t capacity);
 };
+
+// A CPU backend's device() on `threads` threads: "cpu, 1 thread",
+// "cpu, 8 threads".
+std::string cpu_device_text(unsigned threads);
 
 // The checks every backend runs before searching: k in [1, kMaxK], a batch
 // of at most kMaxBatch queries (checked before any size product), sizes,

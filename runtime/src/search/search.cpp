@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "database/cost_bound.hpp"
 
@@ -159,6 +160,10 @@ float frame_cost(const Database& database, std::uint32_t frame, std::span<const 
     cost += params.continuing_bias;
   }
   return cost;
+}
+
+std::string cpu_device_text(unsigned threads) {
+  return "cpu, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads");
 }
 
 }  // namespace mmvk

@@ -11,30 +11,19 @@ namespace mmvk::vulkan {
 
 namespace {
 
-// The options a BackendSpec sets; `base` the rest.
-VulkanSearchOptions spec_options(const BackendSpec& spec, const VulkanSearchOptions& base) {
-  VulkanSearchOptions options = base;
-  options.max_batch = spec.max_batch;
-  options.max_k = spec.max_k;
-  options.max_tile = spec.max_tile;
-  options.warm_up = spec.warm_up;
-  return options;
-}
-
-BackendFactory brute_force_factory(const ContextSource& context, const VulkanSearchOptions& base) {
-  return [context, base](const BackendSpec& spec, const Database& database) -> Result<std::unique_ptr<SearchBackend>> {
+BackendFactory brute_force_factory(const ContextSource& context, const VulkanSearchOptions& options) {
+  return [context, options](const BackendSpec& spec, const Database& database) -> Result<std::unique_ptr<SearchBackend>> {
     if (!context) return make_error("backend '" + spec.name + "': no Vulkan context source");
     MMVK_ASSIGN_OR_RETURN(Context* device, context());
-    MMVK_ASSIGN_OR_RETURN(std::unique_ptr<VulkanBruteForce> search,
-                          VulkanBruteForce::create(*device, database, spec_options(spec, base)));
+    MMVK_ASSIGN_OR_RETURN(std::unique_ptr<VulkanBruteForce> search, VulkanBruteForce::create(*device, database, options));
     return std::unique_ptr<SearchBackend>(std::move(search));
   };
 }
 
 // `probe`: vulkan-nprobe (spec.nprobe clusters per query), else exact.
-BackendFactory cluster_factory(const ContextSource& context, const VulkanSearchOptions& base, bool probe) {
-  return [context, base, probe](const BackendSpec& spec,
-                                const Database& database) -> Result<std::unique_ptr<SearchBackend>> {
+BackendFactory cluster_factory(const ContextSource& context, const VulkanSearchOptions& options, bool probe) {
+  return [context, options, probe](const BackendSpec& spec,
+                                   const Database& database) -> Result<std::unique_ptr<SearchBackend>> {
     if (!context) return make_error("backend '" + spec.name + "': no Vulkan context source");
     if (probe && spec.nprobe == 0) return make_error("backend '" + spec.name + "': nprobe must be at least 1");
     MMVK_ASSIGN_OR_RETURN(Context* device, context());
@@ -43,24 +32,23 @@ BackendFactory cluster_factory(const ContextSource& context, const VulkanSearchO
     VulkanClusterOptions cluster_options;
     cluster_options.nprobe = probe ? spec.nprobe : 0;
     MMVK_ASSIGN_OR_RETURN(std::unique_ptr<VulkanClusterSearch> search,
-                          VulkanClusterSearch::create(*device, database, *table, spec_options(spec, base),
-                                                      cluster_options));
+                          VulkanClusterSearch::create(*device, database, *table, options, cluster_options));
     return std::unique_ptr<SearchBackend>(std::move(search));
   };
 }
 
 }  // namespace
 
-Status add_backends(BackendRegistry& registry, Context& context, const VulkanSearchOptions& base) {
-  return add_backends(registry, [&context]() -> Result<Context*> { return &context; }, base);
+Status add_backends(BackendRegistry& registry, Context& context, const VulkanSearchOptions& options) {
+  return add_backends(registry, [&context]() -> Result<Context*> { return &context; }, options);
 }
 
-Status add_backends(BackendRegistry& registry, ContextSource context, const VulkanSearchOptions& base) {
-  MMVK_TRY(registry.add({"vulkan-brute", "GPU, exact, every row", brute_force_factory(context, base)}));
+Status add_backends(BackendRegistry& registry, ContextSource context, const VulkanSearchOptions& options) {
+  MMVK_TRY(registry.add({"vulkan-brute", "GPU, exact, every row", brute_force_factory(context, options)}));
   MMVK_TRY(registry.add({"vulkan-clusters", "GPU, exact, rows pruned by k-means cluster bounds",
-                         cluster_factory(context, base, false), true}));
+                         cluster_factory(context, options, false), true}));
   MMVK_TRY(registry.add({"vulkan-nprobe", "GPU, approximate: the nprobe clusters with the nearest centroids",
-                         cluster_factory(context, base, true), true, true}));
+                         cluster_factory(context, options, true), true, true}));
   return {};
 }
 

@@ -53,6 +53,16 @@ int type_rank(VkPhysicalDeviceType type) {
   }
 }
 
+const char* device_type_text(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU, software Vulkan";
+    default: return "other";
+  }
+}
+
 // A queue family with compute, preferring one with timestamps.
 std::optional<std::uint32_t> find_compute_family(VkPhysicalDevice device) {
   std::uint32_t count = 0;
@@ -303,7 +313,20 @@ Status Context::init_device_info(const DeviceLimitCaps& caps) {
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &count, families.data());
   timestamp_valid_bits_ = queue_family_ < count ? families[queue_family_].timestampValidBits : 0;
   if (properties_.limits.timestampPeriod <= 0.0f) timestamp_valid_bits_ = 0;
+  init_description();
   return {};
+}
+
+void Context::init_description() {
+  // The index is looked up rather than remembered from create(), so that an
+  // adopted device gets it too; the instance lists its devices in one order.
+  std::string index;
+  if (Result<std::vector<VkPhysicalDevice>> devices = physical_devices(instance_); devices) {
+    for (std::size_t i = 0; i < devices->size(); ++i) {
+      if ((*devices)[i] == physical_device_) index = "Vulkan device " + std::to_string(i) + ", ";
+    }
+  }
+  description_ = device_name() + " (" + index + device_type_text(properties_.deviceType) + ")";
 }
 
 Status Context::init_pipeline_cache(VkPipelineCache adopted, std::span<const std::byte> initial) {

@@ -31,8 +31,8 @@ Status LazyContext::save_pipeline_cache() const {
   return save_pipeline_cache_file(*context_, options_.cache_directory);
 }
 
-Status LazyContext::add_backends(BackendRegistry& registry, const VulkanSearchOptions& base) {
-  return vulkan::add_backends(registry, [this]() { return get(); }, base);
+Status LazyContext::add_backends(BackendRegistry& registry, const VulkanSearchOptions& options) {
+  return vulkan::add_backends(registry, [this]() { return get(); }, options);
 }
 
 }  // namespace mmvk::vulkan

@@ -392,6 +392,8 @@ VulkanSearch::VulkanSearch(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) 
 VulkanSearch::~VulkanSearch() = default;
 
 const Database& VulkanSearch::database() const { return *impl_->database; }
+
+std::string VulkanSearch::device() const { return impl_->context->description(); }
 SearchStats VulkanSearch::stats() const { return impl_->stats; }
 void VulkanSearch::reset_stats() { impl_->stats = {}; }
 std::optional<double> VulkanSearch::last_kernel_seconds() const { return impl_->last_kernel_seconds; }

@@ -3,7 +3,9 @@
 // (VulkanClusterSearch, nprobe 0 and spec.nprobe), made on `context`.
 //
 //   mmvk::BackendRegistry registry = mmvk::cpu_backends();
-//   MMVK_TRY(mmvk::vulkan::add_backends(registry, context));
+//   mmvk::vulkan::VulkanSearchOptions options;
+//   options.max_batch = 256;
+//   MMVK_TRY(mmvk::vulkan::add_backends(registry, context, options));
 #pragma once
 
 #include <functional>
@@ -22,10 +24,10 @@ namespace mmvk::vulkan {
 using ContextSource = std::function<Result<Context*>()>;
 
 // `context` must outlive the registry and every backend made from it.
-// `base` supplies the options a BackendSpec does not carry (slots,
-// rows_per_invocation, scratch_bytes, force_staging_upload); the search
-// and its nprobe come from the name, max_batch, max_k, max_tile and
-// warm_up from the spec.
+// `options` are the made searches' own (max_batch, max_k, max_tile,
+// warm_up, slots, ...: the device's side, which BackendSpec does not
+// carry); the search and its nprobe come from the name and the spec, the
+// cluster table from spec.clusters or spec.kmeans.
 // Error when one of the names is already registered.
 Status add_backends(BackendRegistry& registry, Context& context, const VulkanSearchOptions& base = {});
 Status add_backends(BackendRegistry& registry, ContextSource context, const VulkanSearchOptions& base = {});

@@ -110,6 +110,11 @@ class Context {
   // Valid bits of the queue's timestamps; 0 = no timestamp support.
   std::uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
   std::string device_name() const { return properties_.deviceName; }
+  // The device as a host shows it (every Vulkan backend's device()): its
+  // name, the index vkEnumeratePhysicalDevices gives it (what
+  // ContextOptions::device_index and the hosts' --device take) and its type:
+  // "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan device 0, CPU, software Vulkan)".
+  const std::string& description() const { return description_; }
   // VkPhysicalDeviceMaintenance3Properties::maxMemoryAllocationSize.
   VkDeviceSize max_memory_allocation_size() const { return max_allocation_size_; }
 
@@ -163,6 +168,7 @@ class Context {
  private:
   Context() = default;
   Status init_device_info(const DeviceLimitCaps& caps);
+  void init_description();
   Status init_pipeline_cache(VkPipelineCache adopted, std::span<const std::byte> initial);
 
   // Declaration order = reverse destruction order; the destructor destroys
@@ -184,6 +190,7 @@ class Context {
   std::uint32_t subgroup_size_ = 1;
   std::uint32_t timestamp_valid_bits_ = 0;
   VkDeviceSize max_allocation_size_ = 0;
+  std::string description_;
 
   // Mutable: device loss and injected faults are observed by the const
   // paths that submit and wait (the Context is used from one thread).

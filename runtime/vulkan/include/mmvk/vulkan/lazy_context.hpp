@@ -51,9 +51,10 @@ class LazyContext {
   Status save_pipeline_cache() const;
 
   // Adds vulkan-brute, vulkan-clusters and vulkan-nprobe (backends.hpp),
-  // made on get(). This object must outlive the registry and every backend
-  // made from it. Error when one of the names is already registered.
-  Status add_backends(BackendRegistry& registry, const VulkanSearchOptions& base = {});
+  // made on get() with `options`. This object must outlive the registry and
+  // every backend made from it. Error when one of the names is already
+  // registered.
+  Status add_backends(BackendRegistry& registry, const VulkanSearchOptions& options = {});
 
  private:
   LazyContextOptions options_;

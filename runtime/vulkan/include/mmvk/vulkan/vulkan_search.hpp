@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -70,6 +71,7 @@ class VulkanSearch : public SearchBackend {
   VulkanSearch(const VulkanSearch&) = delete;
   VulkanSearch& operator=(const VulkanSearch&) = delete;
 
+  std::string device() const override;  // the Context's description()
   const Database& database() const override;
   // Blocking: any batch up to kMaxBatch, paged over the slots. Errors:
   // validate_search, k over max_k, every slot held by an asynchronous

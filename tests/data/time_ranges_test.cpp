@@ -74,9 +74,10 @@ TEST_F(TimeRanges, PerFrameTagsAndCostsFollowTheRanges) {
   }
   EXPECT_EQ(db->max_multiplier(), 1.25f * 6.0f);
 
-  // The .mmdb keeps them (a version 4 file, since the build also records
-  // the clips' units: version 3 files have per-frame modifiers alone).
-  EXPECT_EQ(serialize_database(*db)[8], char(4));
+  // The .mmdb keeps them (a version 7 file, since the build also records
+  // where the clips' units and axes came from: version 3 files have
+  // per-frame modifiers alone).
+  EXPECT_EQ(serialize_database(*db)[8], char(7));
   Result<Database> back = deserialize_database(serialize_database(*db), "db.mmdb");
   ASSERT_TRUE(back.ok()) << back.message();
   EXPECT_EQ(back->content_hash(), db->content_hash());

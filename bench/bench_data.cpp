@@ -11,11 +11,11 @@
 #include <vector>
 #include <string>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::bench {
 

@@ -18,7 +18,7 @@
 
 #include <string_view>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::bench {
 

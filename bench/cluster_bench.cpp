@@ -31,10 +31,10 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/search/cluster_search.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
 
 namespace mmvk::bench {
 namespace {
@@ -43,7 +43,7 @@ constexpr std::size_t kStreamQueries = 1024;
 const char* const kStreams[] = {"continue", "transition", "random"};
 constexpr std::uint32_t kBatchSizes[] = {1, 64, 1024};
 
-// The rows: registry backends (mmvk/backends.hpp) by name with the nprobe.
+// The rows: registry backends (mmvk/search/backends.hpp) by name with the nprobe.
 struct Variant {
   const char* label;
   const char* backend;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
 
 namespace mmvk::bench {
 

@@ -13,14 +13,14 @@
 #include <filesystem>
 #include <vector>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/normalization.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/features/normalization.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk {
 namespace {

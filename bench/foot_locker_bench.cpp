@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "mmvk/foot_locker.hpp"
-#include "mmvk/pose_batch.hpp"
+#include "mmvk/animation/foot_locker.hpp"
+#include "mmvk/animation/pose_batch.hpp"
 
 namespace mmvk::bench {
 

@@ -1,4 +1,4 @@
-// The strict JSON check (mmvk/json_check.hpp: duplicate keys, trailing
+// The strict JSON check (mmvk/common/json_check.hpp: duplicate keys, trailing
 // bytes, depth) on crowd scenarios of 8, 16 and 46 MB: arrays of agent
 // objects as `mmvk crowd --scenario` reads them, the shape whose check was
 // quadratic in the number of objects (nlohmann's callback parser). The
@@ -11,7 +11,7 @@
 #include <cstdio>
 #include <string>
 
-#include "mmvk/json_check.hpp"
+#include "mmvk/common/json_check.hpp"
 
 namespace mmvk::bench {
 namespace {

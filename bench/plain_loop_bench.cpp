@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "query_streams.hpp"
 
 namespace mmvk::bench {

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::bench {
 

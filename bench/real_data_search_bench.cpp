@@ -21,16 +21,16 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "mmvk/backends.hpp"
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/search/cluster_search.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "query_streams.hpp"
 
 namespace mmvk::bench {
 namespace {
 
-// The rows: a registry backend (mmvk/backends.hpp) and, for the nprobe
+// The rows: a registry backend (mmvk/search/backends.hpp) and, for the nprobe
 // rows, the nprobe; the row's label is the backend's name plus the nprobe.
 struct Variant {
   std::string label;

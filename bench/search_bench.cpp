@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/fast_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/search/fast_search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "query_streams.hpp"
 
 namespace mmvk::bench {
@@ -69,7 +69,7 @@ Database synthetic_motion_database(std::uint32_t frames, std::uint64_t seed) {
   return std::move(Database::create(std::move(parts)).value());
 }
 
-// The rows: registry backends (mmvk/backends.hpp) by name, on the
+// The rows: registry backends (mmvk/search/backends.hpp) by name, on the
 // all-cores pool, plus fast-brute on a one-thread pool ("-1thread"): its CPU
 // time is the single-core kernel throughput, which a loaded machine disturbs
 // less than wall time.

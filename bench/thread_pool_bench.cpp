@@ -10,7 +10,7 @@
 
 #include <atomic>
 
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::bench {
 namespace {

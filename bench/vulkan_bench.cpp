@@ -24,10 +24,10 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "host_backends.hpp"
-#include "mmvk/backends.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "backends/host_backends.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 #if defined(MMVK_HAS_VULKAN)
 #include "mmvk/vulkan/vulkan_search.hpp"

@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "host_backends.hpp"
-#include "mmvk/backends.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "backends/host_backends.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "query_streams.hpp"
 
@@ -34,7 +34,7 @@ constexpr std::size_t kQueries = 1024;
 constexpr QueryStream kStreams[] = {QueryStream::Continue, QueryStream::Transition, QueryStream::Uniform};
 constexpr DataSet kSets[] = {DataSet::Locomotion, DataSet::Volume, DataSet::VolumeMirrored};
 constexpr std::uint32_t kBatches[] = {1, 64, 1024};
-// The rows: registry backends (mmvk/backends.hpp) by name, with the nprobe
+// The rows: registry backends (mmvk/search/backends.hpp) by name, with the nprobe
 // of the *-nprobe ones in the label.
 struct Variant {
   const char* label;

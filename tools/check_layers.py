@@ -9,10 +9,11 @@ Fails (exit 1, one line per include) on:
     runtime/vulkan/ (the white-box tests below are the declared exceptions);
   - an include by a relative path that climbs out of its folder ("../").
 
-Each public header (runtime/include/mmvk/X.hpp) belongs to the layer whose
-folder holds X.cpp; a header without a .cpp of its name is listed in
-HEADER_LAYERS. A public header the script cannot place is an error, so the
-table stays complete.
+Each public header lives in its layer's folder, runtime/include/mmvk/<layer>/,
+as the sources do in runtime/src/<layer>/, so its layer is where it is. The
+one header above the layers is mmvk/mmvk.hpp, the start-here header that
+includes them all: hosts, benchmarks and tests may include it, the runtime
+may not. A public header elsewhere is an error.
 
 usage: tools/check_layers.py [--root DIR]   (default: the repository holding this script)
 """
@@ -27,21 +28,8 @@ LAYERS = ["common", "import", "features", "database", "clusters", "search", "que
 # mmvk::vulkan (runtime/vulkan/) is a target of its own above this layer.
 VULKAN_USES_UP_TO = "search"
 
-# Public headers with no .cpp of their name.
-HEADER_LAYERS = {
-    "status": "common",
-    "hash": "common",
-    "json_check": "common",
-    "number_text": "common",
-    "bvh": "import",
-    "character": "import",
-    "cluster_table": "clusters",
-    "async_search": "search",
-    "pose_batch": "animation",
-    "spring": "animation",
-    # The start-here header includes the whole public API, up to the top layer.
-    "mmvk": "animation",
-}
+# The header above the layers (runtime/include/mmvk/mmvk.hpp).
+UMBRELLA = "mmvk/mmvk.hpp"
 
 # Tests that read a target's private headers on purpose, through an include
 # directory their CMake target declares (tests/CMakeLists.txt).
@@ -56,23 +44,17 @@ SCANNED = ["runtime", "host", "bench", "tests"]
 INCLUDE = re.compile(r'^[ \t]*#[ \t]*include[ \t]+"([^"]+)"', re.MULTILINE)
 
 
-def public_header_layers(root):
-    """{stem: layer} for runtime/include/mmvk/*.hpp, or an error list."""
-    stems_by_layer = {}
-    for layer in LAYERS:
-        folder = root / "runtime/src" / layer
-        if folder.is_dir():
-            for cpp in folder.glob("*.cpp"):
-                stems_by_layer.setdefault(cpp.stem, layer)
-    layers, errors = {}, []
-    for header in sorted((root / "runtime/include/mmvk").glob("*.hpp")):
-        layer = HEADER_LAYERS.get(header.stem) or stems_by_layer.get(header.stem)
-        if layer is None:
-            errors.append(f"runtime/include/mmvk/{header.name}: no layer (no {header.stem}.cpp under runtime/src/<layer>/"
-                          " and not in tools/check_layers.py's HEADER_LAYERS): add it there")
-        else:
-            layers[header.stem] = layer
-    return layers, errors
+def public_header_errors(root):
+    """Public headers outside a layer folder, as error lines."""
+    errors = []
+    base = root / "runtime/include/mmvk"
+    for header in sorted(base.rglob("*.hpp")) if base.is_dir() else []:
+        rel = header.relative_to(base)
+        if rel.as_posix() == "mmvk.hpp" or (len(rel.parts) == 2 and rel.parts[0] in LAYERS):
+            continue
+        errors.append(f"runtime/include/mmvk/{rel.as_posix()}: not in a layer folder: public headers live in"
+                      f" runtime/include/mmvk/<layer>/ ({', '.join(LAYERS)})")
+    return errors
 
 
 def rank(layer):
@@ -82,7 +64,7 @@ def rank(layer):
 class Checker:
     def __init__(self, root):
         self.root = root
-        self.public, self.errors = public_header_layers(root)
+        self.errors = public_header_errors(root)
 
     def fail(self, path, line, include, why):
         self.errors.append(f"{path}:{line}: #include \"{include}\": {why}")
@@ -92,20 +74,24 @@ class Checker:
         parts = rel.parts
         if parts[:2] == ("runtime", "src") and len(parts) > 3 and parts[2] in LAYERS:
             return parts[2]
+        if parts[:3] == ("runtime", "include", "mmvk") and len(parts) == 5 and parts[3] in LAYERS:
+            return parts[3]
         if parts[:3] == ("runtime", "include", "mmvk") and len(parts) == 4:
-            return self.public.get(Path(parts[3]).stem)
+            return "umbrella"
         if parts[:2] == ("runtime", "vulkan"):
             return "vulkan"
         return None
 
     def target_of(self, include, rel):
-        """Where an include lands: ("public", layer), ("vulkan-public",), ("private", layer),
+        """Where an include lands: ("public", layer), ("umbrella",), ("vulkan-public",), ("private", layer),
         ("vulkan-private",), or None (this folder's own header, a generated or system one)."""
         if include.startswith("mmvk/vulkan/"):
             return ("vulkan-public",)
-        if include.startswith("mmvk/") and include.count("/") == 1:
-            stem = Path(include).stem
-            return ("public", self.public[stem]) if stem in self.public else None
+        if include == UMBRELLA:
+            return ("umbrella",)
+        parts = include.split("/")
+        if len(parts) == 3 and parts[0] == "mmvk" and parts[1] in LAYERS:
+            return ("public", parts[1])
         if (self.root / rel.parent / include).is_file():
             return None  # next to the including file
         first = include.split("/")[0]
@@ -144,6 +130,11 @@ class Checker:
                 elif kind == "vulkan-private" and white_box != "runtime/vulkan/src":
                     self.fail(rel, line, include, "a private header of mmvk::vulkan (runtime/vulkan/src/);"
                               " what a host needs is public")
+            elif own == "umbrella":
+                if kind in ("private", "vulkan-private"):
+                    self.fail(rel, line, include, "mmvk/mmvk.hpp includes only public headers")
+            elif kind == "umbrella":
+                self.fail(rel, line, include, "the runtime includes the headers it needs, not mmvk/mmvk.hpp")
             elif own == "vulkan":
                 if kind == "private":
                     self.fail(rel, line, include, "mmvk::vulkan includes a private header of mmvk::runtime")

@@ -30,7 +30,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/database_io.hpp"
+#include "mmvk/database/database_io.hpp"
 
 namespace {
 

@@ -17,9 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "mmvk/database.hpp"
-#include "mmvk/search.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/search.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::peers {
 

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "bench_data.hpp"
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 #include "peer.hpp"
 #include "box_scan.hpp"
 #if defined(MMVK_HAS_FAISS)
@@ -62,7 +62,7 @@ double cluster_table_bytes(const ClusterTable& t) {
 // Tiles of 16 rows (kFastTileRows) that hold every frame.
 double tile_count(const Database& db) { return double((db.frame_count() + kFastTileRows - 1) / kFastTileRows); }
 
-// FastSearch's and ClusterSearch's tiled copy (mmvk/fast_search.hpp): rows
+// FastSearch's and ClusterSearch's tiled copy (mmvk/search/fast_search.hpp): rows
 // in tiles of 16, each tile with a min/max box, plus fast-box's group boxes
 // of 256 rows. Computed from the documented layout, not measured.
 double tiled_copy_bytes(const Database& db) {

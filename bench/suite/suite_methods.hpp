@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::vulkan {
 class VulkanSearch;

@@ -5,8 +5,8 @@
 // are absent.
 #pragma once
 
-#include "host_backends.hpp"
-#include "mmvk/search.hpp"
+#include "backends/host_backends.hpp"
+#include "mmvk/search/search.hpp"
 
 namespace mmvk::vulkan {
 class VulkanSearch;

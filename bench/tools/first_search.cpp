@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/database_io.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/database/database_io.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "mmvk/vulkan/vulkan_brute_force.hpp"

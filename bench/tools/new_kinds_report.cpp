@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/search/reference_search.hpp"
 
 namespace {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <string>
 
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 #include "cli_args.hpp"
 #include "contact_report.hpp"
 

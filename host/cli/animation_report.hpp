@@ -6,8 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mmvk/database.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::cli {
 

@@ -10,11 +10,11 @@
 #include "cli_args.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::cli {
 
@@ -22,7 +22,7 @@ namespace {
 
 constexpr const char* kBuildDescription =
     "Builds a motion matching database from BVH motion capture. A BVH file or a folder of BVH is built with the "
-    "default schema and options; a JSON manifest names clips, tags, flags and options (see runtime/include/mmvk/manifest.hpp).";
+    "default schema and options; a JSON manifest names clips, tags, flags and options (see runtime/include/mmvk/database/manifest.hpp).";
 
 // The command line, parsed: overrides of the manifest and build options.
 struct BuildArgs {

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::cli {
 

@@ -9,10 +9,10 @@
 #include "cli_args.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::cli {
 

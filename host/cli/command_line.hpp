@@ -13,7 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::cli {
 

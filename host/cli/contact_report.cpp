@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/animation_data.hpp"
+#include "mmvk/database/animation_data.hpp"
 
 namespace mmvk::cli {
 

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::cli {
 

@@ -11,9 +11,9 @@
 #include "command_line.hpp"
 #include "animation_report.hpp"
 #include "commands.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/hash.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/hash.hpp"
 
 namespace mmvk::cli {
 

@@ -10,11 +10,11 @@
 #include "cli_args.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/gait_coverage.hpp"
-#include "mmvk/hash.hpp"
-#include "mmvk/input_text.hpp"
-#include "mmvk/normalization.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/database/gait_coverage.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/common/input_text.hpp"
+#include "mmvk/features/normalization.hpp"
 #include "animation_report.hpp"
 #include "units_report.hpp"
 
@@ -22,7 +22,7 @@ namespace mmvk::cli {
 
 namespace {
 
-// Names are shown with the input-text rule (mmvk/input_text.hpp); a path
+// Names are shown with the input-text rule (mmvk/common/input_text.hpp); a path
 // the user typed and the joined lists are longer than one name, so they get
 // bounds of their own.
 constexpr std::size_t kMaxPathBytes = 4096;
@@ -106,7 +106,7 @@ nlohmann::json channels_json(const Database& db, const std::vector<RawDimStats>&
   return channels;
 }
 
-// The measured gait tags' coverage (mmvk/gait_coverage.hpp); null when the
+// The measured gait tags' coverage (mmvk/database/gait_coverage.hpp); null when the
 // database has none.
 nlohmann::json gait_json(const Database& db) {
   const GaitCoverage coverage = measure_gait_coverage(db);

@@ -10,7 +10,7 @@
 
 #include "commands.hpp"
 #include "help_format.hpp"
-#include "mmvk/database_io.hpp"
+#include "mmvk/database/database_io.hpp"
 
 namespace {
 

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "cli_args.hpp"
-#include "gait_speeds.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/pose_batch.hpp"
+#include "steering/gait_speeds.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/animation/pose_batch.hpp"
 
 namespace mmvk::cli {
 

@@ -19,18 +19,18 @@
 #include <pybind11/stl.h>
 
 #include "arrays.hpp"
-#include "bvh_export.hpp"
+#include "output/bvh_export.hpp"
 #include "bindings.hpp"
-#include "crowd_defaults.hpp"
-#include "crowd_limits.hpp"
-#include "crowd_session.hpp"
+#include "setup/crowd_defaults.hpp"
+#include "setup/crowd_limits.hpp"
+#include "setup/crowd_session.hpp"
 #include "errors.hpp"
-#include "gltf_export.hpp"
-#include "mmvk/number_text.hpp"
-#include "mmvk/steering_input.hpp"
-#include "pose_recording.hpp"
-#include "scenario.hpp"
-#include "summary.hpp"
+#include "output/gltf_export.hpp"
+#include "mmvk/common/number_text.hpp"
+#include "mmvk/animation/steering_input.hpp"
+#include "output/pose_recording.hpp"
+#include "steering/scenario.hpp"
+#include "measure/summary.hpp"
 
 namespace mmvk::python {
 
@@ -97,7 +97,7 @@ class PyCrowd {
   }
 
   // Velocities from the host's positions at the end of this tick
-  // (PositionSteering, mmvk/steering_input.hpp).
+  // (PositionSteering, mmvk/animation/steering_input.hpp).
   void step_toward(const py::object& next_positions, const py::object& desired_facing) {
     const auto held = lock();
     read_xz(next_positions, "next_positions", next_);
@@ -288,7 +288,7 @@ void add_stepping(py::class_<PyCrowd>& crowd) {
       .def("step_toward", &PyCrowd::step_toward, py::arg("next_positions"), py::arg("desired_facing") = py::none(),
            "One tick toward the host's positions at the end of the tick: float32 [agents x 2] (x, z) or [agents x 3], "
            "metres. The desired velocity is the host's own motion plus a correction of the gap over 0.2 s "
-           "(mmvk/steering_input.hpp: PositionSteering). desired_facing as for step().")
+           "(mmvk/animation/steering_input.hpp: PositionSteering). desired_facing as for step().")
       .def("run", &PyCrowd::run, py::arg("seconds"),
            "Steps the crowd's own steering for `seconds` of simulated time (rounded to whole ticks), GIL released.")
       .def(

@@ -16,13 +16,13 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "errors.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/json_check.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/json_check.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::python {
 
@@ -109,7 +109,7 @@ py::array normalized_features(const Database& db, const py::handle& raw) {
   return out;
 }
 
-// `text` parsed with the library's checks (mmvk/json_check.hpp: duplicate
+// `text` parsed with the library's checks (mmvk/common/json_check.hpp: duplicate
 // keys, bytes after the value, nesting depth), so that the merge path below
 // refuses what build(path) and `mmvk build` refuse, and never walks or
 // dumps a document nested deeply enough to overflow the stack.

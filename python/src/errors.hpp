@@ -12,7 +12,7 @@
 
 #include <pybind11/pybind11.h>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::python {
 

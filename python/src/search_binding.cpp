@@ -17,12 +17,12 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "errors.hpp"
-#include "host_backends.hpp"
-#include "mmvk/backends.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/query_builder.hpp"
-#include "mmvk/search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "backends/host_backends.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/query/query_builder.hpp"
+#include "mmvk/search/search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::python {
 

@@ -5,14 +5,14 @@
 #include <cmath>
 #include <random>
 
-#include "mmvk/hash.hpp"
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/query_assembly.hpp"
-#include "mmvk/reference_search.hpp"
-#include "mmvk/spring.hpp"
-#include "mmvk/trajectory.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/query/query_assembly.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "mmvk/animation/spring.hpp"
+#include "mmvk/animation/trajectory.hpp"
 
 namespace mmvk {
 namespace {

@@ -1,4 +1,4 @@
-// The backend registry (mmvk/backends.hpp): every CPU name makes a backend
+// The backend registry (mmvk/search/backends.hpp): every CPU name makes a backend
 // whose name() is that name, an unknown name lists the known ones, and the
 // spec's mistakes (no pool, nprobe 0, a table of another database, a
 // duplicate entry) are errors, not crashes; each backend reports its device.
@@ -9,8 +9,8 @@
 #include <set>
 #include <string>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "support/cluster_table_cache.hpp"
 #include "support/search_test_data.hpp"
 

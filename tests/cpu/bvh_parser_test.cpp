@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/bvh.hpp"
+#include "mmvk/import/bvh.hpp"
 #include "support/test_data.hpp"
 
 namespace {

@@ -5,9 +5,9 @@
 
 #include <set>
 
-#include "mmvk/channel_kinds.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/features.hpp"
+#include "mmvk/features/channel_kinds.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/features/features.hpp"
 #include "support/motion_fixtures.hpp"
 
 namespace mmvk {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/database_io.hpp"
+#include "mmvk/database/database_io.hpp"
 #include "support/command.hpp"
 #include "support/test_data.hpp"
 

@@ -8,9 +8,9 @@
 #include <random>
 #include <string>
 
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/fast_search.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/cluster_search.hpp"
+#include "mmvk/search/fast_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "support/clustered_data.hpp"
 
 namespace mmvk {

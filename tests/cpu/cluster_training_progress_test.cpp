@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "support/clustered_data.hpp"
 
 namespace mmvk {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "default_data.hpp"
+#include "setup/default_data.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk::crowd {

@@ -15,7 +15,7 @@
 
 #include <unistd.h>
 
-#include "driver_cache.hpp"
+#include "backends/driver_cache.hpp"
 
 namespace mmvk::crowd {
 namespace {

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "gait_plan.hpp"
-#include "gait_speeds.hpp"
-#include "mmvk/database_build.hpp"
-#include "scenario.hpp"
+#include "steering/gait_plan.hpp"
+#include "steering/gait_speeds.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "steering/scenario.hpp"
 #include "support/motion_fixtures.hpp"
 
 namespace mmvk::crowd {

@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "crowd_limits.hpp"
+#include "setup/crowd_limits.hpp"
 #include "support/search_test_data.hpp"
 
 namespace mmvk::crowd {

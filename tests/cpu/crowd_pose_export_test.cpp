@@ -11,11 +11,11 @@
 #include <filesystem>
 #include <vector>
 
-#include "default_data.hpp"
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/reference_search.hpp"
-#include "pose_recording.hpp"
+#include "setup/default_data.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "output/pose_recording.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk::crowd {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include "histogram.hpp"
-#include "motion_meter.hpp"
-#include "quality_meter.hpp"
+#include "measure/histogram.hpp"
+#include "measure/motion_meter.hpp"
+#include "measure/quality_meter.hpp"
 
 namespace mmvk::crowd {
 namespace {

@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <vector>
 
-#include "default_data.hpp"
-#include "mmvk/async_search.hpp"
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/reference_search.hpp"
-#include "tick_observers.hpp"
+#include "setup/default_data.hpp"
+#include "mmvk/search/async_search.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "measure/tick_observers.hpp"
 
 namespace mmvk::crowd {
 namespace {

@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "crowd_session.hpp"
-#include "default_data.hpp"
+#include "setup/crowd_session.hpp"
+#include "setup/default_data.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk::crowd {

@@ -9,11 +9,11 @@
 #include <fstream>
 #include <vector>
 
-#include "default_data.hpp"
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/reference_search.hpp"
+#include "setup/default_data.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "support/test_data.hpp"
-#include "trace.hpp"
+#include "output/trace.hpp"
 
 namespace mmvk::crowd {
 namespace {

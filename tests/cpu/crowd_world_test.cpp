@@ -7,10 +7,10 @@
 #include <cmath>
 #include <set>
 
-#include "random.hpp"
-#include "scenario.hpp"
-#include "spatial_grid.hpp"
-#include "steering.hpp"
+#include "steering/random.hpp"
+#include "steering/scenario.hpp"
+#include "steering/spatial_grid.hpp"
+#include "steering/steering.hpp"
 
 namespace mmvk::crowd {
 namespace {

@@ -12,8 +12,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "mmvk/hash.hpp"
-#include "mmvk/database_io.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/database/database_io.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

@@ -7,10 +7,10 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/normalization.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/features/normalization.hpp"
 #include "support/motion_fixtures.hpp"
 
 namespace mmvk {

@@ -1,4 +1,4 @@
-// The public file I/O (mmvk/file_io.hpp): float32 row files round-trip bit
+// The public file I/O (mmvk/common/file_io.hpp): float32 row files round-trip bit
 // for bit, and wrong sizes are errors naming the file; the one writer
 // (exclusive temp files, devices and FIFOs written in place, failures that
 // keep the old file) and the one reader (regular files only, capped, never
@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 #include "support/device_nodes.hpp"
 #include "support/test_data.hpp"
 

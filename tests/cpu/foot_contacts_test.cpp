@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "fuzz/repair_mmdb.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
 
 namespace mmvk {
 namespace {

@@ -9,7 +9,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/foot_ik.hpp"
+#include "mmvk/animation/foot_ik.hpp"
 
 namespace mmvk {
 namespace {

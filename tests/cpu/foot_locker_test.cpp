@@ -12,9 +12,9 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/foot_locker.hpp"
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/animation/foot_locker.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk {
 namespace {

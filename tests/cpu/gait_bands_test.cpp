@@ -1,4 +1,4 @@
-// The measured gait tags (mmvk/gait_bands.hpp) on hand-made root paths and
+// The measured gait tags (mmvk/database/gait_bands.hpp) on hand-made root paths and
 // clips: bands, hysteresis, starts and stops, the manifest block, the
 // database build and the .mmdb round trip.
 #include <gtest/gtest.h>
@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/gait_bands.hpp"
-#include "mmvk/gait_coverage.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/database/gait_bands.hpp"
+#include "mmvk/database/gait_coverage.hpp"
+#include "mmvk/database/manifest.hpp"
 #include "support/motion_fixtures.hpp"
 
 namespace mmvk {

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/search.hpp"
+#include "mmvk/search/search.hpp"
 #include "search/half_float.hpp"
 #include "search/half_tile_store.hpp"
 #include "search/tile_kernels.hpp"

@@ -13,16 +13,16 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/hash.hpp"
-#include "mmvk/json_check.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/pose_query.hpp"
-#include "mmvk/motion.hpp"
-#include "mmvk/reference_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/common/json_check.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/query/pose_query.hpp"
+#include "mmvk/import/motion.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "support/search_test_data.hpp"
 #include "support/test_data.hpp"
 

@@ -1,4 +1,4 @@
-// The build's check of an import (mmvk/import_check.hpp) on the shipped CMU
+// The build's check of an import (mmvk/import/import_check.hpp) on the shipped CMU
 // subject 16 walk: right units and axis pass, a centimetre or metre reading
 // of its CMU ASF units and a Z-up reading of the Y-up file are refused with
 // the cause and the manifest field that fixes them, and accept_implausible
@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/import_check.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/import/import_check.hpp"
+#include "mmvk/database/manifest.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

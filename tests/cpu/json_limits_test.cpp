@@ -1,4 +1,4 @@
-// The JSON checks every input gets (mmvk/json_check.hpp), against hostile
+// The JSON checks every input gets (mmvk/common/json_check.hpp), against hostile
 // documents (issue 34): deep nesting is refused before anything walks it,
 // the check is linear in the number of objects, syntax errors give the
 // byte offset and the reason, and keys are echoed safely.
@@ -9,11 +9,11 @@
 #include <cmath>
 #include <string>
 
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/input_text.hpp"
-#include "mmvk/json_check.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/pose_query.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/common/input_text.hpp"
+#include "mmvk/common/json_check.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/query/pose_query.hpp"
 
 namespace mmvk {
 namespace {

@@ -3,9 +3,9 @@
 // manifest and the field; the user bone-pair table over the name heuristics.
 #include <gtest/gtest.h>
 
-#include "mmvk/character.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk {
 namespace {

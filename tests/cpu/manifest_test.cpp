@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "mmvk/manifest.hpp"
+#include "mmvk/database/manifest.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

@@ -7,9 +7,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/animation_data.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
+#include "mmvk/database/animation_data.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
 #include "support/command.hpp"
 #include "support/motion_fixtures.hpp"
 

@@ -10,9 +10,9 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/query_assembly.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/query/query_assembly.hpp"
 #include "support/motion_fixtures.hpp"
 
 namespace mmvk {

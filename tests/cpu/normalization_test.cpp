@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "mmvk/normalization.hpp"
+#include "mmvk/features/normalization.hpp"
 
 namespace mmvk {
 namespace {

@@ -15,7 +15,7 @@
 #include <string>
 #include <thread>
 
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 #include "support/device_nodes.hpp"
 #include "support/test_data.hpp"
 

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <vector>
 
-#include "mmvk/playback.hpp"
-#include "mmvk/root_history.hpp"
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/playback.hpp"
+#include "mmvk/animation/root_history.hpp"
+#include "mmvk/animation/spring.hpp"
 
 namespace mmvk {
 namespace {

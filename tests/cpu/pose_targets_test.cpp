@@ -2,7 +2,7 @@
 // name the file and the field.
 #include <gtest/gtest.h>
 
-#include "mmvk/pose_query.hpp"
+#include "mmvk/query/pose_query.hpp"
 
 namespace mmvk {
 namespace {

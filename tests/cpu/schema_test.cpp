@@ -3,7 +3,7 @@
 
 #include <fstream>
 
-#include "mmvk/feature_schema.hpp"
+#include "mmvk/features/feature_schema.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

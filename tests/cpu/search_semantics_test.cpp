@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/explain.hpp"
-#include "mmvk/query_builder.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/explain.hpp"
+#include "mmvk/query/query_builder.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "support/search_test_data.hpp"
 
 namespace mmvk::test {

@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/reference_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "support/search_test_data.hpp"
 #include "support/test_data.hpp"
 

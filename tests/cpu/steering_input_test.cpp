@@ -1,6 +1,6 @@
 // PositionSteering: a host's positions as the controller's desired
 // velocities (the host's motion plus a correction over the horizon).
-#include "mmvk/steering_input.hpp"
+#include "mmvk/animation/steering_input.hpp"
 
 #include <limits>
 #include <string>

@@ -8,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk {
 namespace {

@@ -12,12 +12,12 @@
 
 #include <glm/vec3.hpp>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/search/search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "support/test_data.hpp"
 
 namespace {

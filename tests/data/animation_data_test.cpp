@@ -12,10 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/pose_batch.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/animation/pose_batch.hpp"
 #include "support/command.hpp"
 #include "support/test_data.hpp"
 

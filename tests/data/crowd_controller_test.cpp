@@ -7,8 +7,8 @@
 
 #include <algorithm>
 
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "support/crowd_scenario.hpp"
 #include "support/test_data.hpp"
 

@@ -13,12 +13,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "default_data.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/foot_contacts.hpp"
-#include "mmvk/gait_coverage.hpp"
-#include "mmvk/manifest.hpp"
+#include "setup/default_data.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/features/foot_contacts.hpp"
+#include "mmvk/database/gait_coverage.hpp"
+#include "mmvk/database/manifest.hpp"
 #include "support/command.hpp"
 #include "support/test_data.hpp"
 

@@ -10,12 +10,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/normalization.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/features/normalization.hpp"
 #include "support/command.hpp"
 #include "support/test_data.hpp"
 

@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mmvk/foot_contacts.hpp"
+#include "mmvk/features/foot_contacts.hpp"
 #include "support/cli_fixture.hpp"
 #include "support/command.hpp"
 

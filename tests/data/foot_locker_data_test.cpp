@@ -11,10 +11,10 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/foot_locker.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/pose_batch.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/animation/foot_locker.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/animation/pose_batch.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

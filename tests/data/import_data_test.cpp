@@ -15,9 +15,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/import/motion.hpp"
 #include "support/test_data.hpp"
 
 namespace {

@@ -6,8 +6,8 @@
 
 #include <fstream>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/file_io.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/common/file_io.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <numbers>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

@@ -9,12 +9,12 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/pose_query.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/query/pose_query.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

@@ -1,4 +1,4 @@
-// FBX, glTF and COLLADA through assimp (mmvk/scene_import.hpp), on
+// FBX, glTF and COLLADA through assimp (mmvk/import/scene_import.hpp), on
 // assimp-testmodels' animated skeletons and on glTF files this test writes
 // from the project's BVH clips.
 //
@@ -28,12 +28,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/motion.hpp"
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/scene_import.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/import/motion.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/import/scene_import.hpp"
 #include "support/command.hpp"
 #include "support/test_data.hpp"
 

@@ -9,10 +9,10 @@
 #include <cmath>
 #include <vector>
 
-#include "mmvk/features.hpp"
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/query_assembly.hpp"
-#include "mmvk/spring.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/query/query_assembly.hpp"
+#include "mmvk/animation/spring.hpp"
 #include "support/new_kinds_data.hpp"
 #include "support/test_data.hpp"
 

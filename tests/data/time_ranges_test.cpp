@@ -8,8 +8,8 @@
 #include <cmath>
 #include <span>
 
-#include "mmvk/database_io.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "support/time_ranges_data.hpp"
 
 namespace mmvk {

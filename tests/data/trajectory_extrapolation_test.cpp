@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/import/motion.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk {

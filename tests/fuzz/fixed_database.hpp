@@ -5,7 +5,7 @@
 
 #include <utility>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::fuzz {
 

@@ -6,9 +6,9 @@
 #include <string_view>
 #include <vector>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/import/motion.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // Larger inputs only make each run slower; the parser's limits are

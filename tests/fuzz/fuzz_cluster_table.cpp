@@ -6,9 +6,9 @@
 #include <cstring>
 #include <string>
 
-#include "mmvk/hash.hpp"
+#include "mmvk/common/hash.hpp"
 #include "fixed_database.hpp"
-#include "mmvk/cluster_table.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
 #include "temp_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/database/manifest.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "mmvk/database_io.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/search/search.hpp"
 
 #if defined(MMVK_FUZZ_REPAIR)
 #include "repair_mmdb.hpp"

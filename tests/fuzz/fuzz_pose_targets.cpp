@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "mmvk/pose_query.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/query/pose_query.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "walk_database.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

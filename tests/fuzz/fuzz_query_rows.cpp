@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "fixed_database.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/search/search.hpp"
 #include "temp_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -10,8 +10,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "crowd_limits.hpp"
-#include "scenario.hpp"
+#include "setup/crowd_limits.hpp"
+#include "steering/scenario.hpp"
 
 namespace {
 

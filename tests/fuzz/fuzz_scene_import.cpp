@@ -20,8 +20,8 @@
 
 #include <assimp/scene.h>
 
-#include "mmvk/import_check.hpp"
-#include "mmvk/scene_import.hpp"
+#include "mmvk/import/import_check.hpp"
+#include "mmvk/import/scene_import.hpp"
 
 namespace {
 

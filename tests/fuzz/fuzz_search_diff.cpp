@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "repair_mmdb.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/json_check.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/common/json_check.hpp"
 #include "fixed_database.hpp"
 #include "walk_database.hpp"
 

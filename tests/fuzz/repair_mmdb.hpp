@@ -7,8 +7,8 @@
 #include <cstring>
 #include <string>
 
-#include "mmvk/hash.hpp"
-#include "mmvk/database_io.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/database/database_io.hpp"
 
 namespace mmvk::fuzz {
 

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/database_build.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/database/database_build.hpp"
 
 namespace mmvk::fuzz {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "mmvk/mmvk.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 
 int main() {
   mmvk::DatabaseParts parts;

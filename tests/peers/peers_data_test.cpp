@@ -27,10 +27,10 @@
 
 #include "box_scan.hpp"
 #include "faiss_peers.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/reference_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "query_streams.hpp"
 #include "support/test_data.hpp"
 #if defined(MMVK_HAS_NANOFLANN)

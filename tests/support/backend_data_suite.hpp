@@ -13,9 +13,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
-#include "mmvk/reference_search.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "support/new_kinds_data.hpp"
 #include "support/search_test_data.hpp"
 #include "support/test_data.hpp"

@@ -35,9 +35,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/database.hpp"
-#include "mmvk/reference_search.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "mmvk/search/search.hpp"
 #include "support/search_test_data.hpp"
 
 namespace mmvk::test {

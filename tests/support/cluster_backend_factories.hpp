@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 #include "support/cluster_table_cache.hpp"
 
 namespace mmvk::test {

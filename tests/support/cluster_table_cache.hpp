@@ -9,8 +9,8 @@
 #include <map>
 #include <memory>
 
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::test {
 

@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/database.hpp"
-#include "mmvk/feature_schema.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/features/feature_schema.hpp"
 
 namespace mmvk::test {
 

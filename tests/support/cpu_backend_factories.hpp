@@ -1,12 +1,12 @@
 // Factories of the CPU backends for the typed backend suites
 // (backend_suite.hpp, backend_data_suite.hpp), made through the backend
-// registry (mmvk/backends.hpp) like every other user makes them.
+// registry (mmvk/search/backends.hpp) like every other user makes them.
 #pragma once
 
 #include <memory>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::test {
 

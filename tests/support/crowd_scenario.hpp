@@ -10,9 +10,9 @@
 #include <functional>
 #include <vector>
 
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
 
 namespace mmvk::test {
 

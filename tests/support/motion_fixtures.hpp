@@ -8,8 +8,8 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "mmvk/character.hpp"
-#include "mmvk/features.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/features/features.hpp"
 
 namespace mmvk::test {
 

@@ -13,9 +13,9 @@
 #include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/manifest.hpp"
 
 namespace mmvk::test {
 

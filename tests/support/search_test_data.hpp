@@ -16,10 +16,10 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 
-#include "mmvk/database.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/search.hpp"
 
 namespace mmvk::test {
 

@@ -13,8 +13,8 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/database_build.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/database/database_build.hpp"
 #include "support/test_data.hpp"
 
 namespace mmvk::test {

@@ -12,23 +12,25 @@ SCRIPT = Path(__file__).resolve().parents[2] / "tools" / "check_layers.py"
 
 # A small tree in the repository's shape, every include allowed.
 GOOD_TREE = {
-    "runtime/include/mmvk/status.hpp": "",
-    "runtime/include/mmvk/feature_schema.hpp": '#include "mmvk/status.hpp"\n',
-    "runtime/include/mmvk/normalization.hpp": '#include "mmvk/feature_schema.hpp"\n',
-    "runtime/include/mmvk/database.hpp": '#include "mmvk/normalization.hpp"\n',
-    "runtime/include/mmvk/search.hpp": '#include "mmvk/database.hpp"\n',
-    "runtime/src/features/feature_schema.cpp": '#include "mmvk/feature_schema.hpp"\n',
-    "runtime/src/features/normalization.cpp": '#include "mmvk/normalization.hpp"\n',
-    "runtime/src/database/database.cpp": '#include "mmvk/database.hpp"\n#include "database/cost_bound.hpp"\n',
-    "runtime/src/database/cost_bound.hpp": '#include "mmvk/database.hpp"\n',
-    "runtime/src/search/search.cpp": '#include "mmvk/search.hpp"\n#include "database/cost_bound.hpp"\n',
-    "runtime/vulkan/include/mmvk/vulkan/context.hpp": '#include "mmvk/status.hpp"\n',
+    "runtime/include/mmvk/common/status.hpp": "",
+    "runtime/include/mmvk/features/feature_schema.hpp": '#include "mmvk/common/status.hpp"\n',
+    "runtime/include/mmvk/features/normalization.hpp": '#include "mmvk/features/feature_schema.hpp"\n',
+    "runtime/include/mmvk/database/database.hpp": '#include "mmvk/features/normalization.hpp"\n',
+    "runtime/include/mmvk/search/search.hpp": '#include "mmvk/database/database.hpp"\n',
+    "runtime/include/mmvk/mmvk.hpp": '#include "mmvk/search/search.hpp"\n',
+    "runtime/src/features/feature_schema.cpp": '#include "mmvk/features/feature_schema.hpp"\n',
+    "runtime/src/features/normalization.cpp": '#include "mmvk/features/normalization.hpp"\n',
+    "runtime/src/database/database.cpp": '#include "mmvk/database/database.hpp"\n#include "database/cost_bound.hpp"\n',
+    "runtime/src/database/cost_bound.hpp": '#include "mmvk/database/database.hpp"\n',
+    "runtime/src/search/search.cpp": '#include "mmvk/search/search.hpp"\n#include "database/cost_bound.hpp"\n',
+    "runtime/vulkan/include/mmvk/vulkan/context.hpp": '#include "mmvk/common/status.hpp"\n',
     "runtime/vulkan/src/check.hpp": '#include "mmvk/vulkan/context.hpp"\n',
-    "runtime/vulkan/src/context.cpp": '#include "check.hpp"\n#include "mmvk/search.hpp"\n',
-    "host/cli/main.cpp": '#include "commands.hpp"\n#include "mmvk/search.hpp"\n#include "mmvk/vulkan/context.hpp"\n',
+    "runtime/vulkan/src/context.cpp": '#include "check.hpp"\n#include "mmvk/search/search.hpp"\n',
+    "host/cli/main.cpp": '#include "commands.hpp"\n#include "mmvk/search/search.hpp"\n#include "mmvk/vulkan/context.hpp"\n',
     "host/cli/commands.hpp": "",
-    "tests/cpu/search_test.cpp": '#include "support/data.hpp"\n#include "mmvk/search.hpp"\n',
-    "tests/support/data.hpp": '#include "mmvk/database.hpp"\n',
+    "tests/cpu/search_test.cpp": '#include "support/data.hpp"\n#include "mmvk/search/search.hpp"\n',
+    "tests/cpu/start_here_test.cpp": '#include "mmvk/mmvk.hpp"\n',
+    "tests/support/data.hpp": '#include "mmvk/database/database.hpp"\n',
 }
 
 
@@ -61,13 +63,13 @@ class CheckLayersTest(unittest.TestCase):
 
     def test_a_public_header_that_includes_a_higher_layer_fails(self):
         # The case: normalization.hpp (features) including database.hpp.
-        self.assert_fails(with_file("runtime/include/mmvk/normalization.hpp",
-                                    '#include "mmvk/feature_schema.hpp"\n#include "mmvk/database.hpp"\n'),
-                          "runtime/include/mmvk/normalization.hpp:2", "goes up a layer: features includes database")
+        self.assert_fails(with_file("runtime/include/mmvk/features/normalization.hpp",
+                                    '#include "mmvk/features/feature_schema.hpp"\n#include "mmvk/database/database.hpp"\n'),
+                          "runtime/include/mmvk/features/normalization.hpp:2", "goes up a layer: features includes database")
 
     def test_a_source_that_includes_a_higher_layers_private_header_fails(self):
         tree = with_file("runtime/src/search/cost_bound.hpp", "")
-        tree["runtime/src/database/database.cpp"] = '#include "mmvk/database.hpp"\n#include "search/cost_bound.hpp"\n'
+        tree["runtime/src/database/database.cpp"] = '#include "mmvk/database/database.hpp"\n#include "search/cost_bound.hpp"\n'
         self.assert_fails(tree, "runtime/src/database/database.cpp:2", "database includes search")
 
     def test_the_runtime_including_the_vulkan_target_fails(self):
@@ -84,8 +86,13 @@ class CheckLayersTest(unittest.TestCase):
         self.assert_fails(with_file("tests/cpu/cost_test.cpp", '#include "../../runtime/src/database/cost_bound.hpp"\n'),
                           "tests/cpu/cost_test.cpp:1", "relative path")
 
-    def test_a_public_header_without_a_layer_fails(self):
-        self.assert_fails(with_file("runtime/include/mmvk/mystery.hpp", ""), "mystery.hpp: no layer")
+    def test_a_public_header_outside_a_layer_folder_fails(self):
+        self.assert_fails(with_file("runtime/include/mmvk/mystery.hpp", ""), "mystery.hpp: not in a layer folder")
+        self.assert_fails(with_file("runtime/include/mmvk/misc/mystery.hpp", ""), "misc/mystery.hpp: not in a layer")
+
+    def test_the_runtime_including_the_start_here_header_fails(self):
+        self.assert_fails(with_file("runtime/src/search/search.cpp", '#include "mmvk/mmvk.hpp"\n'),
+                          "runtime/src/search/search.cpp:1", "not mmvk/mmvk.hpp")
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@
 // continuing_multiplier (fewer jumps, the same frames on both).
 #include <gtest/gtest.h>
 
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "mmvk/vulkan/vulkan_async_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/crowd_scenario.hpp"

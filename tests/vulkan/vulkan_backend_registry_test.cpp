@@ -8,7 +8,7 @@
 #include <set>
 #include <string>
 
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 #include "mmvk/vulkan/backends.hpp"
 #include "support/cluster_table_cache.hpp"
 #include "support/search_test_data.hpp"

@@ -3,7 +3,7 @@
 // which must report zero messages.
 #include <memory>
 
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 #include "mmvk/vulkan/backends.hpp"
 #include "support/backend_data_suite.hpp"
 #include "support/backend_suite.hpp"

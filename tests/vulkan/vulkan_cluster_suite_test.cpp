@@ -8,9 +8,9 @@
 #include <memory>
 #include <string_view>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/cluster_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/search/cluster_search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 #include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/vulkan_brute_force.hpp"
 #include "mmvk/vulkan/vulkan_cluster_search.hpp"

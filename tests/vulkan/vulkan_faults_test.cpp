@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "mmvk/vulkan/vulkan_async_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/search_test_data.hpp"

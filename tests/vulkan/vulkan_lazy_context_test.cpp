@@ -7,7 +7,7 @@
 #include <memory>
 #include <system_error>
 
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 #include "mmvk/vulkan/lazy_context.hpp"
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "support/search_test_data.hpp"

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <vector>
 
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "mmvk/vulkan/pipeline_cache_file.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "support/device_nodes.hpp"

@@ -8,7 +8,7 @@
 #include <optional>
 #include <thread>
 
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 #include "mmvk/vulkan/vulkan_async_search.hpp"
 #include "mmvk/vulkan/vulkan_cluster_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 #include "mmvk/vulkan/backends.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_brute_force.hpp"

@@ -3,8 +3,8 @@
 // that draws garbage.
 #pragma once
 
-#include "mmvk/status.hpp"
-#include "recording.hpp"
+#include "mmvk/common/status.hpp"
+#include "output/recording.hpp"
 
 namespace mmvk::crowd {
 

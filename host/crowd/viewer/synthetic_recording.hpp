@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "recording.hpp"
+#include "output/recording.hpp"
 
 namespace mmvk::crowd {
 

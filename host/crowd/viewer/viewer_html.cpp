@@ -4,7 +4,7 @@
 #include <array>
 #include <string_view>
 
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 #include "mmvk_viewer_assets.hpp"  // generated from viewer.html, its scripts and three.js
 #include "viewer/recording_check.hpp"
 #include "viewer/viewer_payload.hpp"

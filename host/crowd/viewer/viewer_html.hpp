@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <string>
 
-#include "mmvk/status.hpp"
-#include "recording.hpp"
+#include "mmvk/common/status.hpp"
+#include "output/recording.hpp"
 
 namespace mmvk::crowd {
 

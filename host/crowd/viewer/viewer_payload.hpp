@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/status.hpp"
-#include "recording.hpp"
+#include "mmvk/common/status.hpp"
+#include "output/recording.hpp"
 
 namespace mmvk::crowd {
 

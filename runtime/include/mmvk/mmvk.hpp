@@ -33,27 +33,27 @@
 // for characters CrowdController::create -> place -> tick -> world_positions.
 #pragma once
 
-#include "mmvk/status.hpp"
-#include "mmvk/thread_pool.hpp"
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/status.hpp"
+#include "mmvk/common/thread_pool.hpp"
+#include "mmvk/common/file_io.hpp"
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/import/motion.hpp"
 
-#include "mmvk/feature_schema.hpp"
+#include "mmvk/features/feature_schema.hpp"
 
-#include "mmvk/database.hpp"
-#include "mmvk/database_build.hpp"
-#include "mmvk/database_io.hpp"
-#include "mmvk/manifest.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/database/database_build.hpp"
+#include "mmvk/database/database_io.hpp"
+#include "mmvk/database/manifest.hpp"
 
-#include "mmvk/cluster_table.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
 
-#include "mmvk/async_search.hpp"
-#include "mmvk/backends.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/search/async_search.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/search/search.hpp"
 
-#include "mmvk/query_builder.hpp"
+#include "mmvk/query/query_builder.hpp"
 
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/animation/crowd_controller.hpp"

@@ -3,7 +3,7 @@
 
 #include <cstddef>
 
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::detail {
 

@@ -1,7 +1,7 @@
 // The batched motion matching controller loop (crowd_controller.hpp): the
 // state's setup, placement and the two ticks. The passes of a tick are in
 // crowd_controller_passes.cpp.
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <string>
 
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/spring.hpp"
 #include "play_rate.hpp"
 
 namespace mmvk {

@@ -5,9 +5,9 @@
 #include <cmath>
 
 #include "character_ranges.hpp"
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/playback.hpp"
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/animation/playback.hpp"
+#include "mmvk/animation/spring.hpp"
 #include "play_rate.hpp"
 #include "pose_velocity.hpp"
 #include "root_correction.hpp"

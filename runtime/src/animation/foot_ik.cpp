@@ -4,7 +4,7 @@
 // inverse trigonometry: acos of a clamped dot product is where the usual
 // formulations lose precision (and their derivative blows up) near a
 // straight leg.
-#include "mmvk/foot_ik.hpp"
+#include "mmvk/animation/foot_ik.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // Foot locking (foot_locker.hpp): per foot a horizontal and a yaw correction
 // that hold a planted contact point on its anchor and decay after release;
 // the hips lowered for out-of-reach targets; two-bone IK on the result.
-#include "mmvk/foot_locker.hpp"
+#include "mmvk/animation/foot_locker.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -11,9 +11,9 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/character.hpp"
-#include "mmvk/foot_ik.hpp"
-#include "mmvk/spring.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/animation/foot_ik.hpp"
+#include "mmvk/animation/spring.hpp"
 #include "yaw.hpp"
 
 namespace mmvk {

@@ -3,8 +3,8 @@
 #include <cassert>
 #include <cmath>
 
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/animation/spring.hpp"
 
 namespace mmvk {
 

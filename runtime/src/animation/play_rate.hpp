@@ -8,8 +8,8 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/crowd_controller.hpp"
-#include "mmvk/database.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::detail {
 

@@ -1,10 +1,10 @@
 // Sub-frame playback (playback.hpp).
-#include "mmvk/playback.hpp"
+#include "mmvk/animation/playback.hpp"
 
 #include <cassert>
 #include <cmath>
 
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/spring.hpp"
 #include "yaw.hpp"
 
 namespace mmvk {

@@ -3,9 +3,9 @@
 #include <cassert>
 #include <cmath>
 
-#include "mmvk/animation_data.hpp"
-#include "mmvk/pose_batch.hpp"
-#include "mmvk/spring.hpp"
+#include "mmvk/database/animation_data.hpp"
+#include "mmvk/animation/pose_batch.hpp"
+#include "mmvk/animation/spring.hpp"
 #include "yaw.hpp"
 
 namespace mmvk {

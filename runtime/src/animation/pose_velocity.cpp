@@ -3,7 +3,7 @@
 
 #include <utility>
 
-#include "mmvk/pose_batch.hpp"
+#include "mmvk/animation/pose_batch.hpp"
 
 namespace mmvk::detail {
 

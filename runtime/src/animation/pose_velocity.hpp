@@ -8,8 +8,8 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
-#include "mmvk/animation_data.hpp"
-#include "mmvk/database.hpp"
+#include "mmvk/database/animation_data.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::detail {
 

@@ -6,7 +6,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/spring.hpp"
 
 namespace mmvk::detail {
 

@@ -4,7 +4,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "mmvk/crowd_controller.hpp"
+#include "mmvk/animation/crowd_controller.hpp"
 
 namespace mmvk::detail {
 

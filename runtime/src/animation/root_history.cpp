@@ -1,11 +1,11 @@
 // The recorded root path of each character (root_history.hpp).
-#include "mmvk/root_history.hpp"
+#include "mmvk/animation/root_history.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/spring.hpp"
 
 namespace mmvk {
 

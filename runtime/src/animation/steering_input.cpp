@@ -1,4 +1,4 @@
-#include "mmvk/steering_input.hpp"
+#include "mmvk/animation/steering_input.hpp"
 
 #include <cmath>
 #include <string>

@@ -1,10 +1,10 @@
 // The simulated root and its prediction (trajectory.hpp).
-#include "mmvk/trajectory.hpp"
+#include "mmvk/animation/trajectory.hpp"
 
 #include <cassert>
 #include <cmath>
 
-#include "mmvk/spring.hpp"
+#include "mmvk/animation/spring.hpp"
 
 namespace mmvk {
 

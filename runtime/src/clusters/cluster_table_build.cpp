@@ -7,7 +7,7 @@
 #include <string>
 
 #include "clusters/cluster_table_build.hpp"
-#include "mmvk/hash.hpp"
+#include "mmvk/common/hash.hpp"
 
 namespace mmvk::detail {
 

@@ -5,8 +5,8 @@
 #include <functional>
 #include <vector>
 
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk::detail {
 

@@ -20,9 +20,9 @@
 #include <cstring>
 #include <string>
 
-#include "mmvk/file_io.hpp"
-#include "mmvk/hash.hpp"
-#include "mmvk/cluster_table.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
 
 namespace mmvk {
 

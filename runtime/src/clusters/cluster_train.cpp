@@ -11,8 +11,8 @@
 #include <string>
 
 #include "clusters/cluster_table_build.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk {
 

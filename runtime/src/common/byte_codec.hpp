@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 
 namespace mmvk::detail {
 

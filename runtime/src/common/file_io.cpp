@@ -1,4 +1,4 @@
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

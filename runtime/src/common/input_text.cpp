@@ -1,4 +1,4 @@
-#include "mmvk/input_text.hpp"
+#include "mmvk/common/input_text.hpp"
 
 #include <algorithm>
 #include <cstdio>

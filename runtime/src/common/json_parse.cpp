@@ -1,7 +1,7 @@
 #include "common/json_parse.hpp"
 
-#include "mmvk/input_text.hpp"
-#include "mmvk/json_check.hpp"
+#include "mmvk/common/input_text.hpp"
+#include "mmvk/common/json_check.hpp"
 
 #include <cmath>
 #include <utility>

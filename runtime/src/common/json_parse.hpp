@@ -9,11 +9,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::detail {
 
-// Parses `text` with the checks of mmvk/json_check.hpp, in time linear in
+// Parses `text` with the checks of mmvk/common/json_check.hpp, in time linear in
 // its size; errors name `source`: "not valid JSON at byte N: <reason>"
 // (bytes after the value included), a NUL byte, a duplicate key or nesting
 // deeper than kMaxJsonDepth. What it returns may be walked and dumped

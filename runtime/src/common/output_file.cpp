@@ -1,4 +1,4 @@
-// The one writer for every mmvk output (mmvk/file_io.hpp: OutputFile).
+// The one writer for every mmvk output (mmvk/common/file_io.hpp: OutputFile).
 //
 // The old writer opened "<out>.tmp-<pid>" with O_CREAT | O_TRUNC, so a
 // symlink planted at that predictable name redirected the write anywhere, and
@@ -7,10 +7,10 @@
 // Here the kind of target decides first (replace a regular file, write a
 // device or FIFO in place, write an open descriptor through itself), and the
 // temp file is created exclusively under a random name.
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 
 #include "common/temp_files.hpp"
-#include "mmvk/number_text.hpp"
+#include "mmvk/common/number_text.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -1,8 +1,8 @@
-// The up-front checks of a command's paths (mmvk/file_io.hpp:
+// The up-front checks of a command's paths (mmvk/common/file_io.hpp:
 // check_command_paths). Without them `mmvk export a.mmdb --features a.mmdb`
 // replaced its own input and exited 0, and two outputs given one path kept
 // only the last while the messages named both.
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 
 namespace mmvk {
 

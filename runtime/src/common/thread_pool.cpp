@@ -1,4 +1,4 @@
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 #include <chrono>
 #include <system_error>

@@ -6,7 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include "features/foot_contacts.hpp"
-#include "mmvk/character.hpp"
+#include "mmvk/import/character.hpp"
 
 namespace mmvk::detail {
 

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/animation_data.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/motion.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/animation_data.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/import/motion.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::detail {
 

@@ -1,5 +1,5 @@
 // Validation and sizes of the animation section (animation_data.hpp).
-#include "mmvk/animation_data.hpp"
+#include "mmvk/database/animation_data.hpp"
 
 #include <cmath>
 #include <string>

@@ -9,7 +9,7 @@
 #include <limits>
 #include <span>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 
 namespace mmvk::detail {
 

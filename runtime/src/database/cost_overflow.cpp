@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "database/cost_bound.hpp"
-#include "mmvk/number_text.hpp"
+#include "mmvk/common/number_text.hpp"
 
 namespace mmvk::detail {
 

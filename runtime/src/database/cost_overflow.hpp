@@ -7,8 +7,8 @@
 
 #include <string>
 
-#include "mmvk/database.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::detail {
 

@@ -1,10 +1,10 @@
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <set>
 
-#include "mmvk/hash.hpp"
+#include "mmvk/common/hash.hpp"
 
 namespace mmvk {
 

@@ -1,4 +1,4 @@
-#include "mmvk/database_build.hpp"
+#include "mmvk/database/database_build.hpp"
 
 #include <algorithm>
 #include <array>
@@ -8,12 +8,12 @@
 #include <mutex>
 #include <optional>
 
-#include "mmvk/bvh.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/import_check.hpp"
-#include "mmvk/normalization.hpp"
-#include "mmvk/scene_import.hpp"
+#include "mmvk/import/bvh.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/import/import_check.hpp"
+#include "mmvk/features/normalization.hpp"
+#include "mmvk/import/scene_import.hpp"
 #include "database/animation_build.hpp"
 #include "database/cost_overflow.hpp"
 

@@ -1,4 +1,4 @@
-#include "mmvk/database_io.hpp"
+#include "mmvk/database/database_io.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -10,9 +10,9 @@
 #include <cstring>
 #include <span>
 
-#include "mmvk/character.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/hash.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/hash.hpp"
 #include "common/byte_codec.hpp"
 
 namespace mmvk {

@@ -1,9 +1,9 @@
-#include "mmvk/gait_bands.hpp"
+#include "mmvk/database/gait_bands.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "mmvk/number_text.hpp"
+#include "mmvk/common/number_text.hpp"
 
 namespace mmvk {
 

@@ -1,12 +1,12 @@
-#include "mmvk/gait_coverage.hpp"
+#include "mmvk/database/gait_coverage.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <span>
 #include <vector>
 
-#include "mmvk/foot_contacts.hpp"
-#include "mmvk/number_text.hpp"
+#include "mmvk/features/foot_contacts.hpp"
+#include "mmvk/common/number_text.hpp"
 
 namespace mmvk {
 

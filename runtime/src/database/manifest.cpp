@@ -1,5 +1,5 @@
-#include "mmvk/manifest.hpp"
-#include "mmvk/scene_import.hpp"
+#include "mmvk/database/manifest.hpp"
+#include "mmvk/import/scene_import.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -13,8 +13,8 @@
 
 #include "common/json_parse.hpp"
 #include "common/name_table.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/input_text.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/input_text.hpp"
 
 namespace mmvk {
 

@@ -1,6 +1,6 @@
-// The files a manifest's build reads (mmvk/manifest.hpp).
-#include "mmvk/features.hpp"
-#include "mmvk/manifest.hpp"
+// The files a manifest's build reads (mmvk/database/manifest.hpp).
+#include "mmvk/features/features.hpp"
+#include "mmvk/database/manifest.hpp"
 
 namespace mmvk {
 

@@ -1,4 +1,4 @@
-// What a channel kind's extractor reads and writes (see mmvk/channel_kinds.hpp):
+// What a channel kind's extractor reads and writes (see mmvk/features/channel_kinds.hpp):
 // the clip's motion measured once (global joint positions, the root and its
 // future poses) and one channel's place in the output matrix. Extractors are
 // pure functions of this; extract_features() in features.cpp builds it.
@@ -8,10 +8,10 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/channel_kinds.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/features/channel_kinds.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk::detail {
 

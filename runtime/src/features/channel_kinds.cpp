@@ -1,7 +1,7 @@
 // The table of channel kinds and the extractors of the built-in kinds. The
 // rest of the library reads a kind's rules from here; a kind whose extractor
 // grows large keeps it in a file of its own and names it in the table.
-#include "mmvk/channel_kinds.hpp"
+#include "mmvk/features/channel_kinds.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "common/name_table.hpp"
 #include "features/channel_extraction.hpp"
-#include "mmvk/features.hpp"
+#include "mmvk/features/features.hpp"
 
 namespace mmvk {
 

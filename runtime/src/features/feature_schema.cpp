@@ -1,4 +1,4 @@
-#include "mmvk/feature_schema.hpp"
+#include "mmvk/features/feature_schema.hpp"
 
 #include <cmath>
 #include <set>

@@ -1,4 +1,4 @@
-#include "mmvk/features.hpp"
+#include "mmvk/features/features.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "features/channel_extraction.hpp"
 #include "features/foot_contacts.hpp"
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/file_io.hpp"
 
 namespace mmvk {
 

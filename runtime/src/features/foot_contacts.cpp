@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <string>
 
-#include "mmvk/character.hpp"
-#include "mmvk/number_text.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/common/number_text.hpp"
 
 namespace mmvk::detail {
 

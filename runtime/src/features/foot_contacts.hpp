@@ -10,8 +10,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "mmvk/foot_contacts.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/features/foot_contacts.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk::detail {
 

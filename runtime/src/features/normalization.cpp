@@ -1,4 +1,4 @@
-#include "mmvk/normalization.hpp"
+#include "mmvk/features/normalization.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <string>
 
 #include "common/name_table.hpp"
-#include "mmvk/number_text.hpp"
+#include "mmvk/common/number_text.hpp"
 
 namespace mmvk {
 

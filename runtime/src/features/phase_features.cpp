@@ -16,7 +16,7 @@
 
 #include "features/channel_extraction.hpp"
 #include "features/real_fft.hpp"
-#include "mmvk/features.hpp"
+#include "mmvk/features/features.hpp"
 
 namespace mmvk::detail {
 

@@ -6,10 +6,10 @@
 #include <nlohmann/json.hpp>
 
 #include "common/json_parse.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/input_text.hpp"
-#include "mmvk/normalization.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/common/input_text.hpp"
+#include "mmvk/features/normalization.hpp"
 
 namespace mmvk {
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "common/name_table.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/input_text.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/common/input_text.hpp"
 
 namespace mmvk {
 

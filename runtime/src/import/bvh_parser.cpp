@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "import/bvh_lexer.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/input_text.hpp"
-#include "mmvk/bvh.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/input_text.hpp"
+#include "mmvk/import/bvh.hpp"
 
 namespace mmvk {
 
@@ -60,7 +60,7 @@ std::optional<BvhChannel> channel_from_name(std::string_view name) {
 
 // A short, printable excerpt of a token for error messages (garbage input can
 // hold control bytes or megabytes without a space): the rule of every
-// message that echoes input (mmvk/input_text.hpp).
+// message that echoes input (mmvk/common/input_text.hpp).
 std::string quote(std::string_view token) {
   std::string out = "'";
   out += printable_text(token, 40);

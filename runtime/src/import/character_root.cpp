@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/character.hpp"
+#include "mmvk/import/character.hpp"
 
 namespace mmvk {
 

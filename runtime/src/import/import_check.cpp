@@ -1,13 +1,13 @@
 // Measures of an imported motion, and the rule that stops a build whose
 // units or axes are wrong (import_check.hpp).
-#include "mmvk/import_check.hpp"
+#include "mmvk/import/import_check.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
-#include "mmvk/character.hpp"
+#include "mmvk/import/character.hpp"
 
 namespace mmvk {
 

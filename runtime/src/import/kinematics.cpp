@@ -1,7 +1,7 @@
 // Forward kinematics: local joint transforms -> model-space transforms.
 #include <cassert>
 
-#include "mmvk/motion.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk {
 

@@ -23,8 +23,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/character.hpp"
-#include "mmvk/motion.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk {
 

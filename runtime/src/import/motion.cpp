@@ -9,7 +9,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "mmvk/motion.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "mmvk/motion.hpp"
+#include "mmvk/import/motion.hpp"
 
 namespace mmvk {
 

@@ -1,7 +1,7 @@
 // assimp scene -> Motions: the skeleton's nodes, their world transforms
 // sampled at one rate, converted to metres and mmvk's Y-up frame, then
 // turned back into local transforms (scene_import.hpp has the rules).
-#include "mmvk/scene_import.hpp"
+#include "mmvk/import/scene_import.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <functional>
 
-#include "mmvk/scene_import.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/import/scene_import.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::detail {
 

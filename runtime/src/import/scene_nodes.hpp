@@ -9,8 +9,8 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
-#include "mmvk/motion.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/import/motion.hpp"
+#include "mmvk/common/status.hpp"
 
 struct aiScene;
 struct aiNode;

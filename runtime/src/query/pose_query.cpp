@@ -1,4 +1,4 @@
-#include "mmvk/pose_query.hpp"
+#include "mmvk/query/pose_query.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,10 +8,10 @@
 
 #include "common/json_parse.hpp"
 #include "database/cost_bound.hpp"
-#include "mmvk/channel_kinds.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/file_io.hpp"
-#include "mmvk/input_text.hpp"
+#include "mmvk/features/channel_kinds.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/common/file_io.hpp"
+#include "mmvk/common/input_text.hpp"
 
 namespace mmvk {
 

@@ -1,6 +1,6 @@
 // Batched query assembly (query_assembly.hpp): the schema is turned once into
 // copy runs and trajectory slots.
-#include "mmvk/query_assembly.hpp"
+#include "mmvk/query/query_assembly.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -8,10 +8,10 @@
 
 #include <glm/geometric.hpp>
 
-#include "mmvk/channel_kinds.hpp"
-#include "mmvk/character.hpp"
-#include "mmvk/features.hpp"
-#include "mmvk/foot_contacts.hpp"
+#include "mmvk/features/channel_kinds.hpp"
+#include "mmvk/import/character.hpp"
+#include "mmvk/features/features.hpp"
+#include "mmvk/features/foot_contacts.hpp"
 
 namespace mmvk {
 

@@ -1,4 +1,4 @@
-#include "mmvk/query_builder.hpp"
+#include "mmvk/query/query_builder.hpp"
 
 #include <algorithm>
 #include <cmath>

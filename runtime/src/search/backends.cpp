@@ -1,10 +1,10 @@
-#include "mmvk/backends.hpp"
+#include "mmvk/search/backends.hpp"
 
 #include <algorithm>
 #include <utility>
 
-#include "mmvk/reference_search.hpp"
-#include "mmvk/thread_pool.hpp"
+#include "mmvk/search/reference_search.hpp"
+#include "mmvk/common/thread_pool.hpp"
 
 namespace mmvk {
 

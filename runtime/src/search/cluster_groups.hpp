@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/cluster_table.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
 
 namespace mmvk::detail {
 

@@ -1,4 +1,4 @@
-#include "mmvk/cluster_search.hpp"
+#include "mmvk/search/cluster_search.hpp"
 
 #include <algorithm>
 #include <array>

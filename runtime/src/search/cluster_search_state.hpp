@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/cluster_search.hpp"
+#include "mmvk/search/cluster_search.hpp"
 #include "search/half_tile_store.hpp"
 #include "search/tile_kernels.hpp"
 #include "search/tile_store.hpp"

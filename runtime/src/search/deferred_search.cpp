@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "mmvk/async_search.hpp"
+#include "mmvk/search/async_search.hpp"
 
 namespace mmvk {
 

@@ -1,8 +1,8 @@
-#include "mmvk/explain.hpp"
+#include "mmvk/search/explain.hpp"
 
 #include <cstdio>
 
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 
 namespace mmvk {
 

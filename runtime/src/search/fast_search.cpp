@@ -1,4 +1,4 @@
-#include "mmvk/fast_search.hpp"
+#include "mmvk/search/fast_search.hpp"
 
 #include <algorithm>
 #include <array>

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "mmvk/fast_search.hpp"
+#include "mmvk/search/fast_search.hpp"
 #include "search/tile_store.hpp"
 
 namespace mmvk {

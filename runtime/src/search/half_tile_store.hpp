@@ -8,7 +8,7 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 #include "search/tile_kernels.hpp"
 #include "search/tile_store.hpp"
 

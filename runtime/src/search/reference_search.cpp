@@ -1,4 +1,4 @@
-#include "mmvk/reference_search.hpp"
+#include "mmvk/search/reference_search.hpp"
 
 #include <algorithm>
 

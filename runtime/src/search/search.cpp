@@ -1,4 +1,4 @@
-#include "mmvk/search.hpp"
+#include "mmvk/search/search.hpp"
 
 #include <algorithm>
 #include <cmath>

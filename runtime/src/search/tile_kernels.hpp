@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "mmvk/search.hpp"
+#include "mmvk/search/search.hpp"
 
 namespace mmvk::detail {
 

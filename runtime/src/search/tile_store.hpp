@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 #include "search/tile_kernels.hpp"
 
 namespace mmvk::detail {

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <span>
 
-#include "mmvk/database.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/search.hpp"
 
 namespace mmvk::detail {
 

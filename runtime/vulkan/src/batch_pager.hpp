@@ -10,9 +10,9 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/database.hpp"
-#include "mmvk/search.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/search.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::vulkan::detail {
 

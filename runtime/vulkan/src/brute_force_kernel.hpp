@@ -9,7 +9,7 @@
 
 #include "handles.hpp"
 #include "kernel_shape.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

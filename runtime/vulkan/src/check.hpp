@@ -7,7 +7,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

@@ -20,7 +20,7 @@
 //   cluster_merge   round 1: final best K, rows evaluated
 // Exactness: round 0's k-th best is >= the true k-th best, and a cluster
 // or block whose bound is strictly above it holds no member that can enter
-// the best k (ClusterSearch's argument, mmvk/cluster_search.hpp); the rows are
+// the best k (ClusterSearch's argument, mmvk/search/cluster_search.hpp); the rows are
 // evaluated with the brute-force arithmetic, so costs are the reference's.
 #pragma once
 
@@ -32,8 +32,8 @@
 #include "handles.hpp"
 #include "kernel_shape.hpp"
 #include "memory.hpp"
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

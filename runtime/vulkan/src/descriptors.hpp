@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "handles.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

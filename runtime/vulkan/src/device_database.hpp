@@ -22,8 +22,8 @@
 
 #include "handles.hpp"
 #include "memory.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

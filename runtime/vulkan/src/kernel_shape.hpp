@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "mmvk/database.hpp"
-#include "mmvk/feature_schema.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/features/feature_schema.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 #include "pipeline.hpp"

@@ -10,7 +10,7 @@
 #include <span>
 
 #include "handles.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

@@ -12,7 +12,7 @@
 
 #include "handles.hpp"
 #include "memory.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

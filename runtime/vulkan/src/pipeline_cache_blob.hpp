@@ -9,7 +9,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::vulkan::detail {
 

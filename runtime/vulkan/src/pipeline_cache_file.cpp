@@ -5,8 +5,8 @@
 #include <cstring>
 #include <system_error>
 
-#include "mmvk/hash.hpp"
-#include "mmvk/file_io.hpp"
+#include "mmvk/common/hash.hpp"
+#include "mmvk/common/file_io.hpp"
 
 namespace mmvk::vulkan {
 

@@ -4,7 +4,7 @@
 #include <cstddef>
 
 #include "device_database.hpp"
-#include "mmvk/search.hpp"
+#include "mmvk/search/search.hpp"
 
 namespace mmvk::vulkan::detail {
 

@@ -13,7 +13,7 @@
 #include <span>
 #include <vector>
 
-#include "mmvk/database.hpp"
+#include "mmvk/database/database.hpp"
 #include "search_layout.hpp"
 
 namespace mmvk::vulkan::detail {

@@ -13,8 +13,8 @@
 #include <cstdint>
 
 #include "kernel_shape.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 

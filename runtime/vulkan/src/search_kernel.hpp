@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan::detail {

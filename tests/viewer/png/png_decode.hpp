@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 
 namespace mmvk::test {
 

@@ -1,4 +1,4 @@
-// The Vulkan entries of the backend registry (mmvk/backends.hpp):
+// The Vulkan entries of the backend registry (mmvk/search/backends.hpp):
 // vulkan-brute (VulkanBruteForce), vulkan-clusters and vulkan-nprobe
 // (VulkanClusterSearch, nprobe 0 and spec.nprobe), made on `context`.
 //
@@ -10,8 +10,8 @@
 
 #include <functional>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"  // VulkanSearchOptions
 

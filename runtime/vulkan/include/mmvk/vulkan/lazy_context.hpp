@@ -18,8 +18,8 @@
 #include <optional>
 #include <string>
 
-#include "mmvk/backends.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/search/backends.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 

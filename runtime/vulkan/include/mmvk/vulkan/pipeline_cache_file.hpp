@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "mmvk/status.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan {

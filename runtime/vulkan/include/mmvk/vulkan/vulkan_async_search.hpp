@@ -1,4 +1,4 @@
-// VulkanAsyncSearch: the AsyncSearch (mmvk/async_search.hpp) of a
+// VulkanAsyncSearch: the AsyncSearch (mmvk/search/async_search.hpp) of a
 // VulkanSearch, its one asynchronous interface. submit() checks the
 // batch, stages its first pages and starts them on the GPU, returning at
 // once; collect() (the crowd's next tick) waits for them oldest first,
@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <span>
 
-#include "mmvk/async_search.hpp"
+#include "mmvk/search/async_search.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 
 namespace mmvk::vulkan {

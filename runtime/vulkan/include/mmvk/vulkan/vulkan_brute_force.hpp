@@ -7,8 +7,8 @@
 #include <memory>
 #include <string_view>
 
-#include "mmvk/database.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 

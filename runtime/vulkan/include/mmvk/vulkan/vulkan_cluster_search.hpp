@@ -12,9 +12,9 @@
 #include <memory>
 #include <string_view>
 
-#include "mmvk/cluster_table.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/clusters/cluster_table.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 #include "mmvk/vulkan/vulkan_search.hpp"
 

@@ -1,7 +1,7 @@
 // VulkanSearch: the base of the SearchBackends whose costs are evaluated and
 // reduced to the best k frames per query in Vulkan compute shaders,
 // bit-identical to ReferenceSearch (same frames, same cost bits; see
-// docs/search.md and mmvk/search.hpp for the semantics). Two searches derive
+// docs/search.md and mmvk/search/search.hpp for the semantics). Two searches derive
 // from it, as FAISS's GpuIndexFlat and GpuIndexIVFFlat derive from GpuIndex:
 // VulkanBruteForce (vulkan_brute_force.hpp: every row, exact) and
 // VulkanClusterSearch (vulkan_cluster_search.hpp: rows pruned by a
@@ -27,10 +27,10 @@
 #include <string_view>
 #include <vector>
 
-#include "mmvk/async_search.hpp"
-#include "mmvk/database.hpp"
-#include "mmvk/search.hpp"
-#include "mmvk/status.hpp"
+#include "mmvk/search/async_search.hpp"
+#include "mmvk/database/database.hpp"
+#include "mmvk/search/search.hpp"
+#include "mmvk/common/status.hpp"
 #include "mmvk/vulkan/context.hpp"
 
 namespace mmvk::vulkan {

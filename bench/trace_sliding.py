@@ -2,7 +2,7 @@
 """Where a crowd's planted feet slide: splits the sliding of an
 `mmvk crowd --trace FILE --trace-agents M` recording by its cause.
 
-The sliding is measured as the crowd measures it (host/crowd/motion_meter.hpp):
+The sliding is measured as the crowd measures it (host/crowd/measure/motion_meter.hpp):
 between two ticks where the foot is flagged planted, the horizontal speed of
 its point on the ground, the ankle while only the heel bit is set, else the
 toe. It is split two ways:

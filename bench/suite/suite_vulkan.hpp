@@ -1,5 +1,5 @@
 // The suite's backends and its Vulkan side: one HostBackends per process
-// (host/crowd/host_backends.hpp, where the hosts make theirs), whose
+// (host/crowd/backends/host_backends.hpp, where the hosts make theirs), whose
 // Vulkan context is created only when a Vulkan cell runs (a CPU-only filter
 // never touches the driver). Without Vulkan in the build the vulkan-* cells
 // are absent.

@@ -40,7 +40,7 @@ struct PointStats {
 };
 
 // [side][planted, toe, heel]. The planted foot's speed is that of its point
-// on the ground, as the crowd measures sliding (host/crowd/motion_meter.hpp):
+// on the ground, as the crowd measures sliding (host/crowd/measure/motion_meter.hpp):
 // the heel while only the heel bit is set, else the contact joint (the toe
 // where there is one); a toe rolling down after a heel strike is no slide.
 using FootStats = std::array<std::array<PointStats, 3>, 2>;

@@ -102,7 +102,7 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.integer("--seed", options.seed, "N", "the random scenario's seed (default " + std::to_string(options.seed) + ")", 0,
               std::numeric_limits<std::uint64_t>::max());
   cli.text("--scenario", options.scenario, "FILE",
-           "starts, goals, speeds and tags from JSON (see host/crowd/scenario.hpp)");
+           "starts, goals, speeds and tags from JSON (see host/crowd/steering/scenario.hpp)");
   cli.text("--summary", options.summary, "FILE", "write the run's figures as JSON");
   cli.text("--html", options.html, "FILE", "write the viewer: one self-contained page");
 }

@@ -1,7 +1,7 @@
 // The units section of `mmvk inspect` (text and JSON): whether units and data
 // are plausible at a glance, the metres per file unit each clip was imported
 // with, the skeleton's standing height, and the walk and run speeds the
-// crowd measures (host/crowd/gait_speeds.hpp).
+// crowd measures (host/crowd/steering/gait_speeds.hpp).
 #pragma once
 
 #include <nlohmann/json.hpp>

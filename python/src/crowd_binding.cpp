@@ -1,4 +1,4 @@
-// mmvk.Crowd: the crowd host's CrowdSession (host/crowd/crowd_session.hpp)
+// mmvk.Crowd: the crowd host's CrowdSession (host/crowd/setup/crowd_session.hpp)
 // stepped from Python, by its own steering or by another simulator's.
 #include <algorithm>
 #include <chrono>

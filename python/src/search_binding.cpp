@@ -134,7 +134,7 @@ PySearch::PySearch(std::shared_ptr<Database> database, const std::string& backen
   }
   backend_ = take(std::move(made));
   device_ = backend_->device();
-  // Set before the first Vulkan context (host/crowd/driver_cache.hpp).
+  // Set before the first Vulkan context (host/crowd/backends/driver_cache.hpp).
   if (const std::string& note = backends_.driver_cache_note(); !note.empty()) {
     if (PyErr_WarnEx(PyExc_RuntimeWarning, note.c_str(), 1) != 0) throw py::error_already_set();
   }

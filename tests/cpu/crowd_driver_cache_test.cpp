@@ -1,4 +1,4 @@
-// The guard of Mesa's shader disk cache (host/crowd/driver_cache.hpp): a
+// The guard of Mesa's shader disk cache (host/crowd/backends/driver_cache.hpp): a
 // driver whose cache folder is full or unwritable died with SIGBUS in its
 // cache thread (issue 34); the host turns the driver's disk cache off first.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The crowd's up-front bounds (host/crowd/crowd_limits.hpp, issue 23, checked
+// The crowd's up-front bounds (host/crowd/setup/crowd_limits.hpp, issue 23, checked
 // by validate() in crowd_settings.hpp, issue 30): the agents, the time
 // options and tick count are refused outside their documented ranges with
 // the option and the value as given named, and the memory estimate grows with what the run

@@ -1,5 +1,5 @@
 // The displayed pose as CrowdController exposes it, and its recording for
-// the exporters (host/crowd/pose_recording.hpp), on the shipped CMU walks:
+// the exporters (host/crowd/output/pose_recording.hpp), on the shipped CMU walks:
 // forward kinematics of local_rotations() and local_translations() under
 // root_positions() and root_yaws() is world_positions() with foot IK on, at
 // 30 and 60 Hz; the recording keeps exactly that pose; its count and cap are

@@ -1,4 +1,4 @@
-// The viewer's recording of a real crowd (host/crowd/crowd_recorder.hpp) on
+// The viewer's recording of a real crowd (host/crowd/output/crowd_recorder.hpp) on
 // the shipped CMU subject 16 set: the first characters' whole pose as
 // displayed is kept after every tick, and every search of theirs is
 // explained with the frame and the cost the search itself found.

@@ -1,4 +1,4 @@
-// The --trace files (host/crowd/trace.hpp) on the shipped CMU walks: what a
+// The --trace files (host/crowd/output/trace.hpp) on the shipped CMU walks: what a
 // controller showed is written and read back exactly, and the checks that
 // run before a simulation refuse what would fail at its end.
 #include <gtest/gtest.h>

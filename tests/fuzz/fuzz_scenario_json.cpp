@@ -1,4 +1,4 @@
-// libFuzzer target: the crowd's scenario JSON (host/crowd/scenario.cpp,
+// libFuzzer target: the crowd's scenario JSON (host/crowd/steering/scenario.cpp,
 // compiled into this target). Every input ends in an error naming the file
 // and field, or in a scenario the crowd can run: at most kMaxAgents agents,
 // each with at least one goal, every coordinate and speed finite, and a

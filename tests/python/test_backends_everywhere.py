@@ -1,6 +1,6 @@
 """Every entry point offers the same backends and shows each one's device the
 same way: `mmvk query`, `mmvk crowd`, mmvk.backends(), mmvk.Search and
-mmvk.Crowd all make their backends in one place (host/crowd/host_backends.hpp),
+mmvk.Crowd all make their backends in one place (host/crowd/backends/host_backends.hpp),
 and a backend reports its own device text (SearchBackend::device())."""
 import json
 import os

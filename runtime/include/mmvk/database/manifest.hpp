@@ -166,7 +166,7 @@ struct Manifest {
   FootContactParams contacts;      // the animation's contacts and the foot_contact channel
   GaitBandParams gait_bands;       // the measured gait tags (gait_bands.hpp)
   // The "crowd" object as JSON text, or empty: read by the crowd host
-  // (host/crowd/data_settings.hpp), which names its unknown keys; the build
+  // (host/crowd/setup/data_settings.hpp), which names its unknown keys; the build
   // only carries it into the database.
   std::string crowd;
   std::vector<ManifestClip> clips;

@@ -69,11 +69,9 @@ struct FootIkParams {
   // softened (soft_reach), in (0, 1]; 1 is a hard clamp at full extension.
   float soft_reach_start = 0.95f;
   // Horizontal correction (metres, > 0) beyond which a lock is released.
-  // A released foot slides back to its animation, which shows: on Bandai
-  // locomotion in the crowd (200 characters, 10 s, 30 Hz) 0.2 m released 5%
-  // of planted foot-ticks, which then slid 1 m/s (6.8 cm/s over all planted
-  // ticks); 0.3 m 2.8 cm/s; 0.5 m keeps 99.9% locked (1.3 cm/s, what is
-  // left being legs that cannot reach their anchor); CMU 131 0.74 -> 0.60.
+  // A released foot slides back to its animation, which shows, so the
+  // distance is as long as a leg can hold; bench/RESULTS.md "Defaults and
+  // the measurements that chose them" has the figures.
   float unlock_distance = 0.5f;
   // Hold the foot's heading while locked (the foot turns about its contact
   // point by psi), by at most max_yaw_correction (radians, > 0): an animated
@@ -88,21 +86,10 @@ struct FootIkParams {
   // The spring tracks the wanted drop's own motion up to max_hip_goal_rate
   // (metres per second, >= 0; 0: it chases a goal it treats as still, and
   // lags a deepening one by about a half-life, long enough for a held foot
-  // at full stride to slip out of reach). Measured in the crowd (1,000
-  // characters x 20 s, sliding after IK at 30 / 60 Hz, bench/RESULTS.md
-  // "The default data"): chasing a still goal (before) gave CMU 16
-  // (cmu-walk-run) 0.60 / 0.74 cm/s, CMU 131 0.51 / 0.34, Bandai 0.86 / 0.89;
-  // following it at up to 1 m/s 0.35 / 0.45, 0.42 / 0.23, 0.63 / 0.65 (0.5
-  // m/s: 0.38 / 0.49, 0.42 / 0.23, 0.68 / 0.68), all with a 0.1 m drop.
-  // The drop (same runs, each knee keeping its direction while its leg is
-  // nearly straight): 0.1 m 0.35 / 0.45, 0.42 / 0.23, 0.63 / 0.65; 0.15 m
-  // 0.25 / 0.33, 0.42 / 0.23, 0.49 / 0.51; 0.2 m 0.19 / 0.26, 0.42 / 0.23,
-  // 0.42 / 0.44; 0.3 m 0.16 / 0.22, 0.42 / 0.23, 0.39 / 0.41; no other
-  // figure moved, and the worst displayed joint step of
-  // tests/data/crowd_controller_test.cpp was 0.22 m up to 0.2 m, 0.23 at 0.3
-  // (before the knees kept their direction, 0.2 m flipped a knee: 0.46 m in
-  // one tick). 0.2 m: most of the gain without a deeper crouch. A faster hip
-  // spring (0.03 s) shakes the pose (its acceleration p99 up 8%).
+  // at full stride to slip out of reach). 0.2 m gives most of the sliding
+  // gain without a deeper crouch, and a faster hip spring shakes the pose;
+  // the figures are in bench/RESULTS.md ("Defaults and the measurements that
+  // chose them", and "The default data").
   float max_hip_drop = 0.2f;
   float hip_half_life = 0.1f;
   float max_hip_goal_rate = 1.0f;

@@ -21,13 +21,10 @@ namespace mmvk {
 // the first tick or after reset) plus a correction that closes the gap
 // between the simulated root and `next` over `horizon` seconds. The
 // correction alone, re-aimed every tick at a one-tick horizon, would fight
-// the springs' lag and oscillate (measured: a line followed 0.35 m off and a
-// circle diverging at 1/30 s). Measured on CMU walks at 0.64 m/s, 16
-// characters for 10 s at 30 Hz (the roots' largest distance from a line and
-// from a 3 m circle after the first 2 s): horizon 0.15 s 0.030 / 0.072 m,
-// 0.2 s 0.021 / 0.023 m, 0.3 s 0.021 / 0.051 m, 1 s 0.026 / 0.077 m; the
-// springs' half-life is 0.2 s (ControllerParams::spring), and so is the
-// default horizon (tests/python/test_crowd.py).
+// the springs' lag and oscillate; a horizon equal to the springs' half-life
+// (0.2 s, ControllerParams::spring) follows lines and circles closest
+// (bench/RESULTS.md, "Defaults and the measurements that chose them";
+// tests/python/test_crowd.py).
 class PositionSteering {
  public:
   // `characters` [B]; horizon in seconds, > 0 (else the default).

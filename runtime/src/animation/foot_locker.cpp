@@ -257,6 +257,45 @@ void FootLocker::reset(std::uint32_t b) {
   clear(b);
 }
 
+namespace {
+
+glm::vec3 contact_at(const glm::vec3& ankle, const glm::vec3& toe, std::uint8_t contact_point) {
+  return contact_point == kToe ? toe : ankle;
+}
+
+}  // namespace
+
+// update()'s steps, per foot f = 2 b + side, with the locker they update.
+struct FootLocker::Steps {
+  // One foot as animated this tick, with what its lock reads.
+  struct FootView {
+    glm::vec3 ankle{}, toe{};  // world positions, metres (toe = ankle without a toe joint)
+    bool planted = false;
+    std::uint8_t point = 0;  // the contact point the data names: heel 0 or toe 1
+    bool has_yaw = false;    // the foot's heading is read and not vertical
+    float yaw = 0.0f;        // that heading, radians
+  };
+  // Where the IK puts one ankle, and the foot's world rotation there.
+  struct FootTarget {
+    glm::vec3 ankle{};
+    glm::quat rotation{};
+    bool solve = false;
+  };
+  static FootView view_foot(FootLocker& l, std::size_t f, std::size_t side, std::uint8_t contacts,
+                            const glm::vec3* world, const glm::quat* global);
+  static bool move_point(FootLocker& l, std::size_t f, const FootView& foot, std::uint8_t to);
+  static void hold_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt);
+  static void update_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt);
+  static FootTarget foot_target(FootLocker& l, std::size_t f, std::size_t side, const FootView& foot,
+                                const glm::vec3& root_position, const glm::quat* global);
+  static float wanted_hip_drop(FootLocker& l, std::size_t side, const FootTarget& target, const glm::vec3* world);
+  static float lower_hips(FootLocker& l, std::uint32_t b, float dt, float wanted_drop, const glm::quat& root,
+                          const glm::quat* global, glm::vec3* translations, glm::vec3* world);
+  static void solve_leg(FootLocker& l, std::size_t f, std::size_t side, const FootTarget& target, const glm::vec3& pole,
+                        const glm::quat& root, glm::quat* global, glm::quat* rotations, const glm::vec3* translations,
+                        glm::vec3* world);
+};
+
 void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const glm::vec3& root_position,
                         float root_yaw, std::span<const glm::vec3> animated_world,
                         std::span<glm::quat> local_rotations, std::span<glm::vec3> local_translations,
@@ -285,16 +324,17 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
   }
 
   // Per foot: the lock's state machine, then its ankle target and rotation.
-  FootTarget targets[2];
+  Steps::FootTarget targets[2];
   float wanted_drop = 0.0f;
   for (std::size_t side = 0; side < 2; ++side) {
     const std::size_t f = std::size_t{b} * 2 + side;
-    const FootView foot = view_foot(f, side, contacts, world, global);
-    update_lock(f, foot, dt);
-    targets[side] = foot_target(f, side, foot, root_position, global);
-    if (targets[side].solve) wanted_drop = std::max(wanted_drop, wanted_hip_drop(side, targets[side], world));
+    const Steps::FootView foot = Steps::view_foot(*this, f, side, contacts, world, global);
+    Steps::update_lock(*this, f, foot, dt);
+    targets[side] = Steps::foot_target(*this, f, side, foot, root_position, global);
+    if (targets[side].solve)
+      wanted_drop = std::max(wanted_drop, Steps::wanted_hip_drop(*this, side, targets[side], world));
   }
-  const float drop = lower_hips(b, dt, wanted_drop, root, global, translations, world);
+  const float drop = Steps::lower_hips(*this, b, dt, wanted_drop, root, global, translations, world);
 
   // Two-bone IK on each leg that has a correction (both when the hips are
   // lowered: the other foot must stay where it was animated). The knee bends
@@ -308,13 +348,14 @@ void FootLocker::update(std::uint32_t b, float dt, std::uint8_t contacts, const 
     const glm::vec3 pole =
         follow_knee(knee_direction_[f], world[leg.upper], world[leg.lower], world[leg.foot], root, dt, solve);
     if (!solve) continue;
-    solve_leg(f, side, targets[side], pole, root, global, rotations, translations, world);
+    Steps::solve_leg(*this, f, side, targets[side], pole, root, global, rotations, translations, world);
   }
 }
 
-FootLocker::FootView FootLocker::view_foot(std::size_t f, std::size_t side, std::uint8_t contacts,
-                                           const glm::vec3* world, const glm::quat* global) const {
-  const Leg& leg = legs_[side];
+FootLocker::Steps::FootView FootLocker::Steps::view_foot(FootLocker& l, std::size_t f, std::size_t side,
+                                                         std::uint8_t contacts, const glm::vec3* world,
+                                                         const glm::quat* global) {
+  const Leg& leg = l.legs_[side];
   FootView foot;
   foot.ankle = world[leg.foot];
   foot.toe = leg.toe >= 0 ? world[leg.toe] : foot.ankle;
@@ -324,56 +365,48 @@ FootLocker::FootView FootLocker::view_foot(std::size_t f, std::size_t side, std:
   // Data without point bits (older files) counts as planted on the toe.
   foot.point = leg.toe >= 0 && (toe_touches || !heel_touches) ? kToe : kHeel;
   // The foot's heading, only where a lock reads it.
-  foot.has_yaw = params_.lock_yaw && (foot.planted || locked_[f] != 0) &&
-                 heading_yaw(global[leg.foot] * heading_[side], foot.yaw);
+  foot.has_yaw = l.params_.lock_yaw && (foot.planted || l.locked_[f] != 0) &&
+                 heading_yaw(global[leg.foot] * l.heading_[side], foot.yaw);
   return foot;
 }
 
-namespace {
-
-glm::vec3 contact_at(const glm::vec3& ankle, const glm::vec3& toe, std::uint8_t contact_point) {
-  return contact_point == kToe ? toe : ankle;
-}
-
-}  // namespace
-
 // A new contact point keeps the displayed foot where it is: the offset takes
 // up the turn of the new point about the old one.
-bool FootLocker::move_point(std::size_t f, const FootView& foot, std::uint8_t to) {
-  if (to == point_[f]) return false;
-  const glm::vec3 step = contact_at(foot.ankle, foot.toe, to) - contact_at(foot.ankle, foot.toe, point_[f]);
-  offset_[f] += horizontal(yaw_rotation(yaw_offset_[f]) * step - step);
-  point_[f] = to;
+bool FootLocker::Steps::move_point(FootLocker& l, std::size_t f, const FootView& foot, std::uint8_t to) {
+  if (to == l.point_[f]) return false;
+  const glm::vec3 step = contact_at(foot.ankle, foot.toe, to) - contact_at(foot.ankle, foot.toe, l.point_[f]);
+  l.offset_[f] += horizontal(yaw_rotation(l.yaw_offset_[f]) * step - step);
+  l.point_[f] = to;
   return true;
 }
 
 // A locked, planted foot: the offsets that hold its contact point on the
 // anchor, or the release when the animation walked it too far away.
-void FootLocker::hold_lock(std::size_t f, const FootView& foot, float dt) {
-  glm::vec3& offset = offset_[f];
-  float& yaw_offset = yaw_offset_[f];
+void FootLocker::Steps::hold_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt) {
+  glm::vec3& offset = l.offset_[f];
+  float& yaw_offset = l.yaw_offset_[f];
   // Heel to toe (or back): the anchor moves to the new point as shown.
-  if (move_point(f, foot, foot.point)) anchor_[f] = contact_at(foot.ankle, foot.toe, point_[f]) + offset;
+  if (move_point(l, f, foot, foot.point)) l.anchor_[f] = contact_at(foot.ankle, foot.toe, l.point_[f]) + offset;
   if (!foot.has_yaw) {
-    anchor_yaw_[f] = kNoYaw;
-  } else if (std::isnan(anchor_yaw_[f])) {
-    anchor_yaw_[f] = foot.yaw + yaw_offset;
+    l.anchor_yaw_[f] = kNoYaw;
+  } else if (std::isnan(l.anchor_yaw_[f])) {
+    l.anchor_yaw_[f] = foot.yaw + yaw_offset;
   }
-  const glm::vec3 next = horizontal(anchor_[f] - contact_at(foot.ankle, foot.toe, point_[f]));
-  float next_yaw = foot.has_yaw ? wrap_angle(anchor_yaw_[f] - foot.yaw) : yaw_offset;
-  if (std::abs(next_yaw) > params_.max_yaw_correction) {
+  const glm::vec3 next = horizontal(l.anchor_[f] - contact_at(foot.ankle, foot.toe, l.point_[f]));
+  float next_yaw = foot.has_yaw ? wrap_angle(l.anchor_yaw_[f] - foot.yaw) : yaw_offset;
+  if (std::abs(next_yaw) > l.params_.max_yaw_correction) {
     // The animated foot turned further than the lock holds: it pivots
     // about its contact point from here, the position still held.
-    next_yaw = std::clamp(next_yaw, -params_.max_yaw_correction, params_.max_yaw_correction);
-    anchor_yaw_[f] = foot.yaw + next_yaw;
+    next_yaw = std::clamp(next_yaw, -l.params_.max_yaw_correction, l.params_.max_yaw_correction);
+    l.anchor_yaw_[f] = foot.yaw + next_yaw;
   }
-  if (glm::length(next) > params_.unlock_distance) {
-    locked_[f] = 0;
-    drifted_[f] = 1;
+  if (glm::length(next) > l.params_.unlock_distance) {
+    l.locked_[f] = 0;
+    l.drifted_[f] = 1;
   } else {
     if (dt > 0.0f) {
-      offset_rate_[f] = (next - offset) / dt;
-      yaw_rate_[f] = wrap_angle(next_yaw - yaw_offset) / dt;
+      l.offset_rate_[f] = (next - offset) / dt;
+      l.yaw_rate_[f] = wrap_angle(next_yaw - yaw_offset) / dt;
     }
     offset = next;
     yaw_offset = next_yaw;
@@ -382,30 +415,30 @@ void FootLocker::hold_lock(std::size_t f, const FootView& foot, float dt) {
 
 // The lock's state machine: held while planted, taken where the foot is
 // shown when it plants, and its offsets decaying after release.
-void FootLocker::update_lock(std::size_t f, const FootView& foot, float dt) {
-  if (!foot.planted) drifted_[f] = 0;
-  if (locked_[f] != 0) {
+void FootLocker::Steps::update_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt) {
+  if (!foot.planted) l.drifted_[f] = 0;
+  if (l.locked_[f] != 0) {
     if (!foot.planted) {
-      locked_[f] = 0;
+      l.locked_[f] = 0;
     } else {
-      hold_lock(f, foot, dt);
+      hold_lock(l, f, foot, dt);
     }
   }
-  if (locked_[f] != 0) return;
-  glm::vec3& offset = offset_[f];
-  glm::vec3& offset_rate = offset_rate_[f];
-  float& yaw_offset = yaw_offset_[f];
-  float& yaw_rate = yaw_rate_[f];
-  if (foot.planted && drifted_[f] == 0) {
+  if (l.locked_[f] != 0) return;
+  glm::vec3& offset = l.offset_[f];
+  glm::vec3& offset_rate = l.offset_rate_[f];
+  float& yaw_offset = l.yaw_offset_[f];
+  float& yaw_rate = l.yaw_rate_[f];
+  if (foot.planted && l.drifted_[f] == 0) {
     // Lock where the foot is shown now: the offset carries on, so does the
     // display.
-    move_point(f, foot, foot.point);
-    locked_[f] = 1;
-    anchor_[f] = contact_at(foot.ankle, foot.toe, point_[f]) + offset;
-    anchor_yaw_[f] = foot.has_yaw ? foot.yaw + yaw_offset : kNoYaw;
+    move_point(l, f, foot, foot.point);
+    l.locked_[f] = 1;
+    l.anchor_[f] = contact_at(foot.ankle, foot.toe, l.point_[f]) + offset;
+    l.anchor_yaw_[f] = foot.has_yaw ? foot.yaw + yaw_offset : kNoYaw;
   } else if (dt > 0.0f) {
-    spring_decay(offset, offset_rate, params_.release_half_life, dt);
-    spring_decay(yaw_offset, yaw_rate, params_.release_half_life, dt);
+    spring_decay(offset, offset_rate, l.params_.release_half_life, dt);
+    spring_decay(yaw_offset, yaw_rate, l.params_.release_half_life, dt);
     if (glm::length(offset) < kSettled && glm::length(offset_rate) < kSettledRate) {
       offset = offset_rate = glm::vec3(0.0f);
     }
@@ -416,23 +449,24 @@ void FootLocker::update_lock(std::size_t f, const FootView& foot, float dt) {
 // The ankle's target: the animated foot turned by the yaw offset about its
 // contact point and moved by the offset, at its animated height (raised to
 // the floor when clamped).
-FootLocker::FootTarget FootLocker::foot_target(std::size_t f, std::size_t side, const FootView& foot,
-                                               const glm::vec3& root_position, const glm::quat* global) const {
-  const Leg& leg = legs_[side];
+FootLocker::Steps::FootTarget FootLocker::Steps::foot_target(FootLocker& l, std::size_t f, std::size_t side,
+                                                             const FootView& foot, const glm::vec3& root_position,
+                                                             const glm::quat* global) {
+  const Leg& leg = l.legs_[side];
   FootTarget target;
   target.ankle = foot.ankle;
   target.rotation = global[leg.foot];
   target.solve = false;
-  if (offset_[f] != glm::vec3(0.0f) || yaw_offset_[f] != 0.0f) {
-    const glm::vec3 contact = contact_at(foot.ankle, foot.toe, point_[f]);
-    const glm::quat turn = yaw_rotation(yaw_offset_[f]);
-    target.ankle = contact + offset_[f] + turn * (foot.ankle - contact);
+  if (l.offset_[f] != glm::vec3(0.0f) || l.yaw_offset_[f] != 0.0f) {
+    const glm::vec3 contact = contact_at(foot.ankle, foot.toe, l.point_[f]);
+    const glm::quat turn = yaw_rotation(l.yaw_offset_[f]);
+    target.ankle = contact + l.offset_[f] + turn * (foot.ankle - contact);
     target.rotation = turn * global[leg.foot];
     target.solve = true;
   }
-  if (params_.clamp_to_floor) {
+  if (l.params_.clamp_to_floor) {
     // The turn is about +Y, so the toe stays at its animated height above the ankle.
-    const float floor = root_position.y + params_.floor_height;
+    const float floor = root_position.y + l.params_.floor_height;
     const float lowest = std::min(target.ankle.y, target.ankle.y + (foot.toe.y - foot.ankle.y));
     if (lowest < floor) {
       target.ankle.y += floor - lowest;
@@ -447,12 +481,13 @@ FootLocker::FootTarget FootLocker::foot_target(std::size_t f, std::size_t side, 
 // = reach, the smaller root; the drop to the target's height when the target
 // is horizontally further than the reach; 0 within reach. An animated target
 // needs none: the animated extension is within reach by definition.
-float FootLocker::wanted_hip_drop(std::size_t side, const FootTarget& target, const glm::vec3* world) const {
-  const Leg& leg = legs_[side];
+float FootLocker::Steps::wanted_hip_drop(FootLocker& l, std::size_t side, const FootTarget& target,
+                                         const glm::vec3* world) {
+  const Leg& leg = l.legs_[side];
   const glm::vec3 ankle = world[leg.foot];
   const glm::vec3 hip = world[leg.upper];
   const float length = glm::length(world[leg.lower] - hip) + glm::length(ankle - world[leg.lower]);
-  const float reach = std::min(length, std::max(params_.soft_reach_start * length, glm::length(ankle - hip)));
+  const float reach = std::min(length, std::max(l.params_.soft_reach_start * length, glm::length(ankle - hip)));
   const glm::vec3 to_target = target.ankle - hip;
   const float across2 = to_target.x * to_target.x + to_target.z * to_target.z;
   if (across2 + to_target.y * to_target.y <= reach * reach) return 0.0f;
@@ -461,49 +496,49 @@ float FootLocker::wanted_hip_drop(std::size_t side, const FootTarget& target, co
 
 // The hips follow the wanted drop with a critically damped spring; returns
 // the drop applied (metres, >= 0).
-float FootLocker::lower_hips(std::uint32_t b, float dt, float wanted_drop, const glm::quat& root,
-                             const glm::quat* global, glm::vec3* translations, glm::vec3* world) {
-  float& drop = hip_drop_[b];
-  float& drop_rate = hip_drop_rate_[b];
-  const float goal = std::min(wanted_drop, params_.max_hip_drop);
+float FootLocker::Steps::lower_hips(FootLocker& l, std::uint32_t b, float dt, float wanted_drop, const glm::quat& root,
+                                    const glm::quat* global, glm::vec3* translations, glm::vec3* world) {
+  float& drop = l.hip_drop_[b];
+  float& drop_rate = l.hip_drop_rate_[b];
+  const float goal = std::min(wanted_drop, l.params_.max_hip_drop);
   if (dt > 0.0f) {
     // The spring follows the goal as it moved since the last tick, at up to
     // max_hip_goal_rate: a goal that deepens steadily (a stride stretching)
     // is followed without the spring's lag, which let the held foot slip out
     // of reach; a faster change (a step) is left to the spring to smooth.
-    float& last_goal = hip_goal_[b];
+    float& last_goal = l.hip_goal_[b];
     const float goal_rate =
-        std::clamp((goal - last_goal) / dt, -params_.max_hip_goal_rate, params_.max_hip_goal_rate);
+        std::clamp((goal - last_goal) / dt, -l.params_.max_hip_goal_rate, l.params_.max_hip_goal_rate);
     float gap = drop - last_goal;
     float gap_rate = drop_rate - goal_rate;
-    spring_decay(gap, gap_rate, params_.hip_half_life, dt);
-    drop = std::clamp(last_goal + goal_rate * dt + gap, 0.0f, params_.max_hip_drop);
+    spring_decay(gap, gap_rate, l.params_.hip_half_life, dt);
+    drop = std::clamp(last_goal + goal_rate * dt + gap, 0.0f, l.params_.max_hip_drop);
     drop_rate = goal_rate + gap_rate;
     last_goal = goal;
     if (goal == 0.0f && drop < kSettled && std::abs(drop_rate) < kSettledRate) drop = drop_rate = 0.0f;
   }
   if (drop > 0.0f) {
-    const int parent = parents_[static_cast<std::size_t>(hips_)];
+    const int parent = l.parents_[static_cast<std::size_t>(l.hips_)];
     const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
-    translations[static_cast<std::size_t>(hips_)] -= glm::inverse(above) * (kUp * drop);
-    for (std::size_t j = 0; j < parents_.size(); ++j) {
-      if (below_hips_[j] != 0) world[j].y -= drop;
+    translations[static_cast<std::size_t>(l.hips_)] -= glm::inverse(above) * (kUp * drop);
+    for (std::size_t j = 0; j < l.parents_.size(); ++j) {
+      if (l.below_hips_[j] != 0) world[j].y -= drop;
     }
   }
   return drop;
 }
 
 // Two-bone IK on one leg, then the leg's joints again from the upper leg down.
-void FootLocker::solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::vec3& pole,
-                           const glm::quat& root, glm::quat* global, glm::quat* rotations,
-                           const glm::vec3* translations, glm::vec3* world) {
-  const Leg& leg = legs_[side];
+void FootLocker::Steps::solve_leg(FootLocker& l, std::size_t f, std::size_t side, const FootTarget& target,
+                                  const glm::vec3& pole, const glm::quat& root, glm::quat* global, glm::quat* rotations,
+                                  const glm::vec3* translations, glm::vec3* world) {
+  const Leg& leg = l.legs_[side];
   const TwoBoneIkSolution solution = solve_two_bone_ik_toward(world[leg.upper], world[leg.lower], world[leg.foot],
-                                                              target.ankle, pole, params_.soft_reach_start);
-  clamped_[f] = solution.clamped ? 1 : 0;
-  for (const int joint : leg_joints_[side]) {
+                                                              target.ankle, pole, l.params_.soft_reach_start);
+  l.clamped_[f] = solution.clamped ? 1 : 0;
+  for (const int joint : l.leg_joints_[side]) {
     const std::size_t j = static_cast<std::size_t>(joint);
-    const int parent = parents_[j];
+    const int parent = l.parents_[j];
     const glm::quat above = parent < 0 ? root : global[static_cast<std::size_t>(parent)];
     if (joint == leg.upper) {
       global[j] = solution.upper * global[j];

@@ -169,36 +169,8 @@ class FootLocker {
   FootLocker() = default;
   void clear(std::uint32_t b);
 
-  // The steps of update() (foot_locker.cpp), per foot f = 2 b + side.
-  // One foot as animated this tick, with what its lock reads.
-  struct FootView {
-    glm::vec3 ankle{}, toe{};  // world positions, metres (toe = ankle without a toe joint)
-    bool planted = false;
-    std::uint8_t point = 0;    // the contact point the data names: heel 0 or toe 1
-    bool has_yaw = false;      // the foot's heading is read and not vertical
-    float yaw = 0.0f;          // that heading, radians
-  };
-  // Where the IK puts one ankle, and the foot's world rotation there.
-  struct FootTarget {
-    glm::vec3 ankle{};
-    glm::quat rotation{};
-    bool solve = false;
-  };
-  // Inline (defined in foot_locker.cpp, the only caller) so that update(),
-  // run per character per tick, compiles to one function as before its split.
-  inline FootView view_foot(std::size_t f, std::size_t side, std::uint8_t contacts, const glm::vec3* world,
-                            const glm::quat* global) const;
-  inline bool move_point(std::size_t f, const FootView& foot, std::uint8_t to);
-  inline void hold_lock(std::size_t f, const FootView& foot, float dt);
-  inline void update_lock(std::size_t f, const FootView& foot, float dt);
-  inline FootTarget foot_target(std::size_t f, std::size_t side, const FootView& foot, const glm::vec3& root_position,
-                                const glm::quat* global) const;
-  inline float wanted_hip_drop(std::size_t side, const FootTarget& target, const glm::vec3* world) const;
-  inline float lower_hips(std::uint32_t b, float dt, float wanted_drop, const glm::quat& root, const glm::quat* global,
-                          glm::vec3* translations, glm::vec3* world);
-  inline void solve_leg(std::size_t f, std::size_t side, const FootTarget& target, const glm::vec3& pole,
-                        const glm::quat& root, glm::quat* global, glm::quat* rotations,
-                        const glm::vec3* translations, glm::vec3* world);
+  // update()'s steps, per foot, defined where update() is (foot_locker.cpp).
+  struct Steps;
 
   std::uint32_t characters_ = 0;
   FootIkParams params_;

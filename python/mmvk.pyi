@@ -10,6 +10,7 @@ __version__: str
 
 PathLike = Union[str, os.PathLike[str]]
 FloatArray = npt.NDArray[np.float32]
+IntArray = npt.NDArray[np.integer]
 
 def backends() -> list[str]:
     """The search backends by name (CPU ones, then vulkan-* when built with Vulkan)."""
@@ -128,6 +129,8 @@ class Crowd:
                  search_interval: float = 0.1, foot_ik: bool = True, record: bool = False,
                  title: str = "", correction_half_life: Optional[float] = None,
                  record_poses: int = 0, speed_from_animation: bool = True) -> None: ...
+    def set_tags(self, agents: Union[int, Sequence[int], IntArray], require: Optional[Sequence[str]] = None,
+                 exclude: Optional[Sequence[str]] = None) -> None: ...
     def step(self, desired_velocity: Optional[FloatArray] = None,
              desired_facing: Optional[FloatArray] = None) -> None:
         """One tick: own steering, or desired_velocity float32 [agents x 2|3] m/s and

@@ -58,6 +58,36 @@ class HeldSession {
 // check for signals, so Ctrl-C stops a long run with KeyboardInterrupt.
 constexpr auto kSignalCheckInterval = std::chrono::milliseconds(100);
 
+// One agent index or a sequence (or integer array) of them.
+std::vector<std::uint64_t> agent_indices(const py::object& agents) {
+  if (py::isinstance<py::int_>(agents)) {
+    const long long b = agents.cast<long long>();
+    if (b < 0) raise("agents: " + std::to_string(b) + " is not a character of this crowd");
+    return {std::uint64_t(b)};
+  }
+  const auto values = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(agents);
+  if (!values || values.ndim() != 1) raise("agents: expected an index or a 1-D sequence of indices");
+  std::vector<std::uint64_t> out;
+  out.reserve(std::size_t(values.size()));
+  for (const long long b : std::span(values.data(), std::size_t(values.size()))) {
+    if (b < 0) raise("agents: " + std::to_string(b) + " is not a character of this crowd");
+    out.push_back(std::uint64_t(b));
+  }
+  return out;
+}
+
+// None (no tags) or a sequence of tag names; `field` names it in errors.
+std::vector<std::string> tag_names(const py::object& names, const char* field) {
+  if (names.is_none()) return {};
+  if (py::isinstance<py::str>(names)) raise(std::string(field) + ": expected a list of tag names, got one string");
+  std::vector<std::string> out;
+  for (const py::handle name : names) {
+    if (!py::isinstance<py::str>(name)) raise(std::string(field) + ": expected tag names (str)");
+    out.push_back(name.cast<std::string>());
+  }
+  return out;
+}
+
 class PyCrowd {
  public:
   PyCrowd(std::shared_ptr<Database> database, const CrowdSessionOptions& options, std::uint32_t record_poses)
@@ -103,6 +133,15 @@ class PyCrowd {
     read_xz(next_positions, "next_positions", next_);
     check(positions_->velocities(session_->controller().simulation(), next_, float(session_->dt()), velocity_));
     steer(desired_facing);
+  }
+
+  // Crowd.set_tags: the characters' search tags from their next search on.
+  void set_tags(const py::object& agents, const py::object& require, const py::object& exclude) {
+    const std::vector<std::uint64_t> which = agent_indices(agents);
+    const std::vector<std::string> required = tag_names(require, "require");
+    const std::vector<std::string> excluded = tag_names(exclude, "exclude");
+    const auto held = lock();
+    check(session_->set_tags(which, required, excluded));
   }
 
   void run(double seconds) {
@@ -289,6 +328,15 @@ void add_stepping(py::class_<PyCrowd>& crowd) {
            "One tick toward the host's positions at the end of the tick: float32 [agents x 2] (x, z) or [agents x 3], "
            "metres. The desired velocity is the host's own motion plus a correction of the gap over 0.2 s "
            "(mmvk/animation/steering_input.hpp: PositionSteering). desired_facing as for step().")
+      .def("set_tags", &PyCrowd::set_tags, py::arg("agents"), py::arg("require") = py::none(),
+           py::arg("exclude") = py::none(),
+           "set_tags(agents, require=None, exclude=None) -> None\n\n"
+           "The tags the characters `agents` (an index or a sequence of them) search with from their next search "
+           "on (within search_interval): candidates must carry every `require` tag and none of the `exclude` "
+           "tags; both replace what the characters had (a scenario's gait tags included). The measured gait "
+           "tags ('gait:stand', 'gait:walk', 'gait:jog', 'gait:run', 'gait:start', 'gait:stop'; Database.tags) "
+           "change a character's gait at any tick. Errors, before anything changes: an agent out of range, an "
+           "unknown tag (listing the known ones), a tag both required and excluded.")
       .def("run", &PyCrowd::run, py::arg("seconds"),
            "Steps the crowd's own steering for `seconds` of simulated time (rounded to whole ticks), GIL released.")
       .def(

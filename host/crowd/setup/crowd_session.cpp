@@ -130,6 +130,27 @@ Status CrowdSession::place(std::uint32_t b, float x, float z, float yaw, std::ui
   return controller_->place(b, glm::vec3(x, 0.0f, z), yaw, frame);
 }
 
+Status CrowdSession::set_tags(std::span<const std::uint64_t> agents, std::span<const std::string> require,
+                              std::span<const std::string> exclude) {
+  for (const std::uint64_t b : agents) {
+    if (b >= agents_) {
+      return make_error("agents: " + std::to_string(b) + " is not a character of this crowd (0 to " +
+                        std::to_string(agents_ - 1) + ")");
+    }
+  }
+  Result<TagMask> required = database_.tag_mask(require);
+  if (!required.ok()) return make_error("require: " + required.message());
+  Result<TagMask> excluded = database_.tag_mask(exclude);
+  if (!excluded.ok()) return make_error("exclude: " + excluded.message());
+  if ((*required & *excluded) != 0) return make_error("require, exclude: a tag is both required and excluded");
+  const std::span<QueryParams> params = controller_->query_params();
+  for (const std::uint64_t b : agents) {
+    params[b].require_all = *required;
+    params[b].exclude_any = *excluded;
+  }
+  return {};
+}
+
 Status CrowdSession::step() {
   // The tick's time counts the steering too.
   const auto tick_start = Clock::now();

@@ -86,6 +86,15 @@ class CrowdSession {
   // velocity. Errors: sizes, non-finite values (CrowdController::tick).
   Status step(std::span<const glm::vec3> desired_velocity, std::span<const float> desired_yaw);
 
+  // The tags characters `agents` search with from their next search on
+  // (QueryParams::require_all and exclude_any, replaced): a host changes a
+  // character's gait (the measured "gait:stand", "gait:walk", ... of
+  // mmvk/database/gait_bands.hpp) or style at any tick. Errors, before
+  // anything changes: an agent out of range, an unknown tag (listing the
+  // database's tags), a tag both required and excluded.
+  Status set_tags(std::span<const std::uint64_t> agents, std::span<const std::string> require,
+                  std::span<const std::string> exclude);
+
   // Places character b at (x, z) facing yaw, playing `frame`; its next tick
   // searches (CrowdController::place).
   Status place(std::uint32_t b, float x, float z, float yaw, std::uint32_t frame = 0);

@@ -172,6 +172,12 @@ class Crowd:
     @property
     def contacts(self) -> npt.NDArray[np.uint8]: ...
     @property
+    def gaits(self) -> npt.NDArray[np.uint8]:
+        """[agents x 2] the commanded band (0 stand, 1 walk, 2 jog, 3 run) and phase (0 stand, 1 start, 2 move, 3 stop)."""
+    @property
+    def resting(self) -> npt.NDArray[np.uint8]:
+        """[agents] 1 while a character told to stand holds a frame with both feet down."""
+    @property
     def foot_locked(self) -> npt.NDArray[np.uint8]:
         """[agents x 2] (left, right)."""
     @property

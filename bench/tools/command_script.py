@@ -8,7 +8,12 @@ animation".
 at 1.3, stop, walk 0.8). Prints one JSON object: the summary's figures
 (glide, speed and heading errors, trajectory error, sliding, pose
 acceleration, jumps) and, per commanded speed, the played and shown root
-speeds over the held part of each segment (from 1 s after its command).
+speeds over the held part of each segment (from 1 s after its command);
+for a stand, the share of its held agent-ticks with the root and both toes
+under 5 cm/s (still_share); and for every segment the time it took to
+settle (settle_s): from the first tick after which, to the segment's end,
+every character's shown speed over the last 0.5 s is within 10% of the
+command (a stand: under 5 cm/s) and its heading within 10 degrees.
 
   PYTHONPATH=build/python python3 bench/tools/command_script.py DATA [--rate 30] [--speed-from-animation off]
       [--correction-half-life S]
@@ -30,6 +35,7 @@ AGENTS = 16
 SCRIPT = [(2.0, 0.0, 0.0), (4.0, 1.3, 0.0), (4.0, 1.3, 90.0), (4.0, 0.8, 90.0), (4.0, 3.0, 90.0),
           (4.0, 1.3, 270.0), (3.0, 0.0, 270.0), (4.0, 0.8, 270.0)]
 SETTLE_S = 1.0
+WINDOW_S = 0.5  # the shown speed that settling is judged on: path length over this long
 
 
 def main():
@@ -47,26 +53,49 @@ def main():
     for i in range(AGENTS):
         crowd.place(i, 4.0 * i, 0.0, 0.0)
     has_corrections = hasattr(crowd, "root_corrections")
+    toes = [j for j in db.animation.contact_joints if j >= 0]
     segments = []
     last = crowd.root_positions.copy()
+    last_toes = crowd.joint_positions[:, toes].copy()
     for seconds, speed, heading in SCRIPT:
         h = math.radians(heading)
         velocity = np.tile(np.array([speed * math.sin(h), speed * math.cos(h)], np.float32), (AGENTS, 1))
         facing = np.full(AGENTS, h, np.float32)
         ticks = int(round(seconds * crowd.rate))
         shown = played = held = 0.0
+        still = steady = 0
+        recent = []
+        following = []  # per tick: the mean shown speed within 10% (stops: under 5 cm/s) and heading within 10 degrees
         for tick in range(ticks):
             crowd.step(velocity, facing)
             roots = crowd.root_positions
             step = np.hypot(*(roots - last)[:, [0, 2]].T)
+            toe_positions = crowd.joint_positions[:, toes]
+            toe_speed = np.linalg.norm(toe_positions - last_toes, axis=2).max(axis=1) / crowd.dt
+            last_toes = toe_positions.copy()
+            recent.append(step)
+            window = recent[-int(round(WINDOW_S * crowd.rate)):]
+            shown_speed = np.sum(window, axis=0) / (len(window) * crowd.dt)
+            yaw_error = np.degrees(np.abs(np.angle(np.exp(1j * (crowd.root_yaws - h)))))
+            if speed == 0.0:
+                following.append(bool(np.all(shown_speed < 0.05)))
+            else:
+                following.append(bool(np.all(np.abs(shown_speed / speed - 1) < 0.1) and np.all(yaw_error < 10)))
             if tick * crowd.dt >= SETTLE_S:
+                if speed == 0.0:
+                    steady += AGENTS
+                    still += int(np.count_nonzero((step / crowd.dt < 0.05) & (toe_speed < 0.05)))
                 held += crowd.dt
                 shown += step.mean()
                 if has_corrections:
                     own = (roots - last - crowd.root_corrections)[:, [0, 2]]
                     played += np.hypot(*own.T).mean()
             last = roots.copy()
+        # Settled: from the first tick after which the crowd follows to the segment's end (null: never).
+        settled = next((i for i in range(len(following)) if all(following[i:])), None)
         segments.append({"speed_mps": speed, "heading_deg": heading,
+                         "settle_s": None if settled is None else round(settled * crowd.dt, 2),
+                         "still_share": round(still / steady, 3) if steady else None,
                          "shown_mps": round(shown / held, 3),
                          "played_mps": round(played / held, 3) if has_corrections else None})
     s = crowd.summary()

@@ -419,6 +419,26 @@ void add_state_arrays(py::class_<PyCrowd>& crowd) {
           [](const PyCrowd& c) { return copy_array(c.session()->controller().contacts(), {py::ssize_t(c.agents())}); },
           "Foot contact bits of each character's frame, uint8 [agents] (Animation.contacts).")
       .def_property_readonly(
+          "gaits",
+          [](const PyCrowd& c) {
+            const auto states = c.session()->controller().gait_states();
+            py::array_t<std::uint8_t> out({py::ssize_t(c.agents()), py::ssize_t(2)});
+            std::uint8_t* o = out.mutable_data();
+            for (std::size_t b = 0; b < states.size(); ++b) {
+              o[2 * b] = std::uint8_t(states[b].band), o[2 * b + 1] = std::uint8_t(states[b].phase);
+            }
+            return out;
+          },
+          "Each character's commanded gait after the last step, uint8 [agents x 2]: the band (0 stand, 1 walk, "
+          "2 jog, 3 run) and the phase (0 stand, 1 start, 2 move, 3 stop), as the controller chose them from the "
+          "desired velocity (docs/animation.md, \"Gait from the command\"); zeros on data without measured gait "
+          "tags.")
+      .def_property_readonly(
+          "resting",
+          [](const PyCrowd& c) { return copy_array(c.session()->controller().resting(), {py::ssize_t(c.agents())}); },
+          "1 while a character told to stand holds a frame with both feet down (the data's rest frame where "
+          "it has no idle, or a standing frame of a clip that goes on), uint8 [agents].")
+      .def_property_readonly(
           "foot_locked",
           [](const PyCrowd& c) {
             return copy_array(c.session()->controller().foot_locked(), {py::ssize_t(c.agents()), 2});

@@ -405,13 +405,14 @@ TEST(CrowdController, HeldOnAClipsLastFrameGetsNoContinuingBonus) {
   ASSERT_TRUE(controller.ok()) << controller.message();
   ASSERT_TRUE(controller->place(0, glm::vec3(0.0f), 0.0f, 57).ok());
   std::vector<glm::vec3> velocity(1, glm::vec3(0.0f, 0.0f, 1.0f));
-  // Frame 57 plays on to 58, then 59, the last, where it is held: that
-  // search has no continuing frame, and its answer (frame 0) is jumped to.
+  // Frame 57 (held on the first tick, until its first search) plays on to
+  // 58, then 59, the last, where it is held: that search has no continuing
+  // frame, and its answer (frame 0) is jumped to.
   for (int tick = 0; tick < 4 && controller->frames()[0] != 0; ++tick) {
     ASSERT_TRUE(controller->tick(1.0f / 30.0f, CrowdInput{velocity, {}}, search, pool).ok());
   }
   ASSERT_FALSE(search.asked.empty());
-  EXPECT_EQ(search.asked.front(), 58u);  // placed: a forced search after one frame, continuing
+  EXPECT_EQ(search.asked.front(), 57u);  // placed: a forced search before it plays on, continuing
   EXPECT_EQ(search.asked.back(), kNoFrame);
   EXPECT_EQ(controller->frames()[0], 0u);
 }

@@ -198,8 +198,10 @@ def test_speed_from_the_animation_and_its_figures(db):
     the summary reports, and the errors against the command are there."""
     for on in [True, False]:
         crowd = mmvk.Crowd(db, agents=4, backend="clusters", seed=3, speed_from_animation=on)
-        glide = 0.0
-        for _ in range(60):
+        crowd.step(np.tile(np.array([0.0, 0.5], np.float32), (4, 1)))
+        assert np.all(crowd.play_rates == 0.0), "placed: held until the first search"
+        glide = np.linalg.norm(crowd.root_corrections, axis=1).sum()
+        for _ in range(59):
             crowd.step(np.tile(np.array([0.0, 0.5], np.float32), (4, 1)))
             rates, corrections = crowd.play_rates, crowd.root_corrections
             assert rates.shape == (4,) and crowd.stride_scales.shape == (4,) and corrections.shape == (4, 3)
@@ -215,3 +217,29 @@ def test_speed_from_the_animation_and_its_figures(db):
         for key in ["played_speed_error", "shown_speed_error", "heading_error_deg"]:
             assert np.isfinite(s[key]["median"]), key
         assert 0.0 <= s["glide_share_of_travel"] < 1.0
+
+
+def test_told_to_stand_the_characters_stand_still_on_their_own_choice(db):
+    """No tag from the host: the controller chooses the gait from the command
+    (gaits: band and phase), stands on CMU 131's standing frames with the
+    root and toes still, and walks again when told to."""
+    crowd = mmvk.Crowd(db, agents=4, backend="fast-box", seed=1)
+    toes = [j for j in db.animation.contact_joints if j >= 0]
+    walk = np.tile(np.array([0.0, 1.0], np.float32), (4, 1))
+    for _ in range(90):
+        crowd.step(walk)
+    assert np.all(crowd.gaits == [1, 2]), crowd.gaits  # walk band, moving
+    still = ticks = 0
+    for tick in range(90):
+        roots, feet = crowd.root_positions.copy(), crowd.joint_positions[:, toes].copy()
+        crowd.step(np.zeros((4, 2), np.float32))
+        if tick >= 45:
+            speed = np.maximum(np.linalg.norm(crowd.root_positions - roots, axis=1),
+                               np.linalg.norm(crowd.joint_positions[:, toes] - feet, axis=2).max(axis=1)) / crowd.dt
+            still += int(np.count_nonzero(speed < 0.05))
+            ticks += 4
+    assert np.all(crowd.gaits == [0, 0]), crowd.gaits
+    assert still / ticks >= 0.9, still / ticks
+    for _ in range(60):
+        crowd.step(walk)
+    assert np.all(crowd.gaits[:, 0] == 1) and np.all(crowd.resting == 0)

@@ -55,7 +55,9 @@ Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptio
     if (!speeds.has_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     scenario = make_random_scenario(random);
   }
-  MMVK_TRY(resolve_gaits(scenario, speeds));
+  // The crowd's controller chooses each search's gait where the data
+  // measured them (ControllerParams::choose_gait is on).
+  MMVK_TRY(resolve_gaits(scenario, speeds, database.gait_bands() != nullptr));
   return scenario;
 }
 

@@ -103,6 +103,14 @@ void CrowdController::size_state(std::uint32_t characters) {
   schedule_.query_params.assign(n, QueryParams{});
   schedule_.predicted_positions.assign(n * trajectory_size_, glm::vec3(0.0f));
   schedule_.predicted_yaws.assign(n * trajectory_size_, 0.0f);
+  gaits_.state.assign(n, GaitState{});
+  gaits_.constraint.assign(n, GaitConstraint{});
+  gaits_.own_require.assign(n, 0);
+  gaits_.own_exclude.assign(n, 0);
+  gaits_.own_gait.assign(n, 0);
+  gaits_.first.assign(n, 1);
+  gaits_.holding.assign(n, 0);
+  gaits_.entry.assign(n, 0);
   outcome_.jumped.assign(n, 0);
   outcome_.suppressed.assign(n, 0);
   outcome_.match_cost.assign(n, std::numeric_limits<float>::infinity());
@@ -151,6 +159,7 @@ Result<CrowdController> CrowdController::create(const Database& database, std::u
   c.trajectory_size_ = static_cast<std::uint32_t>(c.assembler_.trajectory_offsets().size());
   c.stride_speeds_ = detail::stride_speeds(database, params.stride_window);
   c.size_state(characters);
+  c.start_gaits();
   if (locker.ok()) c.locker_ = std::move(*locker);
   for (std::uint32_t b = 0; b < characters; ++b) MMVK_TRY(c.place(b, glm::vec3(0.0f), 0.0f, 0));
   return c;
@@ -183,6 +192,8 @@ Status CrowdController::place(std::uint32_t b, const glm::vec3& position, float 
   playback_.played_yaw_rate[b] = 0.0f;
   playback_.rate[b] = playback_.stride[b] = 1.0f;
   playback_.contacts[b] = animation_->contacts[frame];
+  gaits_.first[b] = 1;
+  gaits_.holding[b] = 0;
   inertializer_.reset(b);
   const std::size_t base = std::size_t{b} * joints_;
   sample_pose(*animation_, frame, std::span(poses_.animated_rotations).subspan(base, joints_),

@@ -27,11 +27,12 @@ constexpr std::size_t kBlock = 64;
 }  // namespace
 
 void CrowdController::advance(float dt, const CrowdInput& input, ThreadPool& pool) {
+  refresh_gait_options();
   const float fraction = 1.0f - std::exp2(-dt / params_.correction_half_life);
-  for_characters(pool, characters_, [&](std::size_t begin, std::size_t end, unsigned) {
+  for_characters(pool, characters_, [&](std::size_t begin, std::size_t end, unsigned thread) {
     for (std::size_t first = begin; first < end; first += kBlock) {
       const std::size_t last = std::min(end, first + kBlock);
-      simulate_and_play(first, last, dt, input);  // 1
+      simulate_and_play(first, last, dt, input, scratch_[thread]);  // 1
       blend(first, last, dt);                     // 2
       correct(first, last, dt, fraction);         // 3
       decide(first, last, dt);                    // 4
@@ -49,7 +50,8 @@ void CrowdController::advance(float dt, const CrowdInput& input, ThreadPool& poo
 }
 
 // 1. The simulated root follows the input; the character's time moves on.
-void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, float dt, const CrowdInput& input) {
+void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, float dt, const CrowdInput& input,
+                                        ThreadScratch& scratch) {
   const Database& database = *database_;
   const auto flags = database.frame_flags();
   for (std::size_t b = begin; b < end; ++b) {
@@ -59,6 +61,7 @@ void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, floa
     desired = input.desired_velocity[b];
     desired_yaw = input.desired_yaw.empty() ? yaw_of_velocity(desired, desired_yaw) : wrap_angle(input.desired_yaw[b]);
     simulate_step(roots_.simulated[b], desired, desired_yaw, params_.spring, dt);
+    const bool holds = choose_gait(b, dt, scratch);
 
     const PlayTime before{playback_.frames[b], playback_.fractions[b]};
     schedule_.was_blocked[b] = (flags[nearest_frame(database, before)] & kFrameBlockTransition) != 0 ? 1 : 0;
@@ -67,7 +70,11 @@ void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, floa
     const glm::vec3 v = roots_.simulated[b].velocity;
     const float target = std::sqrt(v.x * v.x + v.z * v.z);
     const float stride_speed = stride_speeds_[nearest_frame(database, before)];
-    const detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target);
+    detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target);
+    // A character placed since the last tick holds its frame until its
+    // first search has chosen what it plays: moving on a frame it was only
+    // placed on would give the jump a velocity that nothing commanded.
+    if (holds || poses_.fresh[b] != 0) scale = detail::SpeedScale{0.0f, 1.0f};
     playback_.rate[b] = scale.play_rate;
     playback_.stride[b] = scale.stride_scale;
     const PlaybackStep step = advance_playback(database, before, dt * database.fps() * scale.play_rate);
@@ -143,7 +150,9 @@ void CrowdController::decide(std::size_t begin, std::size_t end, float dt) {
     float& timer = schedule_.timer[b];
     timer -= dt;
     bool regular = false;
-    if (timer <= 0.0f) {
+    // A character holding its rest frame has nothing to search for until
+    // its command changes (which forces a search).
+    if (timer <= 0.0f && gaits_.holding[b] == 0) {
       regular = true;
       timer = std::max(timer + params_.search_interval, 0.0f);
     }
@@ -202,6 +211,8 @@ void CrowdController::assemble(ThreadPool& pool) {
                                 std::span(batch_.queries).subspan(i * dims, dims));
       QueryParams& p = batch_.params[i];
       p = schedule_.query_params[b];
+      p.require_all |= gaits_.constraint[b].require_all;
+      p.exclude_any |= gaits_.constraint[b].exclude_any;
       // A character held on a non-looping clip's last frame has nothing to
       // play on: that frame gets no continuing bonus, else it wins the
       // forced search it triggers and the character searches every tick.
@@ -283,7 +294,9 @@ void CrowdController::apply(std::span<const std::uint32_t> continuing, ThreadPoo
       const std::uint32_t b = characters[i];
       const Match& m = matches[i];
       outcome_.match_cost[b] = m.cost;
-      if (m.frame == kNoFrame || m.frame == continuing[i]) continue;
+      // A resting character holds its frame (a deferred result submitted
+      // before it came to rest does not move it).
+      if (m.frame == kNoFrame || m.frame == continuing[i] || gaits_.holding[b] != 0) continue;
       if (same_location(b, m.frame)) {
         outcome_.suppressed[b] = 1;
         continue;

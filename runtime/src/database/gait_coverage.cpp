@@ -14,19 +14,20 @@ namespace {
 
 constexpr std::uint32_t kNotCandidate = kFrameDoNotUse | kFrameEdgeExcluded;
 
-// The bits of the measured tags in this database, in kGaitTagNames' order.
-std::array<TagMask, kGaitTagNames.size()> gait_tag_bits(const Database& database) {
-  std::array<TagMask, kGaitTagNames.size()> bits{};
-  const auto names = database.tag_names();
-  for (std::size_t i = 0; i < kGaitTagNames.size(); ++i) {
-    const auto it = std::find(names.begin(), names.end(), kGaitTagNames[i]);
-    if (it != names.end()) bits[i] = TagMask{1} << std::size_t(it - names.begin());
+// The frames a coverage counts: candidates that the caller's tags allow.
+struct Candidates {
+  const Database& database;
+  TagMask require_all, exclude_any;
+  bool operator()(std::uint32_t frame) const {
+    if (database.frame_flags()[frame] & kNotCandidate) return false;
+    const TagMask tags = database.frame_tags()[frame];
+    return (tags & require_all) == require_all && (tags & exclude_any) == 0;
   }
-  return bits;
-}
+};
 
 // The smoothed root speeds of the candidate moving frames, clip by clip.
-std::vector<float> moving_speeds(const Database& database, const GaitBandParams& params, TagMask stand) {
+std::vector<float> moving_speeds(const Candidates& candidate, const GaitBandParams& params, TagMask stand) {
+  const Database& database = candidate.database;
   std::vector<float> moving;
   const AnimationData* animation = database.animation();
   if (!animation) return moving;
@@ -35,7 +36,7 @@ std::vector<float> moving_speeds(const Database& database, const GaitBandParams&
     const std::vector<float> speeds = smoothed_root_speeds(root, database.fps(), clip.loop, params.smoothing_seconds);
     for (std::uint32_t f = 0; f < clip.frame_count; ++f) {
       const std::uint32_t frame = clip.first_frame + f;
-      if ((database.frame_flags()[frame] & kNotCandidate) || (database.frame_tags()[frame] & stand)) continue;
+      if (!candidate(frame) || (database.frame_tags()[frame] & stand)) continue;
       moving.push_back(speeds[f]);
     }
   }
@@ -44,11 +45,12 @@ std::vector<float> moving_speeds(const Database& database, const GaitBandParams&
 
 // The longest run of consecutive stand candidates in one clip, and whether
 // a looping clip stands throughout.
-void measure_idles(const Database& database, TagMask stand, GaitCoverage& coverage) {
+void measure_idles(const Candidates& candidate, TagMask stand, GaitCoverage& coverage) {
+  const Database& database = candidate.database;
   for (const Clip& clip : database.clips()) {
     std::uint32_t run = 0, longest = 0;
     for (std::uint32_t f = clip.first_frame; f < clip.first_frame + clip.frame_count; ++f) {
-      const bool stands = !(database.frame_flags()[f] & kNotCandidate) && (database.frame_tags()[f] & stand);
+      const bool stands = candidate(f) && (database.frame_tags()[f] & stand);
       run = stands ? run + 1 : 0;
       longest = std::max(longest, run);
     }
@@ -61,17 +63,29 @@ std::string yes_no(bool value) { return value ? "yes" : "no"; }
 
 }  // namespace
 
-GaitCoverage measure_gait_coverage(const Database& database) {
+GaitTagBits gait_tag_bits(const Database& database) {
+  GaitTagBits bits;
+  const auto names = database.tag_names();
+  for (std::size_t i = 0; i < kGaitTagNames.size(); ++i) {
+    const auto it = std::find(names.begin(), names.end(), kGaitTagNames[i]);
+    if (it != names.end()) bits.bit[i] = TagMask{1} << std::size_t(it - names.begin());
+    bits.all |= bits.bit[i];
+  }
+  return bits;
+}
+
+GaitCoverage measure_gait_coverage(const Database& database, TagMask require_all, TagMask exclude_any) {
   GaitCoverage coverage;
   const GaitBandParams* params = database.gait_bands();
   if (!params) return coverage;
   coverage.measured = true;
-  const auto bits = gait_tag_bits(database);
+  const auto bits = gait_tag_bits(database).bit;
+  const Candidates candidate{database, require_all, exclude_any};
   const AnimationData* animation = database.animation();
   coverage.has_contacts = animation != nullptr && !animation->contacts.empty();
   const std::uint8_t both_feet = kContactLeft | kContactRight;
   for (std::uint32_t f = 0; f < database.frame_count(); ++f) {
-    if (database.frame_flags()[f] & kNotCandidate) continue;
+    if (!candidate(f)) continue;
     const TagMask tags = database.frame_tags()[f];
     for (std::size_t b = 0; b < kGaitBandCount; ++b) coverage.band_frames[b] += (tags & bits[b]) != 0;
     coverage.start_frames += (tags & bits[kGaitStartTag]) != 0;
@@ -81,8 +95,8 @@ GaitCoverage measure_gait_coverage(const Database& database) {
       ++coverage.stand_both_feet_frames;
     }
   }
-  measure_idles(database, bits[std::size_t(GaitBand::Stand)], coverage);
-  std::vector<float> moving = moving_speeds(database, *params, bits[std::size_t(GaitBand::Stand)]);
+  measure_idles(candidate, bits[std::size_t(GaitBand::Stand)], coverage);
+  std::vector<float> moving = moving_speeds(candidate, *params, bits[std::size_t(GaitBand::Stand)]);
   if (!moving.empty()) {
     std::sort(moving.begin(), moving.end());
     const auto at = [&](double q) { return moving[std::min(moving.size() - 1, std::size_t(q * double(moving.size())))]; };

@@ -64,6 +64,7 @@
 #include "mmvk/search/async_search.hpp"
 #include "mmvk/database/database.hpp"
 #include "mmvk/animation/foot_locker.hpp"
+#include "mmvk/animation/gait_choice.hpp"
 #include "mmvk/animation/pose_batch.hpp"
 #include "mmvk/query/query_assembly.hpp"
 #include "mmvk/animation/root_history.hpp"
@@ -115,6 +116,14 @@ struct ControllerParams {
   float min_stride_scale = 0.85f;
   float max_stride_scale = 1.15f;
   float stride_window = 1.0f;  // seconds
+  // Gait from the command (gait_choice.hpp): on a database with measured
+  // gait tags (Database::gait_bands), each character's searches keep to the
+  // frames of its commanded gait and phase: standing frames when told to
+  // stand (or, with no idle in the data, it holds a frame with both feet
+  // down), moving ones when told to move. Characters whose own tags
+  // (query_params()) name a gait: tag, and every character with this false
+  // or on a database without the tags, search as their tags say.
+  bool choose_gait = true;
   // Search options applied to every query (per-character tags: query_params()).
   float continuing_bias = 0.0f;
   float continuing_multiplier = 1.0f;  // finite, >= 0 (QueryParams::continuing_multiplier)
@@ -217,6 +226,15 @@ class CrowdController {
   std::span<const std::uint8_t> jumped() const { return outcome_.jumped; }          // 1: jumped this tick
   std::span<const float> match_costs() const { return outcome_.match_cost; }        // last applied match (inf: none)
   std::span<const std::uint8_t> contacts() const { return playback_.contacts; }     // FootContact bits of the nearest frame
+  // The gait each character was commanded into this tick and the tag
+  // constraint its searches get (ControllerParams::choose_gait; empty
+  // constraints where it does not apply), and 1 while, told to stand, it
+  // holds a frame with both feet down: the data's rest frame where the data
+  // has no idle (GaitConstraint::rest), or a standing frame of a clip that
+  // goes on (not a loop) where it has (gait_choice.hpp), [B].
+  std::span<const GaitState> gait_states() const { return gaits_.state; }
+  std::span<const GaitConstraint> gait_constraints() const { return gaits_.constraint; }
+  std::span<const std::uint8_t> resting() const { return gaits_.holding; }
   // Speed from the animation (ControllerParams::min_play_rate, ...): the
   // rate each character played its clip at this tick, and the scale of its
   // root motion, [B].
@@ -321,6 +339,28 @@ class CrowdController {
     std::vector<QueryParams> params;
     std::uint32_t count = 0;
   };
+  // Gait from the command (gait_choice.hpp), [B] unless noted.
+  struct Gaits {
+    bool enabled = false;  // choose_gait on a database with measured gait tags
+    GaitBandParams params;
+    GaitTagBits bits;
+    // What one distinct pair of a character's own masks leaves: its
+    // options, and the frame to rest on in each clip ([clips]; where a clip
+    // has none, the best of all).
+    struct Entry {
+      TagMask require = 0, exclude = 0;
+      GaitOptions options;
+      std::vector<std::uint32_t> rest_frames;
+    };
+    std::vector<Entry> entries;
+    std::vector<GaitState> state;
+    std::vector<GaitConstraint> constraint;
+    std::vector<std::uint32_t> entry;               // into entries, for b's masks
+    std::vector<TagMask> own_require, own_exclude;  // the query_params() masks entry was found for
+    std::vector<std::uint8_t> own_gait;             // the masks name a gait: tag
+    std::vector<std::uint8_t> first;                // no state yet (placed)
+    std::vector<std::uint8_t> holding;              // resting on its rest frame
+  };
   // A searched batch's characters and the frames they continued, [B]
   // capacity: the deferred batch in flight.
   struct InFlight {
@@ -348,10 +388,22 @@ class CrowdController {
   // Steps 1-4 over every character; fills the batch's characters.
   void advance(float dt, const CrowdInput& input, ThreadPool& pool);
   // The steps of advance() for characters [begin, end).
-  void simulate_and_play(std::size_t begin, std::size_t end, float dt, const CrowdInput& input);
+  void simulate_and_play(std::size_t begin, std::size_t end, float dt, const CrowdInput& input,
+                         ThreadScratch& scratch);
   void blend(std::size_t begin, std::size_t end, float dt);
   void correct(std::size_t begin, std::size_t end, float dt, float fraction);
   void decide(std::size_t begin, std::size_t end, float dt);
+  // Serially before step 1: each character's gait entry, for its current
+  // query_params() masks.
+  void refresh_gait_options();
+  // At create(): whether gaits are chosen, and every character's entry for
+  // its first (empty) masks.
+  void start_gaits();
+  std::uint32_t gait_entry(TagMask require, TagMask exclude);
+  // Step 1's gait: b's state and constraint this tick, and its rest: it
+  // jumps to its rest frame and holds it. Returns whether b holds a frame
+  // (plays at rate 0).
+  bool choose_gait(std::size_t b, float dt, ThreadScratch& scratch);
   // The one forward kinematics of b's animated pose, and the velocities of
   // the joints queries read; `fresh`: no previous tick.
   void measure(std::uint32_t b, float dt, bool fresh);
@@ -385,6 +437,7 @@ class CrowdController {
   Schedule schedule_;
   Outcome outcome_;
   Poses poses_;
+  Gaits gaits_;
   Batch batch_;
   InFlight in_flight_;
   Applied applied_;

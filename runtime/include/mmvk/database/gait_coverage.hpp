@@ -41,7 +41,17 @@ struct GaitCoverage {
   bool can_stand() const { return stand_loop || longest_stand_seconds >= kMinIdleSeconds; }
 };
 
-GaitCoverage measure_gait_coverage(const Database& database);
+// The bit of each measured tag in a database (kGaitTagNames' order), 0 where
+// a name is missing; all: their union.
+struct GaitTagBits {
+  std::array<TagMask, kGaitTagNames.size()> bit{};
+  TagMask all = 0;
+};
+GaitTagBits gait_tag_bits(const Database& database);
+
+// Over the candidate frames whose tags include all of require_all and none
+// of exclude_any (a character's own tags; 0 and 0: every candidate).
+GaitCoverage measure_gait_coverage(const Database& database, TagMask require_all = 0, TagMask exclude_any = 0);
 
 // One line for people and help text, the same facts in the same words:
 // "stands: yes, starts: no, stops: yes, speeds: walk, jog, run" (the moving

@@ -1,0 +1,137 @@
+// The controller's gait from the command (ControllerParams::choose_gait,
+// gait_choice.hpp): per character, the state and the tag constraint of its
+// searches, and the rest on a held frame where the data has no idle.
+#include <cmath>
+#include <limits>
+
+#include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/animation/playback.hpp"
+#include "mmvk/features/foot_contacts.hpp"
+
+namespace mmvk {
+
+namespace {
+
+// Distinct pairs of masks kept; beyond (a host that gives its characters
+// ever new tags) the entries start anew with only those in use.
+constexpr std::size_t kMaxGaitEntries = 256;
+constexpr std::uint32_t kNoEntry = std::numeric_limits<std::uint32_t>::max();
+
+float horizontal_speed(const glm::vec3& v) { return std::sqrt(v.x * v.x + v.z * v.z); }
+
+// The frame to rest on in each clip, among the candidates the masks allow:
+// both feet planted and the slowest stride (stride_speeds, [frames]); a
+// clip without one rests on the best of all (with both feet down if any
+// frame has them, else the slowest). kNoFrame where no frame is allowed.
+std::vector<std::uint32_t> find_rest_frames(const Database& database, std::span<const float> stride_speeds,
+                                            TagMask require, TagMask exclude) {
+  const AnimationData& animation = *database.animation();
+  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
+  constexpr std::uint32_t kNotCandidate = kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition;
+  // Lower is better: no both-feet frame ranks after every both-feet one.
+  const auto rank = [&](std::uint32_t f) {
+    return stride_speeds[f] + ((animation.contacts[f] & kBothFeet) == kBothFeet ? 0.0f : 1e6f);
+  };
+  const auto better = [&](std::uint32_t a, std::uint32_t b) { return b == kNoFrame || rank(a) < rank(b); };
+  std::vector<std::uint32_t> rest(database.clips().size(), kNoFrame);
+  std::uint32_t best = kNoFrame;
+  for (std::size_t c = 0; c < database.clips().size(); ++c) {
+    const Clip& clip = database.clips()[c];
+    for (std::uint32_t f = clip.first_frame; f < clip.first_frame + clip.frame_count; ++f) {
+      const TagMask tags = database.frame_tags()[f];
+      if ((database.frame_flags()[f] & kNotCandidate) || (tags & require) != require || (tags & exclude)) continue;
+      if ((animation.contacts[f] & kBothFeet) == kBothFeet && better(f, rest[c])) rest[c] = f;
+      if (better(f, best)) best = f;
+    }
+  }
+  for (std::uint32_t& r : rest) r = r == kNoFrame ? best : r;
+  return rest;
+}
+
+}  // namespace
+
+void CrowdController::start_gaits() {
+  const GaitBandParams* params = database_->gait_bands();
+  gaits_.enabled = params_.choose_gait && params != nullptr;
+  if (!gaits_.enabled) return;
+  gaits_.params = *params;
+  gaits_.bits = gait_tag_bits(*database_);
+  gaits_.entries.clear();
+  gaits_.entry.assign(characters_, gait_entry(0, 0));
+}
+
+std::uint32_t CrowdController::gait_entry(TagMask require, TagMask exclude) {
+  for (std::size_t i = 0; i < gaits_.entries.size(); ++i) {
+    if (gaits_.entries[i].require == require && gaits_.entries[i].exclude == exclude) return std::uint32_t(i);
+  }
+  Gaits::Entry e;
+  e.require = require;
+  e.exclude = exclude;
+  e.options = gait_options(measure_gait_coverage(*database_, require, exclude));
+  e.rest_frames = find_rest_frames(*database_, stride_speeds_, require, exclude);
+  gaits_.entries.push_back(std::move(e));
+  return std::uint32_t(gaits_.entries.size() - 1);
+}
+
+void CrowdController::refresh_gait_options() {
+  if (!gaits_.enabled) return;
+  if (gaits_.entries.size() > kMaxGaitEntries) {
+    gaits_.entries.clear();
+    std::fill(gaits_.entry.begin(), gaits_.entry.end(), kNoEntry);
+  }
+  for (std::uint32_t b = 0; b < characters_; ++b) {
+    const QueryParams& own = schedule_.query_params[b];
+    if (gaits_.entry[b] != kNoEntry && own.require_all == gaits_.own_require[b] &&
+        own.exclude_any == gaits_.own_exclude[b]) {
+      continue;
+    }
+    gaits_.own_require[b] = own.require_all;
+    gaits_.own_exclude[b] = own.exclude_any;
+    gaits_.own_gait[b] = ((own.require_all | own.exclude_any) & gaits_.bits.all) != 0 ? 1 : 0;
+    gaits_.entry[b] = gait_entry(own.require_all, own.exclude_any);
+  }
+}
+
+bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratch) {
+  if (!gaits_.enabled) return false;
+  const float commanded = horizontal_speed(schedule_.desired_velocity[b]);
+  const float simulated = horizontal_speed(roots_.simulated[b].velocity);
+  GaitState& state = gaits_.state[b];
+  state = gaits_.first[b] ? first_gait_state(gaits_.params, commanded)
+                          : next_gait_state(gaits_.params, state, commanded, simulated, dt);
+  gaits_.first[b] = 0;
+  const Gaits::Entry& entry = gaits_.entries[gaits_.entry[b]];
+  const GaitConstraint constraint =
+      gaits_.own_gait[b] ? GaitConstraint{} : gait_constraint(state, entry.options, gaits_.bits);
+  // New frames are allowed or the old ones forbidden: search now, not at
+  // the next regular search.
+  if (!(constraint == gaits_.constraint[b])) schedule_.force[b] = 1;
+  gaits_.constraint[b] = constraint;
+
+  std::uint8_t& holding = gaits_.holding[b];
+  if (state.phase != GaitPhase::Stand || gaits_.own_gait[b]) {
+    holding = 0;
+    return false;
+  }
+  if (holding) return true;
+  const std::uint32_t frame = playback_.frames[b];
+  const Clip& clip = database_->clips()[database_->frame_clip()[frame]];
+  if (constraint.rest) {
+    // No idle: the rest frame of the clip it plays, blended into by the
+    // inertialization as any jump is, then held (its feet locked).
+    const std::uint32_t rest = entry.rest_frames[database_->frame_clip()[frame]];
+    if (rest == kNoFrame) return false;
+    if (rest != frame) jump(static_cast<std::uint32_t>(b), rest, scratch);
+    holding = 1;
+    return true;
+  }
+  // Standing frames of a clip that goes on (a walk's first steps, a stop's
+  // end) are held once both feet are down: played on they would shift
+  // weight and step off, and each search would cut that short.
+  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
+  const bool stands = (database_->frame_tags()[frame] & gaits_.bits.bit[std::size_t(GaitBand::Stand)]) != 0;
+  holding = !clip.loop && stands && (animation_->contacts[frame] & kBothFeet) == kBothFeet ? 1 : 0;
+  return holding != 0;
+}
+
+}  // namespace mmvk

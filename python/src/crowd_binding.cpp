@@ -499,7 +499,7 @@ void add_exports(py::class_<PyCrowd>& crowd) {
           [](const PyCrowd& c, const py::object& folder) {
             const std::filesystem::path dir = to_path(folder, "folder");
             write_poses(c, "write_bvh", [&dir](const crowd::PoseRecording& poses) -> Status {
-              MMVK_TRY(crowd::prepare_bvh_folder(dir, poses.agents, "folder"));
+              MMVK_TRY(crowd::check_bvh_folder(dir, poses.agents, "folder"));
               return crowd::write_bvh_files(poses, dir);
             });
           },

@@ -205,6 +205,40 @@ TEST_F(CrowdCli, TheBvhFolderIsMadeOnlyWhenTheExportIsWritten) {
   EXPECT_EQ(std::distance(fs::directory_iterator(later), fs::directory_iterator()), 2);
 }
 
+// --detail-agents: the viewer's whole poses and explanations for any set of
+// characters; every bad spec is refused naming the option before the run.
+TEST_F(CrowdCli, DetailAgentsChooseTheViewersLevelOfDetail) {
+  const fs::path page = dir_ / "c.html";
+  const std::string run = "--backend fast-box --agents 3 --seconds 1 --html " + page.string() + " ";
+  expect_failure("--detail-agents 2", "--detail-agents needs --html FILE");
+  const struct {
+    const char* spec;
+    const char* expected;
+  } refused[] = {
+      {"0-1,x", "--detail-agents '0-1,x': 'x' is not an index or a range A-B"},
+      {"''", "--detail-agents '': an empty list"},
+      {"1,1", "--detail-agents '1,1': character 1 is listed twice"},
+      {"2-1", "--detail-agents '2-1': the range 2-1 runs backwards"},
+      {"4", "--detail-agents 4: the crowd has 3 characters"},
+      {"0-1,3", "--detail-agents: character 3 is beyond the crowd (0 to 2)"},
+  };
+  for (const auto& c : refused) {
+    const auto result = run_command(mmvk_ + " crowd " + run + "--detail-agents " + c.spec);
+    EXPECT_EQ(result.exit_code, 1) << c.spec << "\n" << result.output;
+    EXPECT_NE(result.output.find(c.expected), std::string::npos) << c.spec << "\n" << result.output;
+    EXPECT_EQ(result.output.find("ticks in"), std::string::npos) << c.spec << "\n" << result.output;
+  }
+  EXPECT_FALSE(fs::exists(page));
+  const auto ran = run_command(mmvk_ + " crowd " + run + "--detail-agents 0,2");
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  std::ifstream in(page);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("\"detail\":{\"agents\":2,"), std::string::npos);
+  const auto help = run_command(mmvk_ + " crowd --help");
+  EXPECT_NE(help.output.find("--detail-agents"), std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("0-9,42,100-104"), std::string::npos) << help.output;
+}
+
 TEST_F(CrowdCli, TraceWritesThePositionsAndTheSidecar) {
   const fs::path trace = dir_ / "walk.f32";
   const auto ran = run_command(mmvk_ + " crowd --backend fast-box --agents 4 --seconds 1 --rate 60 --foot-ik off " +

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -24,6 +25,7 @@
 #include "setup/crowd_defaults.hpp"
 #include "setup/crowd_limits.hpp"
 #include "setup/crowd_session.hpp"
+#include "setup/detail_agents.hpp"
 #include "errors.hpp"
 #include "output/gltf_export.hpp"
 #include "mmvk/common/number_text.hpp"
@@ -86,6 +88,30 @@ std::vector<std::string> tag_names(const py::object& names, const char* field) {
     out.push_back(name.cast<std::string>());
   }
   return out;
+}
+
+// detail_agents: None (the first kDefaultDetailAgents), a count, a spec as
+// `mmvk crowd --detail-agents` takes it ("0-9,42"), or a sequence of indices.
+std::optional<crowd::DetailAgents> detail_choice(const py::object& value) {
+  constexpr const char* kName = "detail_agents";
+  if (value.is_none()) return std::nullopt;
+  if (py::isinstance<py::str>(value)) return take(crowd::parse_detail_agents(value.cast<std::string>(), kName));
+  // An integer (NumPy's too); an array also has __index__, but is a sequence.
+  if (PyIndex_Check(value.ptr()) && !py::isinstance<py::iterable>(value)) {
+    crowd::DetailAgents choice;
+    choice.count = unsigned_argument(value, kName, std::numeric_limits<std::uint64_t>::max());
+    return choice;
+  }
+  if (!py::isinstance<py::iterable>(value)) {
+    throw py::type_error(std::string(kName) + ": expected None, a count, a spec such as '0-9,42' or a sequence of "
+                         "indices, got " + std::string(py::str(py::type::of(value).attr("__name__"))));
+  }
+  std::vector<std::int64_t> indices;
+  for (const py::handle item : value) {
+    indices.push_back(integer_argument(item, kName, std::numeric_limits<std::int64_t>::min(),
+                                       std::numeric_limits<std::int64_t>::max()));
+  }
+  return take(crowd::detail_agents_from_list(indices, kName));
 }
 
 class PyCrowd {
@@ -286,7 +312,7 @@ void add_construction(py::class_<PyCrowd>& crowd) {
                        double rate, std::uint64_t seed, const py::object& device, const py::object& scenario,
                        double search_interval, bool foot_ik, bool record, const std::string& title,
                        const py::object& correction_half_life, std::uint32_t record_poses,
-                       bool speed_from_animation) {
+                       bool speed_from_animation, const py::object& detail_agents) {
              CrowdSessionOptions options;
              options.backend = backend;
              options.rate_hz = rate;
@@ -299,6 +325,8 @@ void add_construction(py::class_<PyCrowd>& crowd) {
              if (!device.is_none()) options.device = device.cast<std::uint32_t>();
              if (!correction_half_life.is_none()) options.correction_half_life = correction_half_life.cast<float>();
              if (!scenario.is_none()) options.scenario = scenario_of(scenario);
+             options.detail_agents = detail_choice(detail_agents);
+             if (options.detail_agents && !record) raise("detail_agents needs record=True (the viewer's recording)");
              if (!agents.is_none()) {
                // Checked as given, before the session checks the rest (CrowdSession::create).
                const long long n = agents.cast<long long>();
@@ -312,7 +340,7 @@ void add_construction(py::class_<PyCrowd>& crowd) {
            py::arg("scenario") = py::none(), py::arg("search_interval") = kDefaults.search_interval_s,
            py::arg("foot_ik") = kDefaults.foot_ik, py::arg("record") = false,
            py::arg("title") = "", py::arg("correction_half_life") = py::none(), py::arg("record_poses") = 0,
-           py::arg("speed_from_animation") = kDefaults.speed_from_animation);
+           py::arg("speed_from_animation") = kDefaults.speed_from_animation, py::arg("detail_agents") = py::none());
 }
 
 // The ticks: the crowd's own steering, or another simulator's.
@@ -519,7 +547,7 @@ void add_exports(py::class_<PyCrowd>& crowd) {
           [](const PyCrowd& c, const py::object& folder) {
             const std::filesystem::path dir = to_path(folder, "folder");
             write_poses(c, "write_bvh", [&dir](const crowd::PoseRecording& poses) -> Status {
-              MMVK_TRY(crowd::prepare_bvh_folder(dir, poses.agents, "folder"));
+              MMVK_TRY(crowd::check_bvh_folder(dir, poses.agents, "folder"));
               return crowd::write_bvh_files(poses, dir);
             });
           },
@@ -612,7 +640,7 @@ const char* crowd_doc() {
       "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
       "figures and defaults. Crowd(db, agents=None, backend='auto', rate=30.0, seed=1, device=None, scenario=None, "
       "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None, record_poses=0, "
-      "speed_from_animation=True). agents: the number of "
+      "speed_from_animation=True, detail_agents=None). agents: the number of "
       "characters (1 to " + std::to_string(crowd::kMaxAgents) + "), drawn with goals from seed (default " +
       std::to_string(crowd::kDefaultAgents) + "), or scenario: a scenario JSON file or "
       "dict (starts, goals, speeds, tags; `mmvk crowd --scenario`), which sets the count. backend 'auto': a Vulkan "
@@ -625,8 +653,12 @@ const char* crowd_doc() {
       "--correction-half-life`). speed_from_animation: play each clip faster or slower and scale its stride toward "
       "the commanded speed, the root correction held to half the animation's own speed (False: the data's own "
       "speeds; `mmvk crowd --speed-from-animation`). Every setting is checked before anything is allocated. "
-      "record=True keeps the viewer's recording for write_html(); record_poses=M keeps the displayed poses of the "
-      "first M characters every tick for write_bvh() and write_gltf().";
+      "record=True keeps the viewer's recording for write_html(); detail_agents chooses the characters it keeps "
+      "in detail, their whole pose every tick and every search explained (None: the first " +
+      std::to_string(crowd::kDefaultDetailAgents) + ", or the crowd when smaller; a count N: the first N; a spec "
+      "such as '0-9,42,100-104' as `mmvk crowd --detail-agents` takes it; or a sequence of indices). "
+      "record_poses=M keeps the displayed poses of the first M characters every tick for write_bvh() and "
+      "write_gltf().";
   return doc.c_str();
 }
 

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -171,6 +172,71 @@ TEST_F(CrowdCli, ExportErrorsNameTheOptionBeforeTheRun) {
   expect_failure("--backend fast-box --agents 3 --rate 10 --seconds 100000 --gltf " + glb + " --export-agents 1",
                  "over the 512 MiB an export may hold");
   EXPECT_FALSE(fs::exists(glb));
+}
+
+// --bvh DIR makes nothing before the run: a run that fails after the checks
+// leaves no empty folder behind, and the folder appears with the files.
+TEST_F(CrowdCli, TheBvhFolderIsMadeOnlyWhenTheExportIsWritten) {
+  const std::string run = "--backend fast-box --agents 3 --seconds 1 ";
+  const fs::path later = dir_ / "later";
+  // Failures after the paths are checked: the export count against the
+  // crowd, and a scenario file read once the database is open.
+  expect_failure(run + "--bvh " + later.string() + " --export-agents 5", "--export-agents 5 must be in [1, 3]");
+  EXPECT_FALSE(fs::exists(later));
+  const fs::path bad = dir_ / "bad.json";
+  std::ofstream(bad) << R"({"agents": [{"start": [0, 0], "goals": "north"}]})";
+  expect_failure("--backend fast-box --seconds 1 --scenario " + bad.string() + " --bvh " + later.string(),
+                 bad.string());
+  EXPECT_FALSE(fs::exists(later));
+  // Refused before the database, naming the option: a file in the way, a
+  // parent that does not exist (made neither).
+  const fs::path file = dir_ / "file";
+  std::ofstream(file) << "x";
+  expect_failure(run + "--bvh " + file.string(), "--bvh " + file.string() + ": not a folder");
+  const fs::path deep = dir_ / "missing" / "bvh";
+  expect_failure(run + "--bvh " + deep.string(), "--bvh " + deep.string() + ": cannot make the folder there");
+  EXPECT_FALSE(fs::exists(dir_ / "missing"));
+  // The run that succeeds makes the folder, one file per exported character.
+  const auto ran = run_command(mmvk_ + " crowd " + run + "--bvh " + later.string() + " --export-agents 2");
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  ASSERT_TRUE(fs::is_directory(later));
+  EXPECT_TRUE(fs::is_regular_file(later / "agent_0000.bvh"));
+  EXPECT_TRUE(fs::is_regular_file(later / "agent_0001.bvh"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(later), fs::directory_iterator()), 2);
+}
+
+// --detail-agents: the viewer's whole poses and explanations for any set of
+// characters; every bad spec is refused naming the option before the run.
+TEST_F(CrowdCli, DetailAgentsChooseTheViewersLevelOfDetail) {
+  const fs::path page = dir_ / "c.html";
+  const std::string run = "--backend fast-box --agents 3 --seconds 1 --html " + page.string() + " ";
+  expect_failure("--detail-agents 2", "--detail-agents needs --html FILE");
+  const struct {
+    const char* spec;
+    const char* expected;
+  } refused[] = {
+      {"0-1,x", "--detail-agents '0-1,x': 'x' is not an index or a range A-B"},
+      {"''", "--detail-agents '': an empty list"},
+      {"1,1", "--detail-agents '1,1': character 1 is listed twice"},
+      {"2-1", "--detail-agents '2-1': the range 2-1 runs backwards"},
+      {"4", "--detail-agents 4: the crowd has 3 characters"},
+      {"0-1,3", "--detail-agents: character 3 is beyond the crowd (0 to 2)"},
+  };
+  for (const auto& c : refused) {
+    const auto result = run_command(mmvk_ + " crowd " + run + "--detail-agents " + c.spec);
+    EXPECT_EQ(result.exit_code, 1) << c.spec << "\n" << result.output;
+    EXPECT_NE(result.output.find(c.expected), std::string::npos) << c.spec << "\n" << result.output;
+    EXPECT_EQ(result.output.find("ticks in"), std::string::npos) << c.spec << "\n" << result.output;
+  }
+  EXPECT_FALSE(fs::exists(page));
+  const auto ran = run_command(mmvk_ + " crowd " + run + "--detail-agents 0,2");
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  std::ifstream in(page);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("\"detail\":{\"agents\":2,"), std::string::npos);
+  const auto help = run_command(mmvk_ + " crowd --help");
+  EXPECT_NE(help.output.find("--detail-agents"), std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("0-9,42,100-104"), std::string::npos) << help.output;
 }
 
 TEST_F(CrowdCli, TraceWritesThePositionsAndTheSidecar) {

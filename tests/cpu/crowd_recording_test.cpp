@@ -1,11 +1,13 @@
 // The viewer's recording of a real crowd (host/crowd/output/crowd_recorder.hpp) on
-// the shipped CMU subject 16 set: the first characters' whole pose as
-// displayed is kept after every tick, and every search of theirs is
-// explained with the frame and the cost the search itself found.
+// the shipped CMU subject 16 set: the detailed characters' whole pose as
+// displayed (the first 32 by default, or any set: --detail-agents) is kept
+// after every tick, and every search of theirs is explained with the frame
+// and the cost the search itself found.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "setup/default_data.hpp"
@@ -13,6 +15,7 @@
 #include "mmvk/animation/crowd_controller.hpp"
 #include "mmvk/search/reference_search.hpp"
 #include "measure/tick_observers.hpp"
+#include "setup/detail_agents.hpp"
 
 namespace mmvk::crowd {
 namespace {
@@ -36,7 +39,8 @@ struct Recorded {
   std::vector<glm::vec3> shown;  // [ticks x characters x joints]
 };
 
-Recorded record_walk(const Database& db, std::uint32_t characters, std::uint32_t ticks) {
+Recorded record_walk(const Database& db, std::uint32_t characters, std::uint32_t ticks,
+                     const std::optional<DetailAgents>& detail = std::nullopt) {
   Recorded out;
   Result<CrowdController> created = CrowdController::create(db, characters);
   EXPECT_TRUE(created.ok()) << created.message();
@@ -50,7 +54,9 @@ Recorded record_walk(const Database& db, std::uint32_t characters, std::uint32_t
   DeferredSearch deferred(reference, characters);
   ThreadPool pool(1);
   const float dt = 1.0f / 30.0f;
-  RecordingObserver recorder(controller, scenario, "test", dt, 3);
+  Result<std::vector<std::uint32_t>> chosen = resolve_detail_agents(detail, characters, "--detail-agents");
+  EXPECT_TRUE(chosen.ok()) << chosen.message();
+  RecordingObserver recorder(controller, scenario, "test", dt, 3, std::move(chosen.value()));
   std::vector<glm::vec3> velocities(characters);
   for (std::uint32_t t = 0; t < ticks; ++t) {
     // Turning: the searches jump now and then.
@@ -69,25 +75,60 @@ Recorded record_walk(const Database& db, std::uint32_t characters, std::uint32_t
   return out;
 }
 
+// The whole poses recorded are, bit for bit, what the controller displayed
+// after each tick, for each detailed character in its slot.
+void expect_whole_poses(const Recorded& recorded, std::size_t characters) {
+  const Recording& r = recorded.recording;
+  const std::size_t joints = r.joint_count();
+  for (std::size_t t = 0; t < r.detail_sample_count; ++t) {
+    for (std::size_t slot = 0; slot < r.detail_agents.size(); ++slot) {
+      const std::size_t a = r.detail_agents[slot];
+      for (std::size_t j = 0; j < joints; ++j) {
+        const glm::vec3& p = recorded.shown[(t * characters + a) * joints + j];
+        const float* q = r.detail_positions.data() + r.detail_index(t, slot, j);
+        ASSERT_EQ(q[0], p.x) << "tick " << t << ", character " << a << ", joint " << j;
+        ASSERT_EQ(q[1], p.y);
+        ASSERT_EQ(q[2], p.z);
+      }
+    }
+  }
+}
+
 TEST(CrowdRecording, TheFirstCharactersWholePosesAtTheTickRate) {
   const Database db = default_data();
   constexpr std::uint32_t kCharacters = kDefaultDetailAgents + 4, kTicks = 45;
   const Recorded recorded = record_walk(db, kCharacters, kTicks);
   const Recording& r = recorded.recording;
-  ASSERT_EQ(r.detail_agents, kDefaultDetailAgents);
+  ASSERT_EQ(r.detail_agents.size(), kDefaultDetailAgents);
+  for (std::uint32_t a = 0; a < kDefaultDetailAgents; ++a) ASSERT_EQ(r.detail_agents[a], a);
   ASSERT_EQ(r.detail_sample_count, kTicks);
   EXPECT_FLOAT_EQ(r.detail_rate_hz, 30.0f);
   EXPECT_EQ(r.sample_count, 15u);  // the 10 Hz samples of everyone
-  const std::size_t joints = r.joint_count();
-  for (std::size_t t = 0; t < kTicks; ++t) {
-    for (std::size_t a = 0; a < r.detail_agents; ++a) {
-      for (std::size_t j = 0; j < joints; ++j) {
-        const glm::vec3& p = recorded.shown[(t * kCharacters + a) * joints + j];
-        const float* q = r.detail_positions.data() + r.detail_index(t, a, j);
-        ASSERT_EQ(q[0], p.x) << "tick " << t << ", character " << a << ", joint " << j;
-        ASSERT_EQ(q[1], p.y);
-        ASSERT_EQ(q[2], p.z);
-      }
+  expect_whole_poses(recorded, kCharacters);
+}
+
+// --detail-agents 1,4-5,9 (any set): exactly those characters are kept at
+// the tick rate and explained, and no other.
+TEST(CrowdRecording, AChosenSetOfCharactersIsKeptInDetail) {
+  const Database db = default_data();
+  constexpr std::uint32_t kCharacters = 11, kTicks = 45;
+  const Result<DetailAgents> spec = parse_detail_agents("9,4-5,1-1", "--detail-agents");
+  ASSERT_TRUE(spec.ok()) << spec.message();
+  const Recorded recorded = record_walk(db, kCharacters, kTicks, *spec);
+  const Recording& r = recorded.recording;
+  ASSERT_EQ(r.detail_agents, (std::vector<std::uint32_t>{1, 4, 5, 9}));
+  ASSERT_EQ(r.detail_sample_count, kTicks);
+  ASSERT_EQ(r.detail_positions.size(), kTicks * 4 * r.joint_count() * 3);
+  expect_whole_poses(recorded, kCharacters);
+  ASSERT_EQ(r.why.size(), r.agent_count);
+  for (std::uint32_t a = 0; a < kCharacters; ++a) {
+    const bool detailed = a == 1 || a == 4 || a == 5 || a == 9;
+    EXPECT_EQ(r.why[a].size(), detailed ? r.searches[a].size() : 0u) << "character " << a;
+    EXPECT_FALSE(r.searches[a].empty()) << "character " << a;
+    if (!detailed) continue;
+    for (std::size_t e = 0; e < r.why[a].size(); ++e) {
+      ASSERT_EQ(r.why[a][e].search, e);
+      EXPECT_EQ(r.why[a][e].chosen.frame, r.searches[a][e].to_frame) << "character " << a << ", search " << e;
     }
   }
 }
@@ -123,7 +164,7 @@ TEST(CrowdRecording, EverySearchOfTheFirstCharactersIsExplained) {
   EXPECT_EQ(r.clip_names.size(), db.clips().size());
   std::size_t explained = 0, jumps = 0;
   for (std::size_t a = 0; a < r.agent_count; ++a) {
-    if (a >= r.detail_agents) {
+    if (a >= r.detail_agents.size()) {
       EXPECT_TRUE(r.why[a].empty()) << "character " << a << " is not detailed";
       continue;
     }

@@ -133,6 +133,33 @@ def test_arrays_and_errors(db, tmp_path):
         mmvk.Crowd(db, agents=2, correction_half_life=0.0)
 
 
+def test_detail_agents_choose_the_viewers_level_of_detail(db, tmp_path):
+    """detail_agents (`mmvk crowd --detail-agents`): a count, a spec or a sequence of
+    indices; the page keeps that many characters' whole poses, and every bad choice
+    is refused naming the keyword before anything runs."""
+    page = tmp_path / "crowd.html"
+    for choice, count in [(None, 6), (2, 2), ("1,4-5", 3), ([5, 0], 2), (np.array([3]), 1), (0, 0)]:
+        crowd = mmvk.Crowd(db, agents=6, backend="fast-box", record=True, detail_agents=choice)
+        crowd.step()
+        crowd.write_html(page)
+        assert f'"detail":{{"agents":{count},' in page.read_text(), choice
+    for choice, message in [("1,1", "detail_agents '1,1': character 1 is listed twice"),
+                            ("x", "detail_agents 'x': expected a count N"),
+                            ("", "detail_agents '': an empty list"),
+                            ([], "detail_agents: an empty list"),
+                            ([2, 2], "detail_agents: character 2 is listed twice"),
+                            ([-1], "detail_agents: -1 is not a character index"),
+                            (7, "detail_agents 7: the crowd has 6 characters"),
+                            ("0-6", r"detail_agents: character 6 is beyond the crowd \(0 to 5\)")]:
+        with pytest.raises(ValueError, match=message):
+            mmvk.Crowd(db, agents=6, backend="fast-box", record=True, detail_agents=choice)
+    with pytest.raises(ValueError, match="detail_agents needs record=True"):
+        mmvk.Crowd(db, agents=6, detail_agents=2)
+    for wrong in [1.5, [1.5]]:
+        with pytest.raises(TypeError, match="detail_agents"):
+            mmvk.Crowd(db, agents=6, record=True, detail_agents=wrong)
+
+
 CMU16 = CMU131.parent.parent / "cmu16" / "manifest.json"
 
 

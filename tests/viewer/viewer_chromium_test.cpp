@@ -391,7 +391,8 @@ TEST_F(ViewerChromium, ThreeDViewShowsCharactersWhereTheyStand) {
 // explained opens none.
 TEST_F(ViewerChromium, WhyPanelShowsTheRecordedExplanation) {
   const Recording& r = *recording_;
-  ASSERT_GT(r.detail_agents, 3u);
+  ASSERT_GT(r.detail_agents.size(), 3u);
+  ASSERT_EQ(r.detail_agents[3], 3u);
   const Recording::SearchWhy& why = r.why[3][7];
   ASSERT_EQ(why.search, 7u);
   const std::vector<double> v =
@@ -406,8 +407,60 @@ TEST_F(ViewerChromium, WhyPanelShowsTheRecordedExplanation) {
   for (float c : why.chosen.weighted) sum += c;
   EXPECT_NEAR(v[4], sum, 1e-5 * double(why.chosen.weighted.size()));
   const std::string none = status_of(run_chromium(*dir_ / "crowd.html", "--dump-dom", "why-none",
-                                                  "?t=4&agent=" + std::to_string(r.detail_agents) + "&paused=1&why=2"));
+                                                  "?t=4&agent=" + std::to_string(r.detail_agents.size()) + "&paused=1&why=2"));
   EXPECT_NE(none.find("data-why=\"\""), std::string::npos) << none;
+}
+
+// Any set of characters in detail (`mmvk crowd --detail-agents 2-3,7`), not
+// only the first: a detailed character is drawn with its whole pose at the
+// tick rate (the recording's, to the millimetre of the payload) and its
+// searches are explained; one between them (5) or before them (0) falls
+// back to its played frame at the 10 Hz samples, and its panel names the set.
+TEST_F(ViewerChromium, AnySetOfDetailedCharactersIsDrawnAndExplained) {
+  SyntheticRecordingParams params;
+  params.agents = 12;
+  params.seconds = 6.0f;
+  params.detail_set = {2, 3, 7};
+  const Recording r = make_synthetic_recording(params);
+  const fs::path page = *dir_ / "detail-set.html";
+  ASSERT_TRUE(write_viewer_html(page, r).ok());
+  const std::size_t joints = r.joint_count(), tick = 120;  // t = 4 s at 30 Hz
+  ASSERT_LT(tick, r.detail_sample_count);
+
+  const std::string detailed = status_of(run_chromium(page, "--dump-dom", "set-7", "?t=4&agent=7&paused=1&why=5"));
+  ASSERT_NE(detailed.find("data-state=\"ready\""), std::string::npos) << detailed;
+  const std::vector<double> pose = status_numbers(detailed, "data-pose");
+  ASSERT_EQ(pose.size(), 1 + joints * 3) << detailed;
+  EXPECT_EQ(pose[0], 1.0) << "character 7 is detailed";
+  for (std::size_t c = 0; c < joints * 3; ++c) {
+    // Slot 2 is character 7; joint 0 in mm, the others in mm against it.
+    EXPECT_NEAR(pose[1 + c], r.detail_positions[r.detail_index(tick, 2, 0) + c], 0.0021) << "coordinate " << c;
+  }
+  const std::vector<double> why = status_numbers(detailed, "data-why");
+  ASSERT_EQ(why.size(), 5u) << detailed;
+  EXPECT_EQ(why[0], double(r.why[7][5].chosen.frame));
+
+  for (const std::size_t a : {std::size_t{5}, std::size_t{0}}) {
+    const std::string dom =
+        run_chromium(page, "--dump-dom", "set-" + std::to_string(a), "?t=4&agent=" + std::to_string(a) + "&paused=1&why=2");
+    const std::string status = status_of(dom);
+    ASSERT_NE(status.find("data-state=\"ready\""), std::string::npos) << status;
+    const std::vector<double> shown = status_numbers(status, "data-pose");
+    ASSERT_EQ(shown.size(), 1 + joints * 3) << status;
+    EXPECT_EQ(shown[0], 0.0) << "character " << a << " is not detailed";
+    // The played frame's pose (no lift of the synthetic whole poses): the
+    // highest joint's height to the millimetre.
+    const std::size_t i = r.sample_index(40, a);
+    const auto slot = std::size_t(std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]) -
+                                  r.pose_frames.begin());
+    std::size_t top = 0;
+    for (std::size_t j = 0; j < joints; ++j) {
+      if (r.pose_positions[r.pose_index(slot, j) + 1] > r.pose_positions[r.pose_index(slot, top) + 1]) top = j;
+    }
+    EXPECT_NEAR(shown[1 + 3 * top + 1], r.pose_positions[r.pose_index(slot, top) + 1], 0.0011) << "character " << a;
+    EXPECT_NE(status.find("data-why=\"\""), std::string::npos) << status;
+    EXPECT_NE(dom.find("explains the searches of 3 characters: 2-3, 7"), std::string::npos) << "character " << a;
+  }
 }
 
 }  // namespace

@@ -95,13 +95,22 @@ TEST(ViewerRecording, ErrorsNameTheField) {
 
 TEST(ViewerRecording, WholePoseAndExplanationErrorsNameTheField) {
   Recording r = small_recording();
-  ASSERT_GT(r.detail_agents, 0u);
+  ASSERT_FALSE(r.detail_agents.empty());
   r.detail_positions.pop_back();
   expect_error(r, "detail_positions");
 
   r = small_recording();
-  r.detail_agents = r.agent_count + 1;
-  expect_error(r, "detail_agents");
+  r.detail_agents.back() = std::uint32_t(r.agent_count);
+  expect_error(r, "detail_agents[6] = 7 is not below agent_count");
+
+  // Any set, but ascending and unique: each slot's poses are one character's.
+  r = small_recording();
+  std::swap(r.detail_agents[1], r.detail_agents[2]);
+  expect_error(r, "detail_agents[2] = 1 does not follow 2");
+
+  r = small_recording();
+  r.detail_agents[3] = r.detail_agents[2];
+  expect_error(r, "detail_agents[3]");
 
   r = small_recording();
   r.detail_positions[10] = std::nanf("");

@@ -105,8 +105,9 @@ void QualityObserver::summarize(CrowdSummary& s) const {
 }
 
 RecordingObserver::RecordingObserver(const CrowdController& controller, const Scenario& scenario, std::string title,
-                                     float dt, std::uint32_t ticks_per_sample)
-    : recorder_(controller, scenario, std::move(title), dt, ticks_per_sample),
+                                     float dt, std::uint32_t ticks_per_sample,
+                                     std::vector<std::uint32_t> detail_agents)
+    : recorder_(controller, scenario, std::move(title), dt, ticks_per_sample, std::move(detail_agents)),
       frames_before_(controller.size()),
       kinds_before_(controller.size(), SearchKind::None) {}
 

@@ -85,8 +85,9 @@ class QualityObserver {
 // The viewer's recording (crowd_recorder.hpp), fed what each tick searched.
 class RecordingObserver {
  public:
+  // `detail_agents`: the characters kept in detail (CrowdRecorder).
   RecordingObserver(const CrowdController& controller, const Scenario& scenario, std::string title, float dt,
-                    std::uint32_t ticks_per_sample);
+                    std::uint32_t ticks_per_sample, std::vector<std::uint32_t> detail_agents);
 
   void observe(const CrowdController& controller, const TickView& view);
   Result<Recording> finish(ThreadPool& pool) { return recorder_.finish(pool); }

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
 #include <system_error>
+
+#include <unistd.h>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -18,6 +21,13 @@ constexpr float kCentimetresPerMetre = 100.0f;
 // Every export file goes through here: the project's one writer.
 Status write_output(const std::filesystem::path& path, std::string_view bytes) {
   return write_file_atomically(path, bytes);
+}
+
+// `dir` as a folder: made when missing (its parent must exist).
+Status make_folder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (std::filesystem::create_directory(dir, ec) || std::filesystem::is_directory(dir)) return {};
+  return make_error(dir.string() + ": cannot make the folder" + (ec ? ": " + ec.message() : std::string()));
 }
 
 // The joints in the file's order (depth first, children in skeleton order)
@@ -125,16 +135,32 @@ std::vector<std::filesystem::path> bvh_paths(const std::filesystem::path& dir, s
   return paths;
 }
 
-Status prepare_bvh_folder(const std::filesystem::path& dir, std::uint32_t agents, const std::string& option) {
+Status check_bvh_folder(const std::filesystem::path& dir, std::uint32_t agents, const std::string& option) {
+  namespace fs = std::filesystem;
+  if (dir.empty()) return make_error(option + ": an empty path");
   std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) {
-    if (std::filesystem::exists(dir, ec)) return make_error(option + " " + dir.string() + ": not a folder");
-    if (!std::filesystem::create_directory(dir, ec) || ec) {
-      return make_error(option + " " + dir.string() + ": cannot make the folder: " + ec.message());
+  if (fs::is_directory(dir, ec)) {
+    for (const fs::path& file : bvh_paths(dir, agents)) {
+      if (Status writable = check_writable(file); !writable) return make_error(option + ": " + writable.message());
     }
+    return {};
   }
-  for (const std::filesystem::path& file : bvh_paths(dir, agents)) {
-    if (Status writable = check_writable(file); !writable) return make_error(option + ": " + writable.message());
+  const std::string named = option + " " + dir.string();
+  if (fs::exists(fs::symlink_status(dir, ec))) {
+    return make_error(named + (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec)
+                                   ? ": a link to nothing"
+                                   : ": not a folder"));
+  }
+  // Made when the files are written, as mkdir makes it: in a folder that
+  // exists and can be written (the files in a new folder of ours can be).
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent, ec)) {
+    return make_error(named + ": cannot make the folder there: " + parent.string() +
+                      (fs::exists(parent, ec) ? " is not a folder" : " does not exist"));
+  }
+  if (::access(parent.c_str(), W_OK | X_OK) != 0) {
+    return make_error(named + ": cannot make the folder in " + parent.string() + ": " +
+                      std::generic_category().message(errno));
   }
   return {};
 }
@@ -157,6 +183,9 @@ Status write_bvh_files(const PoseRecording& rec, const std::filesystem::path& di
   const std::vector<std::filesystem::path> paths = bvh_paths(dir, rec.agents);
   for (std::uint32_t b = 0; b < rec.agents; ++b) {
     MMVK_ASSIGN_OR_RETURN(const std::string text, bvh_text(rec, b));
+    // The folder only once there is a file to put in it, so a run that
+    // fails before (or a text that cannot be made) leaves nothing behind.
+    if (b == 0) MMVK_TRY(make_folder(dir));
     if (Status written = write_output(paths[b], text); !written) return written;
   }
   return {};

@@ -27,17 +27,20 @@ namespace mmvk::crowd {
 // numbers past 9,999).
 std::vector<std::filesystem::path> bvh_paths(const std::filesystem::path& dir, std::uint32_t agents);
 
-// Before the run: `dir` exists as a folder, or is made (its parent must
-// exist), and every file bvh_paths names can be written there. Errors name
-// `option`.
-Status prepare_bvh_folder(const std::filesystem::path& dir, std::uint32_t agents, const std::string& option);
+// Before the run, making nothing: `dir` is a folder where every file
+// bvh_paths names can be written, or it does not exist yet and can be made
+// (its parent is a writable folder; write_bvh_files makes it). Errors name
+// `option`: `dir` a file or a link to nothing, a missing or unwritable
+// parent, a file that cannot be replaced.
+Status check_bvh_folder(const std::filesystem::path& dir, std::uint32_t agents, const std::string& option);
 
 // Character `agent`'s BVH text. Errors: no ticks recorded, a skeleton whose
 // joints are not in parent-before-child order.
 Result<std::string> bvh_text(const PoseRecording& recording, std::uint32_t agent);
 
-// Every recorded character's file into `dir`, each atomically. Errors name
-// the file.
+// Every recorded character's file into `dir`, each atomically; `dir` is
+// made (not its parents) when missing, just before its first file. Errors
+// name the folder or the file.
 Status write_bvh_files(const PoseRecording& recording, const std::filesystem::path& dir);
 
 }  // namespace mmvk::crowd

@@ -45,11 +45,11 @@ constexpr float kAnchorMoveM = 0.001f;
 }  // namespace
 
 CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& scenario, std::string title, float dt,
-                             std::uint32_t ticks_per_sample, std::size_t detail_agents)
+                             std::uint32_t ticks_per_sample, std::vector<std::uint32_t> detail_agents)
     : controller_(controller),
       dt_(dt),
       ticks_per_sample_(std::max<std::uint32_t>(1, ticks_per_sample)),
-      why_(controller.database(), std::min<std::size_t>(detail_agents, controller.size())) {
+      why_(controller.database(), detail_agents, controller.size()) {
   Recording& r = recording_;
   r.title = std::move(title);
   r.sample_rate_hz = 1.0f / (dt * float(ticks_per_sample_));
@@ -68,7 +68,7 @@ CrowdRecorder::CrowdRecorder(const CrowdController& controller, const Scenario& 
   matched_dims_ = matched_trajectory_dims(controller.database(), offsets);
   r.leg_joints = ik_leg_joints(skeleton);
   r.foot_events.resize(r.agent_count);
-  r.detail_agents = std::min<std::size_t>(detail_agents, r.agent_count);
+  r.detail_agents = std::move(detail_agents);
   r.detail_rate_hz = 1.0f / dt;
   feet_now_.assign(r.agent_count, FootEvent{});
   for (FootEvent& now : feet_now_) now.state = 0xff;  // none yet: the first tick adds one
@@ -102,13 +102,13 @@ void CrowdRecorder::record_tick(std::uint64_t tick, std::span<const Match> colle
 void CrowdRecorder::sample_detail(std::span<const glm::vec3> world) {
   Recording& r = recording_;
   const std::size_t joints = controller_.animation().joint_count();
-  for (std::size_t b = 0; b < r.detail_agents; ++b) {
+  for (const std::uint32_t b : r.detail_agents) {
     for (std::size_t j = 0; j < joints; ++j) {
-      const glm::vec3& p = world[b * joints + j];
+      const glm::vec3& p = world[std::size_t(b) * joints + j];
       r.detail_positions.insert(r.detail_positions.end(), {p.x, p.y, p.z});
     }
   }
-  if (r.detail_agents > 0) ++r.detail_sample_count;
+  if (!r.detail_agents.empty()) ++r.detail_sample_count;
 }
 
 void CrowdRecorder::record_feet(float time_s) {

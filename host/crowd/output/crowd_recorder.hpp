@@ -1,8 +1,9 @@
 // Fills the viewer's Recording (recording.hpp) while a crowd runs: the
 // sampled roots, frames, desired trajectories and legs as displayed, each
 // search and each change of the feet (contacts, locks) as an event, the
-// whole displayed pose of the first characters after every tick and why
-// each of their searches chose its frame, and at the end the
+// whole displayed pose of a few characters (--detail-agents,
+// setup/detail_agents.hpp) after every tick and why each of their searches
+// chose its frame, and at the end the
 // character-space poses of every frame that was played.
 #pragma once
 
@@ -17,18 +18,13 @@
 
 namespace mmvk::crowd {
 
-// The characters recorded after every tick with their whole pose, and whose
-// searches are explained: the page's level of detail (docs/viewer.md, "Size":
-// 32 of them keep 1,000 characters x 20 s at 60 Hz within its budget).
-inline constexpr std::size_t kDefaultDetailAgents = 32;
-
 class CrowdRecorder {
  public:
   // Records every `ticks_per_sample`-th tick (ticks of `dt` seconds), and
-  // every tick of the first `detail_agents` characters (fewer in a smaller
-  // crowd).
+  // every tick of the characters `detail_agents` (ascending, unique, each
+  // below controller.size(): resolve_detail_agents).
   CrowdRecorder(const CrowdController& controller, const Scenario& scenario, std::string title, float dt,
-                std::uint32_t ticks_per_sample, std::size_t detail_agents = kDefaultDetailAgents);
+                std::uint32_t ticks_per_sample, std::vector<std::uint32_t> detail_agents);
 
   // After each tick `tick` (0-based, its end at (tick + 1) * dt):
   // `collected` are the matches the tick applied, for the characters that

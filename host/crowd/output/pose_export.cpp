@@ -15,7 +15,7 @@ std::uint32_t export_count(const CrowdOptions& options, std::uint32_t crowd_agen
 Status check_pose_export_paths(const CrowdOptions& options) {
   // The files of the largest count the run may take (the crowd is not known yet).
   const std::uint32_t count = options.export_agents > 0 ? options.export_agents : kDefaultExportAgents;
-  if (options.bvh) MMVK_TRY(prepare_bvh_folder(*options.bvh, count, "--bvh"));
+  if (options.bvh) MMVK_TRY(check_bvh_folder(*options.bvh, count, "--bvh"));
   if (options.gltf) MMVK_TRY(check_gltf_path(*options.gltf, "--gltf"));
   return {};
 }

@@ -15,9 +15,10 @@
 
 namespace mmvk::crowd {
 
-// Before the database is opened: --bvh's folder made and its files
-// writable, --gltf named .glb and writable, --export-agents only with one
-// of them. Errors name the option.
+// Before the database is opened, making and writing nothing: --bvh's
+// folder and its files writable (a folder not there yet is made when the
+// files are written, so a run that fails leaves none behind), --gltf named
+// .glb and writable. Errors name the option.
 Status check_pose_export_paths(const CrowdOptions& options);
 
 // The characters exported from a crowd of `crowd_agents`: --export-agents,

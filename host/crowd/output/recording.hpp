@@ -116,17 +116,19 @@ struct Recording {
   // time order, the first at time 0.
   std::vector<std::vector<FootEvent>> foot_events;
 
-  // --- the whole displayed pose at the tick rate, for the first characters -
+  // --- the whole displayed pose at the tick rate, for a few characters ----
   // The 10 Hz samples above pose a character from its played frame with the
-  // legs as displayed; the first `detail_agents` characters are also
+  // legs as displayed; the characters `detail_agents` (ascending, unique,
+  // each below agent_count; any set, by default the first 32) are also
   // recorded after every tick (at `detail_rate_hz`, the simulation's rate)
   // with every joint as displayed (after foot IK), upper body included.
-  // Empty (0) when not recorded.
+  // Empty when not recorded.
   float detail_rate_hz = 0.0f;
-  std::size_t detail_agents = 0;
+  std::vector<std::uint32_t> detail_agents;
   std::size_t detail_sample_count = 0;
-  // [detail_sample_count x detail_agents x joint_count x 3], world metres;
-  // detail sample k is the state after tick k, at time k / detail_rate_hz.
+  // [detail_sample_count x detail_agents.size() x joint_count x 3], world
+  // metres, slot i holding character detail_agents[i]; detail sample k is
+  // the state after tick k, at time k / detail_rate_hz.
   std::vector<float> detail_positions;
 
   // --- why each search of the detailed characters chose its frame --------
@@ -175,8 +177,9 @@ struct Recording {
   std::size_t leg_index(std::size_t sample, std::size_t agent, std::size_t leg_joint) const {
     return ((sample * agent_count + agent) * leg_joints.size() + leg_joint) * 3;
   }
-  std::size_t detail_index(std::size_t sample, std::size_t agent, std::size_t joint) const {
-    return ((sample * detail_agents + agent) * joint_count() + joint) * 3;
+  // `slot`: an index into detail_agents, not a character.
+  std::size_t detail_index(std::size_t sample, std::size_t slot, std::size_t joint) const {
+    return ((sample * detail_agents.size() + slot) * joint_count() + joint) * 3;
   }
 };
 

@@ -23,25 +23,32 @@ Recording::FrameWhy frame_why(const Database& db, const FrameExplanation& e) {
 
 }  // namespace
 
-SearchWhyRecorder::SearchWhyRecorder(const Database& database, std::size_t agents)
-    : database_(database), agents_(agents), pending_(agents * database.dims()), pending_params_(agents) {}
+SearchWhyRecorder::SearchWhyRecorder(const Database& database, std::span<const std::uint32_t> agents,
+                                     std::size_t crowd_agents)
+    : database_(database),
+      slot_of_(crowd_agents, -1),
+      pending_(agents.size() * database.dims()),
+      pending_params_(agents.size()) {
+  for (std::size_t slot = 0; slot < agents.size(); ++slot) slot_of_[agents[slot]] = std::int32_t(slot);
+}
 
 void SearchWhyRecorder::submitted(std::span<const std::uint32_t> characters, const QueryBatch& batch) {
   const std::size_t dims = database_.dims();
   for (std::size_t i = 0; i < characters.size() && i < batch.size; ++i) {
-    const std::uint32_t b = characters[i];
-    if (b >= agents_) break;  // ascending: no explained character follows
-    std::copy_n(batch.features.begin() + std::ptrdiff_t(i * dims), dims, pending_.begin() + std::ptrdiff_t(b * dims));
-    pending_params_[b] = batch.params.empty() ? QueryParams{} : batch.params[i];
+    const std::int32_t slot = slot_of_[characters[i]];
+    if (slot < 0) continue;
+    std::copy_n(batch.features.begin() + std::ptrdiff_t(i * dims), dims,
+                pending_.begin() + std::ptrdiff_t(std::size_t(slot) * dims));
+    pending_params_[std::size_t(slot)] = batch.params.empty() ? QueryParams{} : batch.params[i];
   }
 }
 
 void SearchWhyRecorder::applied(std::uint32_t b, std::size_t search, std::uint32_t chosen) {
-  if (b >= agents_) return;
-  const std::size_t dims = database_.dims();
-  kept_.push_back({b, search, chosen, pending_params_[b], queries_.size()});
-  queries_.insert(queries_.end(), pending_.begin() + std::ptrdiff_t(b * dims),
-                  pending_.begin() + std::ptrdiff_t((b + 1) * dims));
+  const std::int32_t slot = slot_of_[b];
+  if (slot < 0) return;
+  const std::size_t dims = database_.dims(), row = std::size_t(slot) * dims;
+  kept_.push_back({b, search, chosen, pending_params_[std::size_t(slot)], queries_.size()});
+  queries_.insert(queries_.end(), pending_.begin() + std::ptrdiff_t(row), pending_.begin() + std::ptrdiff_t(row + dims));
 }
 
 Status SearchWhyRecorder::finish(Recording& r, ThreadPool& pool) const {

@@ -20,8 +20,9 @@ namespace mmvk::crowd {
 
 class SearchWhyRecorder {
  public:
-  // Explains the searches of characters [0, agents).
-  SearchWhyRecorder(const Database& database, std::size_t agents);
+  // Explains the searches of the characters `agents` (ascending, unique,
+  // each below `crowd_agents`).
+  SearchWhyRecorder(const Database& database, std::span<const std::uint32_t> agents, std::size_t crowd_agents);
 
   // The batch the tick submitted: query i is character characters[i]'s.
   void submitted(std::span<const std::uint32_t> characters, const QueryBatch& batch);
@@ -43,8 +44,9 @@ class SearchWhyRecorder {
     std::size_t row = 0;  // into queries_, [dims]
   };
   const Database& database_;
-  std::size_t agents_;
-  // Per explained character, its query in flight: [agents x dims] and params.
+  // [crowd characters] each one's slot among the explained, or -1.
+  std::vector<std::int32_t> slot_of_;
+  // Per explained character (by slot), its query in flight: [slots x dims] and params.
   std::vector<float> pending_;
   std::vector<QueryParams> pending_params_;
   std::vector<Kept> kept_;

@@ -15,7 +15,6 @@
 #include "mmvk/search/search.hpp"
 #include "mmvk/animation/trajectory.hpp"
 #include "setup/crowd_defaults.hpp"
-#include "output/crowd_recorder.hpp"
 #include "output/recording.hpp"
 
 namespace mmvk::crowd {
@@ -108,10 +107,10 @@ std::uint64_t estimate_crowd_bytes(const CrowdSettings& options, const RunOutput
     const std::uint64_t samples = ticks / per_sample + 1;
     const auto searches = std::uint64_t(std::ceil(options.seconds / options.search_interval_s)) + 2;
     const auto steps = std::uint64_t(std::ceil(options.seconds * 8.0)) + 2;
-    // The first characters also keep their whole pose after every tick,
-    // and each of their searches its query until it is explained and then
-    // its two frames' channel costs (crowd_recorder.hpp).
-    const std::uint64_t detailed = std::min<std::uint64_t>(agents, kDefaultDetailAgents);
+    // The detailed characters (--detail-agents) also keep their whole pose
+    // after every tick, and each of their searches its query until it is
+    // explained and then its two frames' channel costs (crowd_recorder.hpp).
+    const std::uint64_t detailed = detail_agent_count(options.detail_agents, agents);
     const std::uint64_t channels = database.schema().channels.size();
     const std::uint64_t recording =
         agents * (samples * (16 + points * 16 + 6 * 12) + searches * sizeof(SearchEvent) + steps * 16 + 48) +
@@ -163,7 +162,8 @@ Status check_crowd_memory(const CrowdSettings& options, const RunOutputs& output
                     (outputs.html ? " with " + html : "") + " would need about " + gib(estimate) + ", over " +
                     number_text(kMemoryShare * 100.0) + "% of the " + gib(limit) +
                     " this process may use (physical memory, cgroup and ulimit)" + lower +
-                    (outputs.html ? ", " + setting_name(names, "seconds") + " or leave out " + html
+                    (outputs.html ? ", " + setting_name(names, "seconds") + ", " +
+                                        setting_name(names, "detail-agents") + " or leave out " + html
                                   : " or " + setting_name(names, "seconds")));
 }
 

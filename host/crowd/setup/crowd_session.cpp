@@ -38,19 +38,24 @@ Result<GaitSpeeds> check_motion(const Database& database, const CrowdSessionOpti
 Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptions& o, const GaitSpeeds& speeds) {
   RunOutputs outputs = o.outputs;
   outputs.html = outputs.html || o.record;
+  if (o.scenario && o.agents && *o.agents != o.scenario->agents.size()) {
+    return make_error(o.scenario->source + ": defines " + std::to_string(o.scenario->agents.size()) +
+                      " agents, but " + setting_name(o.names, "agents") + " asks for " + std::to_string(*o.agents) +
+                      " (leave " + setting_name(o.names, "agents") + " out with a scenario)");
+  }
+  // The detailed characters within the crowd, before the memory estimate counts them.
+  const std::uint64_t agents = o.scenario ? o.scenario->agents.size() : o.agents.value_or(kDefaultAgents);
+  if (o.record) {
+    MMVK_TRY(resolve_detail_agents(o.detail_agents, agents, setting_name(o.names, "detail-agents")).status());
+  }
   Scenario scenario;
   if (o.scenario) {
-    if (o.agents && *o.agents != o.scenario->agents.size()) {
-      return make_error(o.scenario->source + ": defines " + std::to_string(o.scenario->agents.size()) +
-                        " agents, but " + setting_name(o.names, "agents") + " asks for " + std::to_string(*o.agents) +
-                        " (leave " + setting_name(o.names, "agents") + " out with a scenario)");
-    }
     MMVK_TRY(check_crowd_memory(o, outputs, database, &*o.scenario, o.names));
     scenario = *o.scenario;
   } else {
     MMVK_TRY(check_crowd_memory(o, outputs, database, nullptr, o.names));
     RandomScenarioOptions random;
-    random.agents = std::uint32_t(o.agents.value_or(kDefaultAgents));
+    random.agents = std::uint32_t(agents);
     random.seed = o.seed;
     if (!speeds.has_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     scenario = make_random_scenario(random);
@@ -121,8 +126,10 @@ Status CrowdSession::set_up(const ControllerParams& params) {
   if (o.record) {
     // One sample every tenth of a second.
     const auto per_sample = std::uint32_t(std::max(1.0, std::round(o.rate_hz / 10.0)));
+    MMVK_ASSIGN_OR_RETURN(std::vector<std::uint32_t> detail,
+                          resolve_detail_agents(o.detail_agents, agents_, setting_name(o.names, "detail-agents")));
     recording_ = std::make_unique<RecordingObserver>(c, scenario_, page_title(o, agents_, search_), float(dt_),
-                                                     per_sample);
+                                                     per_sample, std::move(detail));
   }
   desired_.resize(agents_);
   return {};

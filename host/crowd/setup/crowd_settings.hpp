@@ -22,6 +22,7 @@
 #include "mmvk/database/database.hpp"
 #include "mmvk/search/search.hpp"
 #include "mmvk/common/status.hpp"
+#include "setup/detail_agents.hpp"
 
 namespace mmvk::crowd {
 
@@ -47,6 +48,10 @@ struct CrowdSettings {
   std::optional<std::uint32_t> exclusion_window;
   std::optional<float> correction_half_life;  // seconds, > 0
   std::vector<std::pair<std::string, float>> weights;  // schema channel name -> weight, each >= 0
+  // The characters a recording for the viewer keeps in detail (their whole
+  // pose every tick, their searches explained); none: the first
+  // kDefaultDetailAgents. Checked against the crowd once its size is known.
+  std::optional<DetailAgents> detail_agents;
 };
 
 // How errors name a setting: as `mmvk crowd`'s flag ("--search-interval") or

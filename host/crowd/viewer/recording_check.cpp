@@ -133,15 +133,22 @@ Status check_feet(const Recording& r) {
 }
 
 Status check_detail(const Recording& r) {
-  if (r.detail_agents > r.agent_count) {
-    return make_error("recording: detail_agents = " + std::to_string(r.detail_agents) + " is over agent_count = " +
-                      std::to_string(r.agent_count));
+  for (std::size_t i = 0; i < r.detail_agents.size(); ++i) {
+    const std::uint32_t a = r.detail_agents[i];
+    if (a >= r.agent_count) {
+      return make_error("recording: detail_agents[" + std::to_string(i) + "] = " + std::to_string(a) +
+                        " is not below agent_count = " + std::to_string(r.agent_count));
+    }
+    if (i > 0 && a <= r.detail_agents[i - 1]) {
+      return make_error("recording: detail_agents[" + std::to_string(i) + "] = " + std::to_string(a) +
+                        " does not follow " + std::to_string(r.detail_agents[i - 1]) + " (ascending, unique)");
+    }
   }
-  if (r.detail_agents > 0 && (!std::isfinite(r.detail_rate_hz) || r.detail_rate_hz <= 0.0f)) {
+  if (!r.detail_agents.empty() && (!std::isfinite(r.detail_rate_hz) || r.detail_rate_hz <= 0.0f)) {
     return make_error("recording: detail_rate_hz = " + std::to_string(r.detail_rate_hz) + " must be positive");
   }
   MMVK_TRY(check_size("detail_positions", r.detail_positions.size(),
-                      r.detail_sample_count * r.detail_agents * r.joint_count() * 3,
+                      r.detail_sample_count * r.detail_agents.size() * r.joint_count() * 3,
                       "detail_sample_count x detail_agents x joints x 3"));
   return check_finite("detail_positions", r.detail_positions);
 }

@@ -220,18 +220,22 @@ void simulate_agent(Recording& r, const SyntheticRecordingParams& params, const 
   }
 }
 
-// The first agents' whole pose at the simulation rate: each 10 Hz sample's
-// played pose in world space, held until the next sample, its arms lifted
-// by a few centimetres (as the displayed pose differs from the played one).
+// The detailed agents' whole pose at the simulation rate: each 10 Hz
+// sample's played pose in world space, held until the next sample, its arms
+// lifted by a few centimetres (as the displayed pose differs from the
+// played one).
 void add_detail(Recording& r, const SyntheticRecordingParams& params) {
-  r.detail_agents = std::min<std::size_t>(params.detail_agents, r.agent_count);
+  r.detail_agents = params.detail_set;
+  if (params.detail_set.empty()) {
+    for (std::uint32_t a = 0; a < std::min(params.detail_agents, r.agent_count); ++a) r.detail_agents.push_back(a);
+  }
   r.detail_rate_hz = params.simulation_rate_hz;
   r.detail_sample_count = static_cast<std::size_t>(std::floor(params.seconds * params.simulation_rate_hz)) + 1;
   const std::size_t joints = r.joint_count();
   for (std::size_t k = 0; k < r.detail_sample_count; ++k) {
     const float t = static_cast<float>(k) / r.detail_rate_hz;
     const std::size_t sample = std::min(r.sample_count - 1, static_cast<std::size_t>(t * r.sample_rate_hz + 1e-3f));
-    for (std::size_t a = 0; a < r.detail_agents; ++a) {
+    for (const std::uint32_t a : r.detail_agents) {
       const std::size_t i = r.sample_index(sample, a);
       const auto pose = std::lower_bound(r.pose_frames.begin(), r.pose_frames.end(), r.frame[i]) - r.pose_frames.begin();
       const float c = std::cos(r.facing[i]), s = std::sin(r.facing[i]);
@@ -269,7 +273,7 @@ void add_why(Recording& r, Rng& rng) {
   r.exclusion_names = {"candidate", "excluded"};
   r.why.assign(r.agent_count, {});
   const std::vector<float> weights = {1.0f, 1.5f, 0.75f, 1.0f};
-  for (std::size_t a = 0; a < r.detail_agents; ++a) {
+  for (const std::uint32_t a : r.detail_agents) {
     for (std::size_t e = 0; e < r.searches[a].size(); ++e) {
       const SearchEvent& event = r.searches[a][e];
       Recording::SearchWhy why;

@@ -59,7 +59,7 @@
   }
 
   function decodePayload(meta, bytes) {
-    if (meta.format !== 1) throw new Error('unknown payload format ' + meta.format);
+    if (meta.format !== 2) throw new Error('unknown payload format ' + meta.format);
     if (bytes.length !== meta.raw_bytes) throw new Error('payload is ' + bytes.length + ' bytes, expected ' + meta.raw_bytes);
     const readers = {};
     let offset = 0;
@@ -222,14 +222,25 @@
     return d;
   }
 
-  // The whole displayed pose of the first detail_agents characters at the
-  // tick rate, world metres: [agent][sample][joint][xyz] in d.detail.
+  // The whole displayed pose of the detailed characters (any set, by
+  // default the first 32) at the tick rate, world metres:
+  // [slot][sample][joint][xyz] in d.detail; d.detailIds[slot] is the
+  // slot's character and d.detailSlot[a] character a's slot (-1: none).
   function decodeDetail(meta, readers, d) {
     d.detailAgents = meta.detail.agents;
     d.detailS = meta.detail.sample_count;
     d.detailRate = meta.detail.rate_hz;
+    d.detailIds = [];
+    d.detailSlot = new Int32Array(d.N).fill(-1);
     if (d.detailAgents === 0) return;
     const r = readers.detail, J = d.J, prev = new Float64Array(J * 3), before = new Float64Array(J * 3);
+    for (let slot = 0, next = 0; slot < d.detailAgents; slot++) {
+      const a = next + r.u();
+      if (a >= d.N) throw new Error('detail: character ' + a + ' of ' + d.N);
+      d.detailIds.push(a);
+      d.detailSlot[a] = slot;
+      next = a + 1;
+    }
     d.detail = new Float32Array(d.detailAgents * d.detailS * J * 3);
     for (let a = 0; a < d.detailAgents; a++) {
       for (let s = 0; s < d.detailS; s++) {
@@ -270,10 +281,11 @@
   // A detailed agent's whole displayed pose at time t, world [J*3],
   // interpolated between its ticks; null for an agent not detailed.
   function detailPoseAt(a, t) {
-    if (a >= D.detailAgents || D.detailS === 0) return null;
+    const slot = a >= 0 && a < D.N ? D.detailSlot[a] : -1;
+    if (slot < 0 || D.detailS === 0) return null;
     const u = Math.min(Math.max(t * D.detailRate, 0), D.detailS - 1), s0 = Math.floor(u);
     const s1 = Math.min(s0 + 1, D.detailS - 1), w = u - s0, n = D.J * 3, out = new Float32Array(n);
-    const b0 = (a * D.detailS + s0) * n, b1 = (a * D.detailS + s1) * n;
+    const b0 = (slot * D.detailS + s0) * n, b1 = (slot * D.detailS + s1) * n;
     for (let c = 0; c < n; c++) out[c] = D.detail[b0 + c] + w * (D.detail[b1 + c] - D.detail[b0 + c]);
     return out;
   }
@@ -1021,6 +1033,16 @@
       D.legs ? D.legs[(i + 1) * D.L * 3 - 2] : 0, D.feet ? D.feet[a].t.length : 0].join(',');
   }
 
+  // The selected character's pose as the page draws it at the current
+  // time, for a test: 1 when it is the whole pose at the tick rate (a
+  // detailed character), 0 when the played frame with the legs at 10 Hz,
+  // then x, y, z per joint in world metres ('' without a pose).
+  function poseProbe() {
+    const a = state.selected, pose = a >= 0 ? worldPoseAt(a, state.t) : null;
+    if (!pose) return '';
+    return [detailPoseAt(a, state.t) ? 1 : 0, ...Array.from(pose, (v) => v.toFixed(4))].join(',');
+  }
+
   async function main() {
     const started = performance.now();
     const meta = JSON.parse(document.getElementById('mmvk-meta').textContent);
@@ -1041,6 +1063,7 @@
     statusEl.dataset.drawn = String(state.drawn);
     statusEl.dataset.decodeMs = String(ms);
     statusEl.dataset.probe = probe();
+    statusEl.dataset.pose = poseProbe();
     statusEl.dataset.view = state.view3d ? '3d' : 'top';
     if (state.view3d && state.selected >= 0) {
       // The selected character's hips on the page, CSS px, for a test.

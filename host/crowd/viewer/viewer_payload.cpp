@@ -24,7 +24,9 @@
 //             z dt_ms, state, and for each locked foot (bits 2, 3 of state):
 //             z dx_mm, z dy_mm, z dz_mm (delta against that foot's previous
 //             anchor, world)
-//   detail    present when meta.detail.agents > 0: for detail agent, for
+//   detail    present when meta.detail.agents > 0: for detail agent, u its
+//             index less the previous detail agent's + 1 (0 for each of
+//             the first N characters in a row); then for detail agent, for
 //             detail sample, for joint, axis: z, in mm, of joint 0's world
 //             position and of every other joint's position less joint 0's
 //             (the body moves less than the world between ticks), less its
@@ -222,9 +224,14 @@ void write_feet(VarintWriter& out, const Recording& r) {
 }
 
 void write_detail(VarintWriter& out, const Recording& r) {
+  std::uint64_t next = 0;
+  for (const std::uint32_t a : r.detail_agents) {
+    out.u(a - next);
+    next = std::uint64_t(a) + 1;
+  }
   const std::size_t joints = r.joint_count();
   std::vector<int64_t> previous(joints * 3), before(joints * 3);
-  for (std::size_t a = 0; a < r.detail_agents; ++a) {
+  for (std::size_t a = 0; a < r.detail_agents.size(); ++a) {
     for (std::size_t s = 0; s < r.detail_sample_count; ++s) {
       const float* root = r.detail_positions.data() + r.detail_index(s, a, 0);
       for (std::size_t j = 0; j < joints; ++j) {
@@ -372,7 +379,7 @@ void write_poses(VarintWriter& out, const Recording& r, const PoseSlots& slots) 
 std::string meta_json(const Recording& r, const PoseSlots& slots, const nlohmann::json& sections,
                       std::size_t raw_bytes) {
   const nlohmann::json meta = {
-      {"format", 1},
+      {"format", 2},  // 2: the detail section starts with its characters
       {"title", r.title},
       {"sample_rate_hz", r.sample_rate_hz},
       {"agent_count", r.agent_count},
@@ -384,7 +391,7 @@ std::string meta_json(const Recording& r, const PoseSlots& slots, const nlohmann
       {"pose_count", slots.poses.size()},
       {"leg_joints", r.leg_joints},
       {"has_feet", !r.foot_events.empty()},
-      {"detail", {{"agents", r.detail_agents}, {"sample_count", r.detail_sample_count}, {"rate_hz", r.detail_rate_hz}}},
+      {"detail", {{"agents", r.detail_agents.size()}, {"sample_count", r.detail_sample_count}, {"rate_hz", r.detail_rate_hz}}},
       {"why", r.why.empty() ? nlohmann::json(nullptr)
                             : nlohmann::json{{"channel_names", r.channel_names},
                                                               {"clip_names", r.clip_names},
@@ -429,7 +436,7 @@ Result<ViewerPayload> encode_viewer_payload(const Recording& r) {
   add_section(sections, raw, "poses", [&](VarintWriter& out) { write_poses(out, r, slots); });
   if (!r.leg_joints.empty()) add_section(sections, raw, "legs", [&](VarintWriter& out) { write_legs(out, r, slots); });
   if (!r.foot_events.empty()) add_section(sections, raw, "feet", [&](VarintWriter& out) { write_feet(out, r); });
-  if (r.detail_agents > 0) add_section(sections, raw, "detail", [&](VarintWriter& out) { write_detail(out, r); });
+  if (!r.detail_agents.empty()) add_section(sections, raw, "detail", [&](VarintWriter& out) { write_detail(out, r); });
   if (!r.why.empty()) add_section(sections, raw, "why", [&](VarintWriter& out) { write_why(out, r); });
 
   MMVK_ASSIGN_OR_RETURN(payload.compressed, deflate_bytes(raw));

@@ -15,6 +15,23 @@ window.MmvkWhy = (function () {
     return D.why[a].find((w) => w.search === index) || null;
   }
 
+  // The detailed characters in words: "the first 32 characters", or their
+  // indices and ranges as --detail-agents takes them ("3 characters: 2, 5-6").
+  function detailText(D) {
+    const ids = D.detailIds || [], n = ids.length;
+    if (n === 0) return 'no characters';
+    if (ids[n - 1] === n - 1) return 'the first ' + n + (n === 1 ? ' character' : ' characters');
+    const ranges = [];
+    for (let i = 0; i < n; i++) {
+      let j = i;
+      while (j + 1 < n && ids[j + 1] === ids[j] + 1) j++;
+      ranges.push(j > i ? ids[i] + '-' + ids[j] : String(ids[i]));
+      i = j;
+    }
+    const shown = ranges.length > 8 ? ranges.slice(0, 8).join(', ') + ', \u2026' : ranges.join(', ');
+    return n + (n === 1 ? ' character: ' : ' characters: ') + shown;
+  }
+
   function frameLine(D, label, f) {
     if (!f) return '<div>' + label + ': none</div>';
     return '<div>' + label + ': frame ' + f.frame + ', ' + esc(D.clipNames[f.clip] || ('clip ' + f.clip)) + ' at ' +
@@ -54,8 +71,8 @@ window.MmvkWhy = (function () {
       jumped ? 'jump ' + e.from[index] + ' \u2192 ' + e.to[index] : 'stays at ' + e.from[index]) + '<br>';
     let probe = '';
     if (!w) {
-      html += '<div style="color:var(--dim)">not explained: the page explains the searches of the first ' +
-        D.detailAgents + ' characters (docs/viewer.md, "Size")</div>';
+      html += '<div style="color:var(--dim)">not explained: the page explains the searches of ' + detailText(D) +
+        ' (mmvk crowd --detail-agents; docs/viewer.md, "Size")</div>';
     } else {
       html += frameLine(D, 'chosen', w.chosen) + frameLine(D, 'continuing', w.continuing) + table(D, w);
       const sum = (f) => (f ? f.weighted.reduce((s, v) => s + v, 0) : 0);
@@ -95,5 +112,5 @@ window.MmvkWhy = (function () {
     return out;
   }
 
-  return { show, decode, find };
+  return { show, decode, find, detailText };
 })();

@@ -154,7 +154,7 @@ Status CrowdSession::set_tags(std::span<const std::uint64_t> agents, std::span<c
 Status CrowdSession::step() {
   // The tick's time counts the steering too.
   const auto tick_start = Clock::now();
-  steering_->update(controller_->root_positions(), desired_, &pool_);
+  steering_->update(controller_->root_positions(), desired_, float(dt_), &pool_);
   return tick(desired_, {}, tick_start);
 }
 

@@ -45,6 +45,12 @@ Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptio
                         " agents, but " + setting_name(o.names, "agents") + " asks for " + std::to_string(*o.agents) +
                         " (leave " + setting_name(o.names, "agents") + " out with a scenario)");
     }
+    // Its agents' waits are its own: one setting that overrode some of them
+    // would leave a reader of the file guessing which.
+    if (o.wait_at_goals_s != 0.0) {
+      return make_error(setting_name(o.names, "wait-at-goals") + " sets the random scenario's wait; " +
+                        o.scenario->source + " sets its own (\"wait_s\", per agent or for all)");
+    }
     MMVK_TRY(check_crowd_memory(o, outputs, database, &*o.scenario, o.names));
     scenario = *o.scenario;
   } else {
@@ -52,6 +58,7 @@ Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptio
     RandomScenarioOptions random;
     random.agents = std::uint32_t(o.agents.value_or(kDefaultAgents));
     random.seed = o.seed;
+    random.wait_s = float(o.wait_at_goals_s);
     if (!speeds.has_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     scenario = make_random_scenario(random);
   }

@@ -215,6 +215,8 @@ void print_figures(const crowd::CrowdSummary& s) {
                s.search_ms_p50, s.search_ms_p99, s.tick_ms_p50, s.tick_ms_p99, s.trajectory_error_m_1s,
                s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
   std::fputs(crowd::describe_motion(s).c_str(), stderr);
+  // What the data could not do for this run, as the summary's notes say it.
+  for (const std::string& note : s.notes) std::fprintf(stderr, "mmvk crowd: note: %s\n", note.c_str());
 }
 
 // Writes the summary and says where the outputs are.

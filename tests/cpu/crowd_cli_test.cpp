@@ -229,6 +229,10 @@ TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
                                  "--summary " + summary.string());
   ASSERT_EQ(walks.exit_code, 0) << walks.output;
   EXPECT_NE(walks.output.find("no run: every character walks"), std::string::npos) << walks.output;
+  // The notes are printed last, once.
+  const std::string printed = "\nmmvk crowd: note: run_mps is null: the data has no run (";
+  EXPECT_NE(walks.output.find(printed), std::string::npos) << walks.output;
+  EXPECT_EQ(walks.output.find(printed), walks.output.rfind(printed)) << walks.output;
   nlohmann::json json = read_summary(summary);
   EXPECT_TRUE(json["run_mps"].is_null()) << json.dump();
   EXPECT_EQ(json["runners"], 0);

@@ -44,23 +44,23 @@ void add_lacking_speed_notes(std::vector<std::string>& notes, const GaitCoverage
     bool faster;
     double bound_mps, percentile_mps;
     float rate, stride;
-    const char *what, *beyond, *percentile;
+    const char *what, *side, *reach, *percentile;
   } sides[] = {
       {true, playable.max_mps, coverage.moving_p95_mps, params.max_play_rate, params.max_stride_scale, "faster",
-       "above the %.2f m/s its moving frames play at most", "95th"},
+       "above", "at most", "95th"},
       {false, playable.min_mps, coverage.moving_p5_mps, params.min_play_rate, params.min_stride_scale, "slower",
-       "below the %.2f m/s its moving frames play at least", "5th"},
+       "below", "at least", "5th"},
   };
   for (const auto& side : sides) {
     const Beyond beyond = speeds_beyond(preferred_mps, side.bound_mps, side.faster);
     if (beyond.characters == 0) continue;
-    char bound[96], text[512];
-    std::snprintf(bound, sizeof(bound), side.beyond, side.bound_mps);
+    char text[512];
     std::snprintf(text, sizeof(text),
-                  "the data lacks %s motion: the scenario asks %zu of %zu characters for %s m/s, %s (%s percentile "
-                  "%.2f m/s x play rate %.2f x stride %.2f)",
+                  "the data lacks %s motion: the scenario asks %zu of %zu characters for %s m/s, %s the %.2f m/s its "
+                  "moving frames play %s (%s percentile %.2f m/s x play rate %.2f x stride %.2f)",
                   side.what, beyond.characters, preferred_mps.size(), speed_range(beyond.min_mps, beyond.max_mps).c_str(),
-                  bound, side.percentile, side.percentile_mps, double(side.rate), double(side.stride));
+                  side.side, side.bound_mps, side.reach, side.percentile, side.percentile_mps, double(side.rate),
+                  double(side.stride));
     notes.push_back(text);
   }
 }

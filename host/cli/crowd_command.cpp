@@ -102,6 +102,10 @@ void declare_run(CommandLine& cli, crowd::CrowdOptions& options) {
   cli.integer("--device", options.device, "N", "the Vulkan device index (default: the best one)");
   cli.integer("--seed", options.seed, "N", "the random scenario's seed (default " + std::to_string(options.seed) + ")", 0,
               std::numeric_limits<std::uint64_t>::max());
+  cli.finite("--wait-at-goals", options.wait_at_goals_s, "S",
+             "seconds each character of the random scenario stands at each goal before it leaves for the next "
+             "(default " + number_text(options.wait_at_goals_s) + "; 0 to " + number_text(crowd::kMaxGoalWaitS) +
+                 "; a --scenario file sets its own \"wait_s\")");
   cli.text("--scenario", options.scenario, "FILE",
            "starts, goals, speeds and tags from JSON (see host/crowd/steering/scenario.hpp)");
   cli.text("--summary", options.summary, "FILE", "write the run's figures as JSON");
@@ -222,6 +226,8 @@ void print_figures(const crowd::CrowdSummary& s) {
                s.search_ms_p50, s.search_ms_p99, s.tick_ms_p50, s.tick_ms_p99, s.trajectory_error_m_1s,
                s.transitions_per_agent_s, static_cast<unsigned long long>(s.chosen_frames_hash));
   std::fputs(crowd::describe_motion(s).c_str(), stderr);
+  // What the data could not do for this run, as the summary's notes say it.
+  for (const std::string& note : s.notes) std::fprintf(stderr, "mmvk crowd: note: %s\n", note.c_str());
 }
 
 // Writes the summary and says where the outputs are.

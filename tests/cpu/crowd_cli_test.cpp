@@ -111,6 +111,10 @@ TEST_F(CrowdCli, BadCommandLinesAreClearErrors) {
   expect_failure("--seconds 333333.4", "--seconds 333333.4 at --rate 30: over 10000000 ticks");
   // The documented bound is the search's batch limit.
   expect_failure("--agents 1048577", "--agents 1048577: expected 1 to 1048576 characters");
+  expect_failure("--wait-at-goals -1", "--wait-at-goals -1: expected 0 to 3600 seconds");
+  expect_failure("--wait-at-goals 3600.5", "--wait-at-goals 3600.5: expected 0 to 3600 seconds");
+  expect_failure("--wait-at-goals nan", "--wait-at-goals expects a finite number");
+  expect_failure("--wait-at-goals 1e999", "--wait-at-goals expects a finite number");
 }
 
 TEST_F(CrowdCli, TheLargestAgentCountIsAccepted) {
@@ -267,6 +271,13 @@ TEST_F(CrowdCli, ScenarioErrorsNameTheFileAndTheField) {
   std::ofstream(tags) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "require_tags": ["moonwalk"]}]})";
   expect_failure("--backend fast-box --scenario " + tags.string(), tags.string() + ": agents[0].require_tags");
   expect_failure("--backend fast-box --agents 3 --scenario " + tags.string(), "defines 1 agents, but --agents asks for 3");
+  const fs::path wait = dir_ / "wait.json";
+  std::ofstream(wait) << R"({"agents": [{"start": [0, 0], "goals": [[4, 0]], "wait_s": -2}]})";
+  expect_failure("--backend fast-box --scenario " + wait.string(),
+                 wait.string() + ": agents[0].wait_s: expected seconds from 0 to 3600, got -2");
+  // A file's waits are its own: the random scenario's flag does not override some of them.
+  expect_failure("--backend fast-box --wait-at-goals 2 --scenario " + tags.string(),
+                 "--wait-at-goals sets the random scenario's wait; " + tags.string() + " sets its own");
 }
 
 // Reads a --summary file (an empty object when it cannot be parsed).
@@ -284,6 +295,10 @@ TEST_F(CrowdCli, DataWithoutARunReportsNoRunSpeedAndAssignsNoRunners) {
                                  "--summary " + summary.string());
   ASSERT_EQ(walks.exit_code, 0) << walks.output;
   EXPECT_NE(walks.output.find("no run: every character walks"), std::string::npos) << walks.output;
+  // The notes are printed last, once.
+  const std::string printed = "\nmmvk crowd: note: run_mps is null: the data has no run (";
+  EXPECT_NE(walks.output.find(printed), std::string::npos) << walks.output;
+  EXPECT_EQ(walks.output.find(printed), walks.output.rfind(printed)) << walks.output;
   nlohmann::json json = read_summary(summary);
   EXPECT_TRUE(json["run_mps"].is_null()) << json.dump();
   EXPECT_EQ(json["runners"], 0);

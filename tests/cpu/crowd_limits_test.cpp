@@ -6,6 +6,7 @@
 // before any allocation instead of dying of bad_alloc.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "setup/crowd_limits.hpp"
@@ -26,8 +27,20 @@ CrowdSettings with(double seconds, double rate, double interval) {
   return o;
 }
 
+// The random scenario's wait at each goal (--wait-at-goals), seconds.
+CrowdSettings waiting(double seconds) {
+  CrowdSettings o;
+  o.wait_at_goals_s = seconds;
+  return o;
+}
+
 TEST(CrowdLimits, TimeOptionsInRangeAreAccepted) {
   EXPECT_TRUE(check_time_options(CrowdSettings{}).ok());
+  EXPECT_EQ(CrowdSettings{}.wait_at_goals_s, 0.0);  // the documented default: leave each goal at once
+  EXPECT_TRUE(check_time_options(waiting(kMaxGoalWaitS)).ok());
+  // mmvk.Crowd's keyword spelling.
+  EXPECT_NE(validate(waiting(-1.0), SettingNames::Keywords).message().find("wait_at_goals -1: expected"),
+            std::string::npos);
   EXPECT_TRUE(check_time_options(with(1.0, kMinRateHz, kMinSearchIntervalS)).ok());
   EXPECT_TRUE(check_time_options(with(1.0, kMaxRateHz, kMaxSearchIntervalS)).ok());
   EXPECT_TRUE(check_time_options(with(1.0 / 30.0, 30.0, 0.1)).ok());  // exactly one tick
@@ -51,6 +64,9 @@ TEST(CrowdLimits, TimeOptionsOutOfRangeNameTheOption) {
       {with(10.0, 0.9999999, 0.1), "--rate 0.9999999: expected 1 to 1000"},
       {with(10.0, 30.0, 3600.001), "--search-interval 3600.001: expected"},
       {with(333333.4, 30.0, 0.1), "--seconds 333333.4 at --rate 30: over 10000000 ticks"},
+      {waiting(-0.5), "--wait-at-goals -0.5: expected 0 to 3600 seconds"},
+      {waiting(3601.0), "--wait-at-goals 3601: expected 0 to 3600 seconds"},
+      {waiting(std::nan("")), "--wait-at-goals nan: expected 0 to 3600 seconds"},
   };
   for (const auto& c : cases) {
     const Status status = check_time_options(c.options);

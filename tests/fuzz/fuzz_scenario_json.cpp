@@ -1,8 +1,8 @@
 // libFuzzer target: the crowd's scenario JSON (host/crowd/steering/scenario.cpp,
 // compiled into this target). Every input ends in an error naming the file
 // and field, or in a scenario the crowd can run: at most kMaxAgents agents,
-// each with at least one goal, every coordinate and speed finite, and a
-// positive world size.
+// each with at least one goal, every coordinate and speed finite, every
+// wait within 0 to kMaxGoalWaitS, and a positive world size.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -37,6 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(std::isfinite(plan.start[0]) && std::isfinite(plan.start[1]), "a start");
     for (const auto& goal : plan.goals) check(std::isfinite(goal[0]) && std::isfinite(goal[1]), "a goal");
     check(std::isfinite(plan.speed.value) && plan.speed.value > 0.0f, "a speed");
+    check(plan.wait_s >= 0.0f && plan.wait_s <= float(mmvk::crowd::kMaxGoalWaitS), "a wait");
   }
   return 0;
 }

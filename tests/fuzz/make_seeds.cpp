@@ -99,8 +99,9 @@ int main(int argc, char** argv) {
   ok = ok && mmvk::save_cluster_table(*table, table_path).ok();
 
   ok = ok && write(out / "scenario" / "scenario.json",
-                   "{\"world_size_m\": 40, \"agents\": [{\"start\": [0, 0], \"goals\": [[4, 0], [4, 4]], "
-                   "\"speed\": \"run\", \"require_tags\": [\"walk\"], \"exclude_tags\": [\"turn\"]}, "
+                   "{\"world_size_m\": 40, \"wait_s\": 2, "
+                   "\"agents\": [{\"start\": [0, 0], \"goals\": [[4, 0], [4, 4]], "
+                   "\"speed\": \"run\", \"require_tags\": [\"walk\"], \"exclude_tags\": [\"turn\"], \"wait_s\": 0.5}, "
                    "{\"start\": [1, -2.5], \"goals\": [[-3, 1]], \"speed\": 1.2}]}");
   ok = ok && write(out / "pose_targets" / "targets.json",
                    "{\"targets\": [{\"bone\": \"@left_foot\", \"position\": [0.1, 0.05, 0.2], "

@@ -1,41 +1,14 @@
 #include "measure/run_summary.hpp"
 
 #include <cmath>
-#include <cstdio>
+#include <span>
 #include <string>
 
+#include "measure/data_notes.hpp"
+#include "mmvk/database/gait_coverage.hpp"
 #include "steering/gait_plan.hpp"
 
 namespace mmvk::crowd {
-
-namespace {
-
-// The speeds held commands asked for that the animation did not play
-// within 20% (command_meter.hpp), as notes.
-void add_missed_speed_notes(CrowdSummary& s) {
-  const CommandFigures& c = s.command;
-  const struct {
-    const CommandFigures::Missed& missed;
-    const char* what;
-  } kinds[] = {{c.too_fast, "slower"}, {c.too_slow, "faster"}};
-  for (const auto& k : kinds) {
-    if (k.missed.windows == 0) continue;
-    char speeds[64], text[256];
-    if (k.missed.max_mps - k.missed.min_mps < 0.005) {
-      std::snprintf(speeds, sizeof(speeds), "%.2f", k.missed.min_mps);
-    } else {
-      std::snprintf(speeds, sizeof(speeds), "%.2f-%.2f", k.missed.min_mps, k.missed.max_mps);
-    }
-    std::snprintf(text, sizeof(text),
-                  "the data lacks %s motion: held commands of %s m/s played more than 20%% %s than asked "
-                  "(%llu of %llu 1 s windows), beyond its play-rate and stride bounds",
-                  k.what, speeds, k.what[0] == 's' ? "faster" : "slower",
-                  static_cast<unsigned long long>(k.missed.windows), static_cast<unsigned long long>(c.windows));
-    s.notes.push_back(text);
-  }
-}
-
-}  // namespace
 
 CrowdSummary summarize_run(const RunParts& run) {
   CrowdSummary s;
@@ -62,8 +35,17 @@ CrowdSummary summarize_run(const RunParts& run) {
   s.speed_from_animation = run.speed_from_animation;
   // 0.07, not 0.0700000003.
   s.correction_half_life_s = std::round(double(run.params.correction_half_life) * 1e6) / 1e6;
+  // What the data lacks for this crowd: the scenario's speeds only when the
+  // crowd's own steering asked for them (a host's commands are measured
+  // instead, below).
+  const std::span<const float> preferred =
+      run.steering.updates() > 0 ? run.steering.preferred_speeds() : std::span<const float>();
+  for (std::string& note : data_notes(measure_gait_coverage(run.database), run.database.gait_bands(), run.params,
+                                      preferred)) {
+    s.notes.push_back(std::move(note));
+  }
   run.quality.summarize(s);
-  add_missed_speed_notes(s);
+  for (std::string& note : missed_speed_notes(s.command)) s.notes.push_back(std::move(note));
   s.clips = run.clips.figures;
   s.planted_height_m = run.clips.planted_height;
   s.goals_reached = run.steering.goals_reached();

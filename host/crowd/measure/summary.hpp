@@ -51,7 +51,9 @@ struct CrowdSummary {
   double transitions_per_agent_s = 0.0;
   std::uint64_t goals_reached = 0;
   std::uint64_t chosen_frames_hash = 0;
-  std::vector<std::string> notes;  // what the data cannot do (no run, ...)
+  // What the data cannot do for this run: no run, no idle, the speeds it
+  // lacks (data_notes.hpp); `mmvk crowd` prints them last.
+  std::vector<std::string> notes;
   // The viewer and the trace, when written.
   std::string html;
   std::uint64_t html_bytes = 0;

@@ -27,6 +27,9 @@ inline constexpr double kMaxRateHz = 1000.0;
 // --search-interval, seconds.
 inline constexpr double kMinSearchIntervalS = 0.001;
 inline constexpr double kMaxSearchIntervalS = 3600.0;
+// --wait-at-goals and a scenario's wait_s, seconds at each goal: 0 to an
+// hour; more is a typo (milliseconds given as seconds), not a plan.
+inline constexpr double kMaxGoalWaitS = 3600.0;
 // round(--seconds x --rate): at least one tick, at most this many.
 inline constexpr std::uint64_t kMaxTicks = 10'000'000;
 // The share of the memory limit (memory_limit_bytes) a run may plan to use;

@@ -57,7 +57,7 @@ void log_start(std::FILE* log, const CrowdOptions& options, const std::string& d
   std::fprintf(log, "mmvk crowd: %u agents for %.1f s at %.0f Hz on %s (%u frames; walk %.2f m/s, %s); backend %s\n",
                crowd.agents(), options.seconds, options.rate_hz, db_name.c_str(), crowd.controller().database().frame_count(),
                speeds.walk_mps, run, backend.c_str());
-  if (!speeds.has_run) std::fprintf(log, "mmvk crowd: note: no run in the data: %s\n", speeds.no_run_reason.c_str());
+  // Why the data has no run is in the summary's notes, printed at the end.
   std::fprintf(log, "mmvk crowd: backend %s on %s\n", std::string(search.backend->name()).c_str(),
                search.device.c_str());
   if (!search.driver_cache_note.empty()) std::fprintf(log, "mmvk crowd: note: %s\n", search.driver_cache_note.c_str());

@@ -50,6 +50,12 @@ Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptio
   }
   Scenario scenario;
   if (o.scenario) {
+    // Its agents' waits are its own: one setting that overrode some of them
+    // would leave a reader of the file guessing which.
+    if (o.wait_at_goals_s != 0.0) {
+      return make_error(setting_name(o.names, "wait-at-goals") + " sets the random scenario's wait; " +
+                        o.scenario->source + " sets its own (\"wait_s\", per agent or for all)");
+    }
     MMVK_TRY(check_crowd_memory(o, outputs, database, &*o.scenario, o.names));
     scenario = *o.scenario;
   } else {
@@ -57,6 +63,7 @@ Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptio
     RandomScenarioOptions random;
     random.agents = std::uint32_t(agents);
     random.seed = o.seed;
+    random.wait_s = float(o.wait_at_goals_s);
     if (!speeds.has_run) random.run_fraction = 0.0f;  // data without a run gets no runners
     scenario = make_random_scenario(random);
   }
@@ -163,7 +170,7 @@ Status CrowdSession::set_tags(std::span<const std::uint64_t> agents, std::span<c
 Status CrowdSession::step() {
   // The tick's time counts the steering too.
   const auto tick_start = Clock::now();
-  steering_->update(controller_->root_positions(), desired_, &pool_);
+  steering_->update(controller_->root_positions(), desired_, float(dt_), &pool_);
   return tick(desired_, {}, tick_start);
 }
 

@@ -98,6 +98,9 @@ Status validate(const CrowdSettings& s, SettingNames names) {
     return out_of_range(names, "search-interval", s.search_interval_s, kMinSearchIntervalS, kMaxSearchIntervalS,
                         " seconds");
   }
+  if (!within(s.wait_at_goals_s, 0.0, kMaxGoalWaitS)) {
+    return out_of_range(names, "wait-at-goals", s.wait_at_goals_s, 0.0, kMaxGoalWaitS, " seconds");
+  }
   MMVK_TRY(check_tick_count(s.seconds, s.rate_hz, 1, setting_name(names, "seconds"), names));
   return check_controls(s, names);
 }

@@ -36,6 +36,9 @@ struct CrowdSettings {
   std::string backend = "auto";         // a backend registry name (mmvk/search/backends.hpp) or "auto" (crowd_backend.hpp)
   std::optional<std::uint32_t> device;  // Vulkan device index; none = the best
   std::uint64_t seed = 1;               // the random scenario's
+  // The random scenario's wait at each goal, seconds, 0 to kMaxGoalWaitS
+  // (AgentPlan::wait_s); 0: leave at once. A scenario file sets its own.
+  double wait_at_goals_s = 0.0;
   bool foot_ik = true;                  // lock planted feet with two-bone IK
   // Play rate and stride warping toward the commanded speed, and the root
   // correction held to the animation's own speed (ControllerParams'

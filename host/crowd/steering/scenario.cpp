@@ -10,6 +10,7 @@
 #include "mmvk/common/file_io.hpp"
 #include "mmvk/common/input_text.hpp"
 #include "mmvk/common/json_check.hpp"
+#include "mmvk/common/number_text.hpp"
 #include "steering/random.hpp"
 
 namespace mmvk::crowd {
@@ -71,10 +72,24 @@ Result<SpeedPreference> read_speed(const Json& value, const std::string& where) 
   return SpeedPreference{Gait::Metres, *metres};
 }
 
-Result<AgentPlan> parse_agent(const Json& object, const std::string& where) {
+// A wait at a goal: seconds, 0 to kMaxGoalWaitS. The reader already
+// refuses 1e999; isfinite keeps the bound honest without relying on it.
+Result<float> read_wait(const Json& value, const std::string& where) {
+  const std::string expected = ": expected seconds from 0 to " + number_text(kMaxGoalWaitS);
+  if (!value.is_number()) return make_error(where + expected);
+  const double seconds = value.get<double>();
+  if (!std::isfinite(seconds) || seconds < 0.0 || seconds > kMaxGoalWaitS) {
+    return make_error(where + expected + ", got " + number_text(seconds));
+  }
+  return static_cast<float>(seconds);
+}
+
+// `wait_s`: the scenario's default wait, for an agent without its own.
+Result<AgentPlan> parse_agent(const Json& object, const std::string& where, float wait_s) {
   if (!object.is_object()) return make_error(where + ": expected an object");
-  MMVK_TRY(check_fields(object, where + ".", {"start", "goals", "speed", "require_tags", "exclude_tags"}));
+  MMVK_TRY(check_fields(object, where + ".", {"start", "goals", "speed", "require_tags", "exclude_tags", "wait_s"}));
   AgentPlan plan;
+  plan.wait_s = wait_s;
   if (!object.contains("start")) return make_error(where + ".start: missing");
   MMVK_ASSIGN_OR_RETURN(plan.start, read_point(object["start"], where + ".start"));
   if (!object.contains("goals")) return make_error(where + ".goals: missing");
@@ -92,6 +107,9 @@ Result<AgentPlan> parse_agent(const Json& object, const std::string& where) {
   }
   if (object.contains("exclude_tags")) {
     MMVK_ASSIGN_OR_RETURN(plan.exclude_tags, read_tags(object["exclude_tags"], where + ".exclude_tags"));
+  }
+  if (object.contains("wait_s")) {
+    MMVK_ASSIGN_OR_RETURN(plan.wait_s, read_wait(object["wait_s"], where + ".wait_s"));
   }
   return plan;
 }
@@ -125,6 +143,8 @@ Scenario make_random_scenario(const RandomScenarioOptions& options) {
     } else {
       plan.speed = {Gait::Walk, random.uniform(0.8f, 1.1f)};
     }
+    // Not drawn: the same seed gives the same goals and speeds at any wait.
+    plan.wait_s = options.wait_s;
   }
   return scenario;
 }
@@ -137,7 +157,7 @@ Result<Scenario> parse_scenario_json(std::string_view json_text, std::string_vie
   const Json root = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
   if (root.is_discarded()) return make_error(name + ": not valid JSON");
   if (!root.is_object()) return make_error(name + ": expected a JSON object with \"agents\"");
-  MMVK_TRY(check_fields(root, name + ": ", {"world_size_m", "agents"}));
+  MMVK_TRY(check_fields(root, name + ": ", {"world_size_m", "wait_s", "agents"}));
   Scenario scenario;
   scenario.source = name;
   if (!root.contains("agents")) return make_error(name + ": agents: missing");
@@ -147,9 +167,14 @@ Result<Scenario> parse_scenario_json(std::string_view json_text, std::string_vie
     return make_error(name + ": agents: " + std::to_string(agents.size()) + " agents, over the limit of " +
                       std::to_string(kMaxAgents));
   }
+  float wait_s = 0.0f;
+  if (root.contains("wait_s")) {
+    MMVK_ASSIGN_OR_RETURN(wait_s, read_wait(root["wait_s"], name + ": wait_s"));
+  }
   float extent = 0.0f;
   for (std::size_t a = 0; a < agents.size(); ++a) {
-    MMVK_ASSIGN_OR_RETURN(AgentPlan plan, parse_agent(agents[a], name + ": agents[" + std::to_string(a) + "]"));
+    MMVK_ASSIGN_OR_RETURN(AgentPlan plan,
+                          parse_agent(agents[a], name + ": agents[" + std::to_string(a) + "]", wait_s));
     extent = std::max({extent, std::abs(plan.start[0]), std::abs(plan.start[1])});
     for (const auto& goal : plan.goals) extent = std::max({extent, std::abs(goal[0]), std::abs(goal[1])});
     scenario.agents.push_back(std::move(plan));

@@ -4,6 +4,7 @@
 //
 // {
 //   "world_size_m": 60,                  // optional: side of the square ground plane
+//   "wait_s": 2,                         // optional, default 0: every agent's wait_s unless it sets its own
 //   "agents": [
 //     { "start": [x, z],                 // metres on the ground plane (Y up)
 //       "goals": [[x, z], ...],          // visited in order, then from the first again
@@ -11,7 +12,10 @@
 //                                        //   when a number, capped to the database's run speed;
 //                                        //   "run" on data without a run is an error (gait_plan.hpp)
 //       "require_tags": ["walk"],        // optional: every searched frame carries all of them
-//       "exclude_tags": ["run"] }        // optional: and none of these
+//       "exclude_tags": ["run"],         // optional: and none of these
+//       "wait_s": 1.5 }                  // optional, default the top-level wait_s, else 0: seconds it
+//                                        //   stands at each goal (desired velocity 0) before it leaves
+//                                        //   for the next; 0 to kMaxGoalWaitS (an hour, crowd_limits.hpp)
 //   ]
 // }
 // Unknown fields, duplicate keys and bytes after the JSON are errors; the
@@ -46,6 +50,9 @@ struct AgentPlan {
   SpeedPreference speed;
   std::vector<std::string> require_tags;
   std::vector<std::string> exclude_tags;
+  // Seconds to stand at each goal before leaving for the next (steering.hpp);
+  // 0: leave at once, as the crowd always did.
+  float wait_s = 0.0f;
 };
 
 struct Scenario {
@@ -62,6 +69,7 @@ struct RandomScenarioOptions {
   float run_fraction = 0.2f;        // share of characters that prefer to run
   float min_goal_distance_m = 5.0f; // each goal lies this far from the previous one ...
   float max_goal_distance_m = 15.0f;// ... up to this, in a random direction
+  float wait_s = 0.0f;              // every character's wait at each goal, seconds (AgentPlan::wait_s)
 };
 
 // Deterministic for a given seed on every platform (own generator, no

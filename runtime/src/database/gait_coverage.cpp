@@ -136,20 +136,28 @@ std::string describe_gait_coverage(const GaitCoverage& coverage, const GaitBandP
                   double(coverage.moving_p95_mps));
     out += text;
   }
-  if (!coverage.can_stand()) {
-    std::snprintf(text, sizeof(text),
-                  "\nthe data has no idle: %llu candidate frames stand (root under %g m/s), the longest run %.2f s, "
-                  "and no looping clip stands (an idle needs %g s or a standing loop); a character told to stop "
-                  "must hold a frame",
-                  static_cast<unsigned long long>(n[0]), double(params->walk_from_mps),
-                  double(coverage.longest_stand_seconds), double(kMinIdleSeconds));
-    out += text;
-  }
+  if (const std::string idle = no_idle_note(coverage, params); !idle.empty()) out += "\n" + idle;
   if (n[0] > 0 && coverage.has_contacts) {
     out += "\nstanding frames with both feet planted: " + std::to_string(coverage.stand_both_feet_frames) + " of " +
            std::to_string(n[0]);
   }
   return out;
+}
+
+std::string no_idle_note(const GaitCoverage& coverage, const GaitBandParams* params) {
+  const char* const holds = "a character told to stop or stand must hold a frame instead";
+  if (!coverage.measured || !params) {
+    return "the data has no idle: its gait tags are " + gait_capabilities(coverage) +
+           ", so no frame is known to stand; " + holds;
+  }
+  if (coverage.can_stand()) return {};
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "the data has no idle: %llu candidate frames stand (root under %g m/s), the longest run %.2f s, "
+                "and no looping clip stands (an idle needs %g s or a standing loop); %s",
+                static_cast<unsigned long long>(coverage.band_frames[0]), double(params->walk_from_mps),
+                double(coverage.longest_stand_seconds), double(kMinIdleSeconds), holds);
+  return text;
 }
 
 }  // namespace mmvk

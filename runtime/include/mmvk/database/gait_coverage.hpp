@@ -64,4 +64,11 @@ std::string gait_capabilities(const GaitCoverage& coverage);
 // ("the data has no idle: ...").
 std::string describe_gait_coverage(const GaitCoverage& coverage, const GaitBandParams* params);
 
+// What the data lacks to stand, one line in the words of
+// describe_gait_coverage ("the data has no idle: ..., a character told to
+// stop or stand must hold a frame instead"), for every report that says it
+// (`mmvk inspect`, the crowd summary's notes); empty when it can stand.
+// Unmeasured coverage has no idle known either, and says why.
+std::string no_idle_note(const GaitCoverage& coverage, const GaitBandParams* params);
+
 }  // namespace mmvk

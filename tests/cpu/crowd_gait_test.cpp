@@ -97,7 +97,7 @@ Scenario three_plans() {
 TEST(CrowdGaitPlan, RunningOnDataWithoutARunIsAnErrorNamingTheGait) {
   const GaitSpeeds walk_only{.walk_mps = 1.3f, .max_mps = 1.5f, .no_run_reason = "no frame is tagged 'run'"};
   Scenario scenario = three_plans();
-  const Status status = resolve_gaits(scenario, walk_only, false);
+  const Status status = resolve_gaits(scenario, walk_only);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("crowd.json: agents[1].speed: asks for the 'run' gait, but the motion data has no "
                                   "run (no frame is tagged 'run')"),
@@ -105,7 +105,7 @@ TEST(CrowdGaitPlan, RunningOnDataWithoutARunIsAnErrorNamingTheGait) {
       << status.message();
   // Without runners, nothing fails and no tag is added (the data is untagged).
   scenario.agents[1].speed = {Gait::Walk, 0.9f};
-  ASSERT_TRUE(resolve_gaits(scenario, walk_only, false).ok());
+  ASSERT_TRUE(resolve_gaits(scenario, walk_only).ok());
   for (const AgentPlan& plan : scenario.agents) EXPECT_TRUE(plan.require_tags.empty());
   EXPECT_EQ(count_runners(scenario), 0u);
 }
@@ -115,16 +115,14 @@ TEST(CrowdGaitPlan, TaggedDataSendsEachPlanToItsGaitUnlessItNamesOne) {
   Scenario scenario = three_plans();
   scenario.agents.push_back(scenario.agents[0]);
   scenario.agents.back().exclude_tags = {"walk"};  // names a gait tag: left alone
-  Scenario chosen = scenario;
-  ASSERT_TRUE(resolve_gaits(scenario, tagged, false).ok());
+  ASSERT_TRUE(resolve_gaits(scenario, tagged).ok());
   EXPECT_EQ(scenario.agents[0].require_tags, std::vector<std::string>{"walk"});
   EXPECT_EQ(scenario.agents[1].require_tags, std::vector<std::string>{"run"});
   EXPECT_EQ(scenario.agents[2].require_tags, std::vector<std::string>{"run"}) << "3 m/s is nearer the run";
   EXPECT_TRUE(scenario.agents[3].require_tags.empty());
   EXPECT_EQ(count_runners(scenario), 1u);
-  // A controller that chooses the gait from the command gets no gait tag.
-  ASSERT_TRUE(resolve_gaits(chosen, tagged, true).ok());
-  for (const AgentPlan& plan : chosen.agents) EXPECT_TRUE(plan.require_tags.empty());
+  EXPECT_EQ(scenario.agents[0].steering_gait_tag, "walk");
+  EXPECT_EQ(scenario.agents[3].steering_gait_tag, "") << "the scenario's own";
 }
 
 TEST(CrowdGaitPlan, ARandomCrowdWithoutARunFractionHasNoRunners) {

@@ -69,7 +69,7 @@ Result<Scenario> plan_scenario(const Database& database, const CrowdSessionOptio
   }
   // The crowd's controller chooses each search's gait where the data
   // measured them (ControllerParams::choose_gait is on).
-  MMVK_TRY(resolve_gaits(scenario, speeds, database.gait_bands() != nullptr));
+  MMVK_TRY(resolve_gaits(scenario, speeds));
   return scenario;
 }
 
@@ -118,6 +118,16 @@ Status CrowdSession::set_up(const ControllerParams& params) {
   controller_.emplace(std::move(created.value()));
   CrowdController& c = *controller_;
   MMVK_TRY(apply_plan_tags(scenario_, database_, c.query_params()));
+  // The gait tags added for the crowd's own steering, lifted where a host
+  // commands the gait and the controller can choose it.
+  steering_gait_masks_.assign(agents_, 0);
+  if (database_.gait_bands() != nullptr && params.choose_gait) {
+    for (std::uint32_t b = 0; b < agents_; ++b) {
+      const std::string& tag = scenario_.agents[b].steering_gait_tag;
+      if (tag.empty()) continue;
+      MMVK_ASSIGN_OR_RETURN(steering_gait_masks_[b], database_.tag_mask(std::span<const std::string>(&tag, 1)));
+    }
+  }
   MMVK_TRY(apply_query_settings(o, database_, o.names, c.query_params()));
   for (std::uint32_t b = 0; b < agents_; ++b) {
     const AgentPlan& plan = scenario_.agents[b];
@@ -163,6 +173,7 @@ Status CrowdSession::set_tags(std::span<const std::uint64_t> agents, std::span<c
   for (const std::uint64_t b : agents) {
     params[b].require_all = *required;
     params[b].exclude_any = *excluded;
+    steering_gait_masks_[b] = 0;  // the host's tags are the host's
   }
   return {};
 }
@@ -193,6 +204,14 @@ Status CrowdSession::step(std::span<const glm::vec3> desired_velocity, std::span
                         number_text(kMaxDesiredSpeed) + " m/s");
     }
     desired_[b] = glm::vec3(desired_velocity[b].x, 0.0f, desired_velocity[b].z);
+  }
+  // The host commands the speed: the controller chooses the gait from it,
+  // free of the walk or run tag the scenario's plan added for the crowd's
+  // own steering (a walker told to run runs).
+  const std::span<QueryParams> params = controller_->query_params();
+  for (std::uint32_t b = 0; b < agents_; ++b) {
+    params[b].require_all &= ~steering_gait_masks_[b];
+    steering_gait_masks_[b] = 0;
   }
   return tick(desired_, desired_yaw, tick_start);
 }

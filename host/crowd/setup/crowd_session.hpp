@@ -84,6 +84,10 @@ class CrowdSession {
   // One tick steered by the caller: desired_velocity [agents] world m/s (y
   // ignored); desired_yaw [agents] radians (0 faces +Z) or empty: face the
   // velocity. Errors: sizes, non-finite values (CrowdController::tick).
+  // From the first such step the controller chooses each character's gait
+  // from its command (ControllerParams::choose_gait, on data with measured
+  // gait tags): the scenario's walk or run tag, which keeps the crowd's own
+  // walkers on the walk clips, is lifted.
   Status step(std::span<const glm::vec3> desired_velocity, std::span<const float> desired_yaw);
 
   // The tags characters `agents` search with from their next search on
@@ -144,6 +148,9 @@ class CrowdSession {
   std::unique_ptr<QualityObserver> quality_;
   std::unique_ptr<RecordingObserver> recording_;
   ControllerParams params_;
+  // [agents] the scenario's gait tag (AgentPlan::steering_gait_tag) while it
+  // still pins the character; 0 once a host commands or sets its tags.
+  std::vector<TagMask> steering_gait_masks_;
   ClipQuality clips_;
 
   // Per tick, sized once.

@@ -17,7 +17,7 @@ bool runs(const SpeedPreference& speed, const GaitSpeeds& speeds) {
 
 }  // namespace
 
-Status resolve_gaits(Scenario& scenario, const GaitSpeeds& speeds, bool controller_chooses) {
+Status resolve_gaits(Scenario& scenario, const GaitSpeeds& speeds) {
   for (std::size_t a = 0; a < scenario.agents.size(); ++a) {
     AgentPlan& plan = scenario.agents[a];
     if (plan.speed.gait == Gait::Run && !speeds.has_run) {
@@ -25,10 +25,12 @@ Status resolve_gaits(Scenario& scenario, const GaitSpeeds& speeds, bool controll
                         "].speed: asks for the 'run' gait, but the motion data has no run (" + speeds.no_run_reason +
                         ")");
     }
-    if (!speeds.tagged || controller_chooses) continue;
+    if (!speeds.tagged) continue;
     const bool named = names(plan.require_tags, kWalkTag) || names(plan.require_tags, kRunTag) ||
                        names(plan.exclude_tags, kWalkTag) || names(plan.exclude_tags, kRunTag);
-    if (!named) plan.require_tags.push_back(runs(plan.speed, speeds) ? kRunTag : kWalkTag);
+    if (named) continue;
+    plan.steering_gait_tag = runs(plan.speed, speeds) ? kRunTag : kWalkTag;
+    plan.require_tags.push_back(plan.steering_gait_tag);
   }
   return {};
 }

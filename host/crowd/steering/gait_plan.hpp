@@ -19,18 +19,18 @@ namespace mmvk::crowd {
 //   - a plan that prefers to run ("speed": "run") on data without a run
 //     (speeds.has_run false) is an error naming the file, the agent and the
 //     'run' gait, with speeds.no_run_reason;
-//   - with speeds.tagged, and unless the controller chooses each search's
-//     gait from the commanded speed (controller_chooses: a database with
-//     measured gait tags, ControllerParams::choose_gait), a plan that names
-//     neither gait tag in its require_tags or exclude_tags requires its
-//     gait's tag: "run" for a plan that prefers to run or asks for
-//     metres/second nearer the run speed than the walk speed, else "walk".
-//     Plans that name a gait tag keep theirs: the scenario knows best. A
-//     controller that chooses needs no such tag, and the tag would keep a
-//     walker off the data's standing and stopping frames.
+//   - with speeds.tagged, a plan that names neither gait tag in its
+//     require_tags or exclude_tags requires its gait's tag: "run" for a plan
+//     that prefers to run or asks for metres/second nearer the run speed
+//     than the walk speed, else "walk" (also kept in steering_gait_tag).
+//     Plans that name a gait tag keep theirs: the scenario knows best. The
+//     tag serves the crowd's own steering, whose walkers keep to the walk
+//     clips (fewer jumps than a controller free to pick a jog's slow
+//     frames); a host's commands choose the gait instead
+//     (CrowdSession::step with velocities lifts it).
 // Random scenarios are drawn without runners when the data has no run (the
 // caller sets RandomScenarioOptions::run_fraction), so they never fail here.
-Status resolve_gaits(Scenario& scenario, const GaitSpeeds& speeds, bool controller_chooses);
+Status resolve_gaits(Scenario& scenario, const GaitSpeeds& speeds);
 
 // Each plan's require_tags and exclude_tags, by name, into the masks of
 // params[agent] (the controller's query parameters, [agents]); an unknown

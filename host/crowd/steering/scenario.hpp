@@ -53,6 +53,9 @@ struct AgentPlan {
   // Seconds to stand at each goal before leaving for the next (steering.hpp);
   // 0: leave at once, as the crowd always did.
   float wait_s = 0.0f;
+  // The gait tag resolve_gaits added to require_tags for the crowd's own
+  // steering (gait_plan.hpp), or empty.
+  std::string steering_gait_tag;
 };
 
 struct Scenario {

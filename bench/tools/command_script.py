@@ -101,7 +101,7 @@ def main():
     s = crowd.summary()
     keys = ["trajectory_error_m_1s", "foot_sliding_cm_s", "foot_sliding_before_ik_cm_s", "pose_acceleration_p99_m_s2",
             "transitions_per_agent_s", "glide_cm_s", "glide_share_of_travel", "animation_share_of_travel",
-            "played_speed_error", "shown_speed_error", "heading_error_deg", "chosen_frames_hash"]
+            "played_speed_error", "shown_speed_error", "heading_error_deg", "standing_still_share", "chosen_frames_hash"]
     print(json.dumps({"data": args.data, "rate": args.rate, "speed_from_animation": args.speed_from_animation,
                       "summary": {k: s.get(k) for k in keys}, "segments": segments}))
 

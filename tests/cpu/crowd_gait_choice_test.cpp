@@ -100,6 +100,8 @@ TEST(CrowdGaitChoice, ToldToStandTheyStandStillOnStandingFrames) {
     });
     EXPECT_EQ(on_stand, ticks);
     EXPECT_GE(still, 0.9);
+    // The summary's figure, measured the same way over the held stand.
+    EXPECT_GE(s->summary().command.standing_still_share, 0.9);
   }
 }
 

@@ -267,6 +267,7 @@ def test_told_to_stand_the_characters_stand_still_on_their_own_choice(db):
             ticks += 4
     assert np.all(crowd.gaits == [0, 0]), crowd.gaits
     assert still / ticks >= 0.9, still / ticks
+    assert crowd.summary()["standing_still_share"] >= 0.9
     for _ in range(60):
         crowd.step(walk)
     assert np.all(crowd.gaits[:, 0] == 1) and np.all(crowd.resting == 0)

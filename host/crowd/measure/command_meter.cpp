@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
 namespace mmvk::crowd {
 
 namespace {
@@ -14,6 +16,8 @@ constexpr double kRadToDeg = 180.0 / kPi;
 constexpr double kHoldTolerance = 0.1;
 constexpr double kMovingSpeed = 0.2;
 constexpr double kSettleSeconds = 1.0;
+// A stand is steady later: the issue gives a stop 1.2 s to come to rest.
+constexpr double kStopSettleSeconds = 1.2;
 
 double horizontal(const glm::vec3& v) { return std::hypot(double(v.x), double(v.z)); }
 
@@ -22,6 +26,7 @@ double horizontal(const glm::vec3& v) { return std::hypot(double(v.x), double(v.
 CommandMeter::CommandMeter(std::size_t agents, double dt)
     : dt_(dt),
       settle_ticks_(std::max<std::uint64_t>(1, std::uint64_t(std::llround(kSettleSeconds / dt)))),
+      stop_settle_ticks_(std::max<std::uint64_t>(1, std::uint64_t(std::llround(kStopSettleSeconds / dt)))),
       agents_(agents),
       glide_(0.1, 20000),
       played_error_(0.001, 5000),
@@ -41,7 +46,12 @@ void CommandMeter::record(const Tick& tick) {
     ++agent_ticks_;
     const glm::vec3 step = tick.roots[b] - a.last_root;
     const bool counted = a.seen && horizontal(step) <= kTeleport;
+    const bool steady = a.held_ticks > settle_ticks_;
+    if (counted && a.held_ticks > stop_settle_ticks_ && horizontal(a.held) < kStandCommand) {
+      record_standing(a, tick, b, horizontal(step));
+    }
     a.last_root = tick.roots[b];
+    if (!tick.toes.empty()) a.last_toes[0] = tick.toes[2 * b], a.last_toes[1] = tick.toes[2 * b + 1];
     a.seen = true;
     if (!counted) continue;
     const double shown = horizontal(step);
@@ -52,8 +62,17 @@ void CommandMeter::record(const Tick& tick) {
     correction_m_ += correction;
     animation_m_ += played;
     glide_.add(100.0 * correction / dt_);
-    if (a.held_ticks > settle_ticks_ && horizontal(a.held) >= kMovingSpeed) record_steady(a, tick, b, shown, played);
+    if (steady && horizontal(a.held) >= kMovingSpeed) record_steady(a, tick, b, shown, played);
   }
+}
+
+void CommandMeter::record_standing(const Agent& a, const Tick& tick, std::size_t b, double shown) {
+  if (tick.toes.empty()) return;
+  ++steady_standing_ticks_;
+  const double still = kStillSpeed * dt_;  // metres per tick
+  const bool toes_still = glm::length(tick.toes[2 * b] - a.last_toes[0]) < still &&
+                          glm::length(tick.toes[2 * b + 1] - a.last_toes[1]) < still;
+  still_ticks_ += shown < still && toes_still ? 1 : 0;
 }
 
 void CommandMeter::record_steady(Agent& a, const Tick& tick, std::size_t b, double shown, double played) {
@@ -91,6 +110,10 @@ CommandFigures CommandMeter::figures() const {
     f.animation_share_of_travel = animation_m_ / travel_m_;
   }
   if (agent_ticks_) f.steady_moving_fraction = double(steady_moving_ticks_) / double(agent_ticks_);
+  if (agent_ticks_ && steady_standing_ticks_) {
+    f.steady_standing_fraction = double(steady_standing_ticks_) / double(agent_ticks_);
+    f.standing_still_share = double(still_ticks_) / double(steady_standing_ticks_);
+  }
   f.played_speed_error_median = played_error_.quantile(0.5);
   f.played_speed_error_p95 = played_error_.quantile(0.95);
   f.shown_speed_error_median = shown_error_.quantile(0.5);

@@ -31,6 +31,8 @@ void add_command(nlohmann::ordered_json& j, const CommandFigures& c) {
   j["glide_share_of_travel"] = number(c.glide_share_of_travel);
   j["animation_share_of_travel"] = number(c.animation_share_of_travel);
   j["steady_moving_fraction"] = number(c.steady_moving_fraction);
+  j["steady_standing_fraction"] = number(c.steady_standing_fraction);
+  j["standing_still_share"] = number(c.standing_still_share);
   j["played_speed_error"] = {{"median", number(c.played_speed_error_median)},
                              {"p95", number(c.played_speed_error_p95)}};
   j["shown_speed_error"] = {{"median", number(c.shown_speed_error_median)}, {"p95", number(c.shown_speed_error_p95)}};
@@ -119,7 +121,15 @@ std::string describe_motion(const CrowdSummary& s) {
                 100.0 * g.animation_share_of_travel, 100.0 * g.played_speed_error_median,
                 100.0 * g.played_speed_error_p95, 100.0 * g.shown_speed_error_median, 100.0 * g.shown_speed_error_p95,
                 g.heading_error_deg_median, g.heading_error_deg_p95);
-  return text;
+  std::string out = text;
+  if (std::isfinite(g.standing_still_share)) {
+    std::snprintf(text, sizeof(text),
+                  "mmvk crowd: told to stand: %.1f%% of the steady standing ticks still (root and toes under 5 "
+                  "cm/s)\n",
+                  100.0 * g.standing_still_share);
+    out += text;
+  }
+  return out;
 }
 
 Status write_summary(const CrowdSummary& summary, const std::filesystem::path& path) {

@@ -72,7 +72,10 @@ QualityObserver::QualityObserver(const CrowdController& controller, const Contro
               motion_params(controller, params, clips, dt, rate_hz, fps)),
       command_(controller.size(), dt),
       desired_xz_(2 * std::size_t{controller.size()}),
-      root_xz_(2 * std::size_t{controller.size()}) {}
+      root_xz_(2 * std::size_t{controller.size()}) {
+  const auto feet = controller.animation().contact_joints;
+  if (feet[0] >= 0 && feet[1] >= 0) toes_.resize(2 * std::size_t{controller.size()});
+}
 
 void QualityObserver::observe(const CrowdController& controller, const TickView& view) {
   // Where each character that searched this tick was predicted 1 s from
@@ -94,7 +97,14 @@ void QualityObserver::observe(const CrowdController& controller, const TickView&
   // latter the tick's own FK.
   motion_.record({view.world, controller.animated_world_positions(), controller.contacts(), controller.foot_locked(),
                   controller.ik_reach_clamped(), controller.jumped()});
-  command_.record({view.desired, view.desired_yaw, roots, controller.root_yaws(), controller.root_corrections()});
+  // The displayed toes, for the stillness of standing characters.
+  const auto feet = controller.animation().contact_joints;
+  const std::size_t joints = controller.animation().joint_count();
+  for (std::size_t b = 0; b < toes_.size() / 2; ++b) {
+    for (int side = 0; side < 2; ++side) toes_[2 * b + side] = view.world[b * joints + std::size_t(feet[side])];
+  }
+  command_.record(
+      {view.desired, view.desired_yaw, roots, controller.root_yaws(), controller.root_corrections(), toes_});
 }
 
 void QualityObserver::summarize(CrowdSummary& s) const {

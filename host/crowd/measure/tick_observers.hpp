@@ -80,6 +80,7 @@ class QualityObserver {
   CommandMeter command_;
   // Per tick, sized once: [agents x 2].
   std::vector<float> desired_xz_, root_xz_;
+  std::vector<glm::vec3> toes_;  // [agents x 2] the contact joints as displayed; empty without both
 };
 
 // The viewer's recording (crowd_recorder.hpp), fed what each tick searched.

@@ -13,7 +13,10 @@ for a stand, the share of its held agent-ticks with the root and both toes
 under 5 cm/s (still_share); and for every segment the time it took to
 settle (settle_s): from the first tick after which, to the segment's end,
 every character's shown speed over the last 0.5 s is within 10% of the
-command (a stand: under 5 cm/s) and its heading within 10 degrees.
+command (a stand: under 5 cm/s) and its heading within 10 degrees; for a
+stand, the mean distance the shown root travelled from the command
+(stop_travel_m) against the simulated root's (spring_travel_m: the spring's
+own overshoot), and where it came to rest against it (rest_offset_m).
 
   PYTHONPATH=build/python python3 bench/tools/command_script.py DATA [--rate 30] [--speed-from-animation off]
       [--correction-half-life S]
@@ -64,6 +67,9 @@ def main():
         ticks = int(round(seconds * crowd.rate))
         shown = played = held = 0.0
         still = steady = 0
+        # A stop: how far the shown and the simulated roots travel after the command (the spring's own
+        # overshoot is the latter), and where the shown root comes to rest against the simulated one.
+        start_shown, start_simulated = crowd.root_positions.copy(), crowd.simulated_positions.copy()
         recent = []
         following = []  # per tick: the mean shown speed within 10% (stops: under 5 cm/s) and heading within 10 degrees
         for tick in range(ticks):
@@ -93,7 +99,13 @@ def main():
             last = roots.copy()
         # Settled: from the first tick after which the crowd follows to the segment's end (null: never).
         settled = next((i for i in range(len(following)) if all(following[i:])), None)
-        segments.append({"speed_mps": speed, "heading_deg": heading,
+        stop = {}
+        if speed == 0.0:
+            flat = lambda p: p[:, [0, 2]]
+            stop = {"stop_travel_m": round(float(np.linalg.norm(flat(crowd.root_positions - start_shown), axis=1).mean()), 3),
+                    "spring_travel_m": round(float(np.linalg.norm(flat(crowd.simulated_positions - start_simulated), axis=1).mean()), 3),
+                    "rest_offset_m": round(float(np.linalg.norm(flat(crowd.root_positions - crowd.simulated_positions), axis=1).mean()), 3)}
+        segments.append({"speed_mps": speed, "heading_deg": heading, **stop,
                          "settle_s": None if settled is None else round(settled * crowd.dt, 2),
                          "still_share": round(still / steady, 3) if steady else None,
                          "shown_mps": round(shown / held, 3),

@@ -129,7 +129,8 @@ class Crowd:
                  search_interval: float = 0.1, foot_ik: bool = True, record: bool = False,
                  title: str = "", correction_half_life: Optional[float] = None,
                  record_poses: int = 0, speed_from_animation: bool = True,
-                 detail_agents: Union[None, int, str, Sequence[int], IntArray] = None) -> None:
+                 detail_agents: Union[None, int, str, Sequence[int], IntArray] = None,
+                 wait_at_goals: float = 0.0) -> None:
         """detail_agents (with record=True): the characters the viewer page keeps in detail, their whole
         pose every tick and every search explained; None: the first 32; N: the first N; a spec such as
         '0-9,42,100-104' (`mmvk crowd --detail-agents`); or a sequence of indices."""

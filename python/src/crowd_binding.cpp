@@ -312,7 +312,7 @@ void add_construction(py::class_<PyCrowd>& crowd) {
                        double rate, std::uint64_t seed, const py::object& device, const py::object& scenario,
                        double search_interval, bool foot_ik, bool record, const std::string& title,
                        const py::object& correction_half_life, std::uint32_t record_poses,
-                       bool speed_from_animation, const py::object& detail_agents) {
+                       bool speed_from_animation, const py::object& detail_agents, double wait_at_goals) {
              CrowdSessionOptions options;
              options.backend = backend;
              options.rate_hz = rate;
@@ -320,6 +320,7 @@ void add_construction(py::class_<PyCrowd>& crowd) {
              options.search_interval_s = search_interval;
              options.foot_ik = foot_ik;
              options.speed_from_animation = speed_from_animation;
+             options.wait_at_goals_s = wait_at_goals;
              options.record = record;
              options.title = title;
              if (!device.is_none()) options.device = device.cast<std::uint32_t>();
@@ -340,7 +341,8 @@ void add_construction(py::class_<PyCrowd>& crowd) {
            py::arg("scenario") = py::none(), py::arg("search_interval") = kDefaults.search_interval_s,
            py::arg("foot_ik") = kDefaults.foot_ik, py::arg("record") = false,
            py::arg("title") = "", py::arg("correction_half_life") = py::none(), py::arg("record_poses") = 0,
-           py::arg("speed_from_animation") = kDefaults.speed_from_animation, py::arg("detail_agents") = py::none());
+           py::arg("speed_from_animation") = kDefaults.speed_from_animation, py::arg("detail_agents") = py::none(),
+           py::arg("wait_at_goals") = kDefaults.wait_at_goals_s);
 }
 
 // The ticks: the crowd's own steering, or another simulator's.
@@ -640,7 +642,7 @@ const char* crowd_doc() {
       "Motion-matched characters stepped from Python, as `mmvk crowd` runs them: the same controller, search and "
       "figures and defaults. Crowd(db, agents=None, backend='auto', rate=30.0, seed=1, device=None, scenario=None, "
       "search_interval=0.1, foot_ik=True, record=False, title='', correction_half_life=None, record_poses=0, "
-      "speed_from_animation=True, detail_agents=None). agents: the number of "
+      "speed_from_animation=True, detail_agents=None, wait_at_goals=0.0). agents: the number of "
       "characters (1 to " + std::to_string(crowd::kMaxAgents) + "), drawn with goals from seed (default " +
       std::to_string(crowd::kDefaultAgents) + "), or scenario: a scenario JSON file or "
       "dict (starts, goals, speeds, tags; `mmvk crowd --scenario`), which sets the count. backend 'auto': a Vulkan "
@@ -652,7 +654,9 @@ const char* crowd_doc() {
       number_text(crowd::kCorrectionHalfLife) + "; `mmvk crowd "
       "--correction-half-life`). speed_from_animation: play each clip faster or slower and scale its stride toward "
       "the commanded speed, the root correction held to half the animation's own speed (False: the data's own "
-      "speeds; `mmvk crowd --speed-from-animation`). Every setting is checked before anything is allocated. "
+      "speeds; `mmvk crowd --speed-from-animation`). wait_at_goals: seconds the drawn characters stand at each goal "
+      "before the next (`mmvk crowd --wait-at-goals`; a scenario sets its own, \"wait_s\"). Every setting is "
+      "checked before anything is allocated. "
       "record=True keeps the viewer's recording for write_html(); detail_agents chooses the characters it keeps "
       "in detail, their whole pose every tick and every search explained (None: the first " +
       std::to_string(crowd::kDefaultDetailAgents) + ", or the crowd when smaller; a count N: the first N; a spec "

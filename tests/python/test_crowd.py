@@ -271,3 +271,16 @@ def test_told_to_stand_the_characters_stand_still_on_their_own_choice(db):
     for _ in range(60):
         crowd.step(walk)
     assert np.all(crowd.gaits[:, 0] == 1) and np.all(crowd.resting == 0)
+
+
+def test_wait_at_goals_is_checked_and_stands_the_drawn_characters(db):
+    """wait_at_goals as `mmvk crowd --wait-at-goals`: a bad value names the
+    keyword; a wait makes the drawn characters stand at their goals."""
+    with pytest.raises(ValueError, match="wait_at_goals"):
+        mmvk.Crowd(db, agents=2, wait_at_goals=-1.0)
+    waiting = mmvk.Crowd(db, agents=20, backend="fast-box", seed=2, wait_at_goals=3.0)
+    waiting.run(20.0)
+    walking = mmvk.Crowd(db, agents=20, backend="fast-box", seed=2)
+    walking.run(20.0)
+    assert waiting.summary()["goals_reached"] < walking.summary()["goals_reached"]
+    assert waiting.summary()["steady_standing_fraction"] > 0.0

@@ -309,7 +309,10 @@ TEST(CrowdController, PlayRateAndStrideBoundsAreNamed) {
                {&ControllerParams::min_stride_scale, 2.0f, "max_stride_scale"},  // above max_stride_scale
                {&ControllerParams::stride_window, 0.0f, "stride_window"},
                {&ControllerParams::correction_speed_ratio, nan, "correction_speed_ratio"},
-               {&ControllerParams::min_correction_speed, -0.1f, "min_correction_speed"}};
+               {&ControllerParams::min_correction_speed, -0.1f, "min_correction_speed"},
+               {&ControllerParams::correction_dead_zone, -0.01f, "correction_dead_zone"},
+               {&ControllerParams::correction_dead_zone, nan, "correction_dead_zone"},
+               {&ControllerParams::correction_dead_zone, 0.5f, "correction_dead_zone"}};  // not below the 0.5 m clamp
   for (const auto& c : cases) {
     ControllerParams params;
     params.*c.field = c.value;

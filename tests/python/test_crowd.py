@@ -90,6 +90,9 @@ class Circle:
         return np.abs(np.linalg.norm(offset - [0.0, self.r], axis=1) - self.r)
 
 
+DEAD_ZONE_M = 0.02  # ControllerParams::correction_dead_zone
+
+
 @pytest.mark.parametrize("shape", ["line", "circle"])
 @pytest.mark.parametrize("by_position", [False, True], ids=["velocities", "positions"])
 def test_external_steering_follows_the_path(db, builtin, shape, by_position):
@@ -103,8 +106,10 @@ def test_external_steering_follows_the_path(db, builtin, shape, by_position):
     # that bound. The bound was the built-in steering's own median error
     # (0.042 m) until speed from the animation brought that to 0.025 m while
     # the host's paths kept 2.6-3.5 cm (p99; 2.0-2.1 before) and 0.026-0.054
-    # m of trajectory error (bench/RESULTS.md, "Speed from the animation").
-    budget = max(own, 0.04)
+    # m of trajectory error (bench/RESULTS.md, "Speed from the animation"),
+    # plus the correction's dead zone (ControllerParams::correction_dead_zone,
+    # 2 cm), the drift the controller now leaves: 4.3-4.5 cm (p99).
+    budget = max(own, 0.04 + DEAD_ZONE_M)
     assert np.percentile(errors, 99) <= budget, (shape, float(np.percentile(errors, 99)), budget)
     assert errors.max() <= 2 * budget, (shape, float(errors.max()), budget)
     assert summary["trajectory_error_m_1s"] <= 1.5 * budget

@@ -59,6 +59,11 @@ Status check_controller_params(const Database& database, std::uint32_t character
   if (!std::isfinite(params.same_location_window) || params.same_location_window < 0.0f) {
     return make_error("crowd controller: same_location_window must be finite and >= 0 (seconds)");
   }
+  if (!std::isfinite(params.correction_dead_zone) || params.correction_dead_zone < 0.0f ||
+      !(params.correction_dead_zone < params.max_correction_distance)) {
+    return make_error("crowd controller: correction_dead_zone must be finite, >= 0 and below "
+                      "max_correction_distance (metres), got " + std::to_string(params.correction_dead_zone));
+  }
   return detail::check_speed_params(params);
 }
 

@@ -114,6 +114,14 @@ bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratc
     return false;
   }
   if (holding) return true;
+  // From the tick it holds, its simulated root waits where the animation
+  // brought the body: the correction would glide it, feet and all, to
+  // wherever the spring stopped. A host that holds a position still draws
+  // it there (its velocities move the simulated root again).
+  const auto settle = [&] {
+    roots_.simulated[b].position = roots_.position[b];
+    return true;
+  };
   const std::uint32_t frame = playback_.frames[b];
   const Clip& clip = database_->clips()[database_->frame_clip()[frame]];
   if (constraint.rest) {
@@ -123,7 +131,7 @@ bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratc
     if (rest == kNoFrame) return false;
     if (rest != frame) jump(static_cast<std::uint32_t>(b), rest, scratch);
     holding = 1;
-    return true;
+    return settle();
   }
   // Standing frames of a clip that goes on (a walk's first steps, a stop's
   // end) are held once both feet are down: played on they would shift
@@ -131,7 +139,7 @@ bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratc
   constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
   const bool stands = (database_->frame_tags()[frame] & gaits_.bits.bit[std::size_t(GaitBand::Stand)]) != 0;
   holding = !clip.loop && stands && (animation_->contacts[frame] & kBothFeet) == kBothFeet ? 1 : 0;
-  return holding != 0;
+  return holding != 0 && settle();
 }
 
 }  // namespace mmvk

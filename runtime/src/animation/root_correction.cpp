@@ -19,6 +19,10 @@ void correct_root(const ControllerParams& params, float dt, float fraction, floa
                   const SimulationState& simulated, glm::vec3& position, float& yaw) {
   glm::vec3 gap = simulated.position - position;
   gap.y = 0.0f;
+  // Only the gap beyond the dead zone is pulled in: a root within it of
+  // its simulated one moves by its animation alone.
+  const float gap_length = glm::length(gap);
+  gap *= gap_length > params.correction_dead_zone ? 1.0f - params.correction_dead_zone / gap_length : 0.0f;
   glm::vec3 step = gap * fraction;
   const float step_length = glm::length(step);
   const float max_step = correction_speed(params, animated_speed) * dt;

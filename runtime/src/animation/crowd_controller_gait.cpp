@@ -7,6 +7,7 @@
 #include "mmvk/animation/crowd_controller.hpp"
 #include "mmvk/animation/playback.hpp"
 #include "mmvk/features/foot_contacts.hpp"
+#include "mmvk/search/search.hpp"
 
 namespace mmvk {
 
@@ -27,7 +28,10 @@ std::vector<std::uint32_t> find_rest_frames(const Database& database, std::span<
                                             TagMask require, TagMask exclude) {
   const AnimationData& animation = *database.animation();
   constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
-  constexpr std::uint32_t kNotCandidate = kFrameDoNotUse | kFrameEdgeExcluded | kFrameBlockTransition;
+  // What a search with these tags could jump to (no continuing frame).
+  QueryParams allowed;
+  allowed.require_all = require;
+  allowed.exclude_any = exclude;
   // Lower is better: no both-feet frame ranks after every both-feet one.
   const auto rank = [&](std::uint32_t f) {
     return stride_speeds[f] + ((animation.contacts[f] & kBothFeet) == kBothFeet ? 0.0f : 1e6f);
@@ -38,8 +42,7 @@ std::vector<std::uint32_t> find_rest_frames(const Database& database, std::span<
   for (std::size_t c = 0; c < database.clips().size(); ++c) {
     const Clip& clip = database.clips()[c];
     for (std::uint32_t f = clip.first_frame; f < clip.first_frame + clip.frame_count; ++f) {
-      const TagMask tags = database.frame_tags()[f];
-      if ((database.frame_flags()[f] & kNotCandidate) || (tags & require) != require || (tags & exclude)) continue;
+      if (!is_candidate(database, f, allowed)) continue;
       if ((animation.contacts[f] & kBothFeet) == kBothFeet && better(f, rest[c])) rest[c] = f;
       if (better(f, best)) best = f;
     }

@@ -8,6 +8,7 @@
 #include "mmvk/animation/playback.hpp"
 #include "mmvk/features/foot_contacts.hpp"
 #include "mmvk/search/search.hpp"
+#include "rest_frames.hpp"
 
 namespace mmvk {
 
@@ -19,37 +20,6 @@ constexpr std::size_t kMaxGaitEntries = 256;
 constexpr std::uint32_t kNoEntry = std::numeric_limits<std::uint32_t>::max();
 
 float horizontal_speed(const glm::vec3& v) { return std::sqrt(v.x * v.x + v.z * v.z); }
-
-// The frame to rest on in each clip, among the candidates the masks allow:
-// both feet planted and the slowest stride (stride_speeds, [frames]); a
-// clip without one rests on the best of all (with both feet down if any
-// frame has them, else the slowest). kNoFrame where no frame is allowed.
-std::vector<std::uint32_t> find_rest_frames(const Database& database, std::span<const float> stride_speeds,
-                                            TagMask require, TagMask exclude) {
-  const AnimationData& animation = *database.animation();
-  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
-  // What a search with these tags could jump to (no continuing frame).
-  QueryParams allowed;
-  allowed.require_all = require;
-  allowed.exclude_any = exclude;
-  // Lower is better: no both-feet frame ranks after every both-feet one.
-  const auto rank = [&](std::uint32_t f) {
-    return stride_speeds[f] + ((animation.contacts[f] & kBothFeet) == kBothFeet ? 0.0f : 1e6f);
-  };
-  const auto better = [&](std::uint32_t a, std::uint32_t b) { return b == kNoFrame || rank(a) < rank(b); };
-  std::vector<std::uint32_t> rest(database.clips().size(), kNoFrame);
-  std::uint32_t best = kNoFrame;
-  for (std::size_t c = 0; c < database.clips().size(); ++c) {
-    const Clip& clip = database.clips()[c];
-    for (std::uint32_t f = clip.first_frame; f < clip.first_frame + clip.frame_count; ++f) {
-      if (!is_candidate(database, f, allowed)) continue;
-      if ((animation.contacts[f] & kBothFeet) == kBothFeet && better(f, rest[c])) rest[c] = f;
-      if (better(f, best)) best = f;
-    }
-  }
-  for (std::uint32_t& r : rest) r = r == kNoFrame ? best : r;
-  return rest;
-}
 
 }  // namespace
 
@@ -71,7 +41,7 @@ std::uint32_t CrowdController::gait_entry(TagMask require, TagMask exclude) {
   e.require = require;
   e.exclude = exclude;
   e.options = gait_options(measure_gait_coverage(*database_, require, exclude));
-  e.rest_frames = find_rest_frames(*database_, stride_speeds_, require, exclude);
+  e.rest_frames = detail::find_rest_frames(*database_, stride_speeds_, require, exclude);
   gaits_.entries.push_back(std::move(e));
   return std::uint32_t(gaits_.entries.size() - 1);
 }

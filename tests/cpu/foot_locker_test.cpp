@@ -467,6 +467,53 @@ TEST(FootLocker, ReleaseDecaysTheCorrectionWithoutAJump) {
   EXPECT_EQ(locker->corrections()[1], glm::vec3(0.0f));
 }
 
+TEST(FootLocker, AStepCarriesALockedFootOntoItsPoseOffTheGround) {
+  // Planted (toe) while the root slides 0.2 m under a still pose, so the
+  // lock holds the toe 0.2 m from its pose; then, still planted, the foot
+  // steps: within 0.25 s it lands on its pose, lifted on the way (a quarter
+  // of the distance, 5 cm), moving in small steps, and locks again there.
+  const AnimationData a = make_skeleton();
+  Result<FootLocker> locker = FootLocker::create(a, 1);
+  ASSERT_TRUE(locker.ok()) << locker.message();
+  Pose still = standing_pose(a);
+  still.contacts = kContactLeft | kContactLeftToe;
+  const float dt = 1.0f / 60.0f;
+  const glm::vec3 slid(0.0f, 0.0f, 0.2f);
+  const std::size_t toe = static_cast<std::size_t>(locker->legs()[0].toe);
+  std::vector<glm::vec3> world(a.joint_count());
+  for (int i = 0; i <= 30; ++i) {
+    Pose pose = still;
+    const glm::vec3 root = slid * (float(i) / 30.0f);
+    update_locker(*locker, a, 0, i == 0 ? 0.0f : dt, pose.contacts, root, 0.0f, pose.rotations, pose.translations, world);
+  }
+  ASSERT_EQ(locker->locked()[0], 1);
+  ASSERT_NEAR(glm::length(locker->corrections()[0]), 0.2f, 1e-3f);
+  const glm::vec3 animated_toe = world_of(a, still, slid, 0.0f)[toe];
+  locker->step(0, 0);
+  EXPECT_TRUE(locker->stepping(0, 0));
+  EXPECT_FALSE(locker->stepping(0, 1));
+  EXPECT_EQ(locker->locked()[0], 0);
+  float highest = 0.0f, largest_step = 0.0f;
+  glm::vec3 previous = world[toe];
+  int ticks = 0;
+  for (; locker->stepping(0, 0) && ticks < 60; ++ticks) {
+    Pose pose = still;
+    update_locker(*locker, a, 0, dt, pose.contacts, slid, 0.0f, pose.rotations, pose.translations, world);
+    highest = std::max(highest, world[toe].y - animated_toe.y);
+    largest_step = std::max(largest_step, glm::length(world[toe] - previous));
+    previous = world[toe];
+  }
+  EXPECT_NEAR(ticks, 15, 1) << "0.25 s at 60 Hz";
+  EXPECT_NEAR(highest, 0.05f, 0.005f);
+  // Smoothstep over 0.25 s: the fastest is 1.5 * 0.2 m / 0.25 s = 1.2 m/s, 2 cm a tick.
+  EXPECT_LT(largest_step, 0.025f);
+  EXPECT_LT(glm::length(world[toe] - animated_toe), 1e-3f);
+  Pose pose = still;
+  update_locker(*locker, a, 0, dt, pose.contacts, slid, 0.0f, pose.rotations, pose.translations, world);
+  EXPECT_EQ(locker->locked()[0], 1) << "planted, it locks where it landed";
+  EXPECT_LT(glm::length(locker->corrections()[0]), 1e-3f);
+}
+
 TEST(FootLocker, ResetForgetsTheLocksAndOffLeavesThePose) {
   const AnimationData a = make_skeleton();
   FootIkParams off;

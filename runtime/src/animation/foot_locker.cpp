@@ -27,6 +27,10 @@ const glm::quat kIdentity(1.0f, 0.0f, 0.0f, 0.0f);
 // per second) is set to zero: the leg is then left exactly as animated, and
 // is not solved at all.
 constexpr float kSettled = 1e-5f;
+// A step's length in time and its height (step()): about a quick shuffle's.
+constexpr float kStepSeconds = 0.25f;
+constexpr float kStepHeightRatio = 0.25f;  // of the distance it covers
+constexpr float kMaxStepHeight = 0.06f;    // metres
 constexpr float kSettledRate = 1e-4f;
 // A unit foot heading shorter than this horizontally (within 14 degrees of
 // vertical) has no reliable yaw: the yaw correction is held meanwhile, and
@@ -230,6 +234,7 @@ Result<FootLocker> FootLocker::create(const AnimationData& animation, std::uint3
   locker.anchor_yaw_.assign(feet, 0.0f);
   locker.yaw_offset_.assign(feet, 0.0f);
   locker.yaw_rate_.assign(feet, 0.0f);
+  locker.steps_.assign(feet, Step{});
   locker.hip_drop_.assign(characters, 0.0f);
   locker.hip_drop_rate_.assign(characters, 0.0f);
   locker.hip_goal_.assign(characters, 0.0f);
@@ -248,6 +253,7 @@ void FootLocker::clear(std::uint32_t b) {
     point_[f] = kHeel;
     anchor_[f] = offset_[f] = offset_rate_[f] = knee_direction_[f] = glm::vec3(0.0f);
     anchor_yaw_[f] = yaw_offset_[f] = yaw_rate_[f] = 0.0f;
+    steps_[f] = Step{};
   }
   hip_drop_[b] = hip_drop_rate_[b] = hip_goal_[b] = 0.0f;
 }
@@ -255,6 +261,14 @@ void FootLocker::clear(std::uint32_t b) {
 void FootLocker::reset(std::uint32_t b) {
   assert(b < characters_);
   clear(b);
+}
+
+void FootLocker::step(std::uint32_t b, std::size_t side) {
+  assert(b < characters_ && side < 2);
+  const std::size_t f = std::size_t{b} * 2 + side;
+  if (stepping(b, side)) return;
+  locked_[f] = 0;
+  steps_[f] = Step{0.0f, 0.0f, yaw_offset_[f], offset_[f]};
 }
 
 namespace {
@@ -286,6 +300,7 @@ struct FootLocker::Steps {
   static bool move_point(FootLocker& l, std::size_t f, const FootView& foot, std::uint8_t to);
   static void hold_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt);
   static void update_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt);
+  static void update_step(FootLocker& l, std::size_t f, float dt);
   static FootTarget foot_target(FootLocker& l, std::size_t f, std::size_t side, const FootView& foot,
                                 const glm::vec3& root_position, const glm::quat* global);
   static float wanted_hip_drop(FootLocker& l, std::size_t side, const FootTarget& target, const glm::vec3* world);
@@ -416,6 +431,10 @@ void FootLocker::Steps::hold_lock(FootLocker& l, std::size_t f, const FootView& 
 // The lock's state machine: held while planted, taken where the foot is
 // shown when it plants, and its offsets decaying after release.
 void FootLocker::Steps::update_lock(FootLocker& l, std::size_t f, const FootView& foot, float dt) {
+  if (l.steps_[f].time >= 0.0f) {
+    update_step(l, f, dt);
+    return;
+  }
   if (!foot.planted) l.drifted_[f] = 0;
   if (l.locked_[f] != 0) {
     if (!foot.planted) {
@@ -446,6 +465,30 @@ void FootLocker::Steps::update_lock(FootLocker& l, std::size_t f, const FootView
   }
 }
 
+// A step (step()): the offsets ease from where it started to zero over
+// kStepSeconds (smoothstep, so the foot leaves and lands at rest), the foot
+// raised on a half sine of kStepHeightRatio times the distance, at most
+// kMaxStepHeight. On arrival the foot is on its animated pose, unlocked: a
+// planted foot locks there on its next update.
+void FootLocker::Steps::update_step(FootLocker& l, std::size_t f, float dt) {
+  Step& step = l.steps_[f];
+  step.time = std::min(step.time + dt, kStepSeconds);
+  const float t = step.time / kStepSeconds;
+  const float eased = t * t * (3.0f - 2.0f * t);
+  const float eased_rate = 6.0f * t * (1.0f - t) / kStepSeconds;
+  l.offset_[f] = step.from * (1.0f - eased);
+  l.offset_rate_[f] = -step.from * eased_rate;
+  l.yaw_offset_[f] = step.from_yaw * (1.0f - eased);
+  l.yaw_rate_[f] = -step.from_yaw * eased_rate;
+  step.lift = std::min(kMaxStepHeight, kStepHeightRatio * glm::length(step.from)) * std::sin(kPi * t);
+  if (step.time >= kStepSeconds) {
+    step = Step{};
+    l.offset_[f] = l.offset_rate_[f] = glm::vec3(0.0f);
+    l.yaw_offset_[f] = l.yaw_rate_[f] = 0.0f;
+    l.drifted_[f] = 0;
+  }
+}
+
 // The ankle's target: the animated foot turned by the yaw offset about its
 // contact point and moved by the offset, at its animated height (raised to
 // the floor when clamped).
@@ -462,6 +505,10 @@ FootLocker::Steps::FootTarget FootLocker::Steps::foot_target(FootLocker& l, std:
     const glm::quat turn = yaw_rotation(l.yaw_offset_[f]);
     target.ankle = contact + l.offset_[f] + turn * (foot.ankle - contact);
     target.rotation = turn * global[leg.foot];
+    target.solve = true;
+  }
+  if (l.steps_[f].lift > 0.0f) {
+    target.ankle.y += l.steps_[f].lift;
     target.solve = true;
   }
   if (l.params_.clamp_to_floor) {

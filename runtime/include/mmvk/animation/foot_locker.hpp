@@ -139,6 +139,14 @@ class FootLocker {
   // controller's place()). Its next update locks planted feet afresh.
   void reset(std::uint32_t b);
 
+  // Character b's foot `side` (0 left, 1 right) steps onto its animated
+  // pose: its lock is released, and over the next 0.3 s its correction eases
+  // to zero with the foot lifted on an arc (a quarter of the distance, at
+  // most 6 cm), whatever the contacts say; then a planted foot locks where
+  // it landed. For a character that rests on a held frame with a foot still
+  // where it planted mid-stride. No effect while that foot steps already.
+  void step(std::uint32_t b, std::size_t side);
+
   std::uint32_t size() const { return characters_; }
   const FootIkParams& params() const { return params_; }
   // New parameters between ticks (not during updates), e.g. IK switched on
@@ -152,6 +160,8 @@ class FootLocker {
   std::span<const std::uint8_t> reach_clamped() const { return clamped_; }  // 1: the ankle missed its target this tick
   std::span<const glm::vec3> corrections() const { return offset_; }     // c, world metres (y = 0)
   std::span<const float> yaw_corrections() const { return yaw_offset_; }  // psi, radians
+  // 1 while the foot steps (step()).
+  bool stepping(std::uint32_t b, std::size_t side) const { return steps_[std::size_t{b} * 2 + side].time >= 0.0f; }
   // Per character [B]: how far the hips are lowered (metres, >= 0).
   std::span<const float> hip_drops() const { return hip_drop_; }
 
@@ -188,6 +198,15 @@ class FootLocker {
   std::vector<glm::vec3> anchor_, offset_, offset_rate_;
   std::vector<glm::vec3> knee_direction_;  // the knee's kept bend direction, character space (zero: none yet)
   std::vector<float> anchor_yaw_, yaw_offset_, yaw_rate_;
+  // A foot's step (step()): seconds into it (negative: none), this
+  // update's lift (metres), and the corrections it started from.
+  struct Step {
+    float time = -1.0f;
+    float lift = 0.0f;
+    float from_yaw = 0.0f;
+    glm::vec3 from{0.0f};
+  };
+  std::vector<Step> steps_;
   // Per character [B].
   std::vector<float> hip_drop_, hip_drop_rate_, hip_goal_;  // hip_goal_: the last tick's wanted drop
 };

@@ -153,6 +153,47 @@ TEST(CrowdGaitChoice, DataWithoutAnIdleRestsOnAHeldFrame) {
   fs::remove_all(dir);
 }
 
+TEST(CrowdGaitChoice, AtRestTheFeetStepOntoTheHeldPose) {
+  // Bandai locomotion (no idle): a character stopped from a walk rests
+  // on a held frame; a foot locked where it planted mid-stride steps onto
+  // that pose, so once it has settled every locked foot is within 11 cm of
+  // its pose (the lock's correction; held, they were 27-37 cm off), and the
+  // feet stand side by side rather than a stride apart. Stopped from a run,
+  // it rests on the same frame: the run's own double supports are wide.
+  MMVK_REQUIRE_DATA_DIR(data);
+  const Database db = open(data / "bandai-namco-nc/locomotion-normal");
+  ASSERT_FALSE(measure_gait_coverage(db).can_stand());
+  const std::unique_ptr<CrowdSession> s = session(db);
+  ASSERT_TRUE(s);
+  const CrowdController& c = s->controller();
+  const auto toes = c.animation().contact_joints;
+  const std::size_t joints = c.animation().joint_count();
+  // The toes' distance along the facing, of the pose shown or the pose held.
+  const auto spread = [&](std::span<const glm::vec3> world, std::uint32_t b) {
+    const glm::vec3 apart = world[b * joints + std::size_t(toes[0])] - world[b * joints + std::size_t(toes[1])];
+    const float yaw = c.root_yaws()[b];
+    return std::abs(apart.x * std::sin(yaw) + apart.z * std::cos(yaw));
+  };
+  for (const float speed : {1.3f, 3.0f}) {
+    SCOPED_TRACE(speed);
+    drive(*s, speed, 3.0, 0.0, [](std::uint32_t) {});
+    float farthest = 0.0f, widest = 0.0f, widest_held = 0.0f;
+    const double still = drive(*s, 0.0f, 3.0, 1.5, [&](std::uint32_t b) {
+      EXPECT_EQ(c.resting()[b], 1);
+      for (std::size_t f = b * 2; f < b * 2 + 2; ++f) {
+        if (c.foot_locked()[f]) farthest = std::max(farthest, glm::length(c.foot_corrections()[f]));
+      }
+      widest = std::max(widest, spread(c.world_positions(), b));
+      widest_held = std::max(widest_held, spread(c.animated_world_positions(), b));
+    });
+    EXPECT_GE(still, 0.9);
+    EXPECT_LE(farthest, 0.11f);
+    // The run clips' slowest double supports are 0.5 m wide: it rests on the walk's.
+    EXPECT_LT(widest_held, 0.3f) << "the frame held has its feet side by side, not a stride (0.5-0.7 m) apart";
+    EXPECT_LT(widest, 0.3f) << "and so do the feet shown";
+  }
+}
+
 TEST(CrowdGaitChoice, AHostsOwnGaitTagIsLeftAlone) {
   const Database db = open(shipped("cmu16") / "manifest.json");
   const std::unique_ptr<CrowdSession> s = session(db);

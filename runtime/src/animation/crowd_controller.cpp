@@ -251,6 +251,10 @@ std::span<const glm::vec3> CrowdController::foot_anchors() const {
   return locker_ ? locker_->anchors() : std::span<const glm::vec3>(no_feet_anchors_);
 }
 
+std::span<const glm::vec3> CrowdController::foot_corrections() const {
+  return locker_ ? locker_->corrections() : std::span<const glm::vec3>(no_feet_anchors_);  // zeros
+}
+
 std::span<const std::uint8_t> CrowdController::ik_reach_clamped() const {
   return locker_ ? locker_->reach_clamped() : std::span<const std::uint8_t>(no_feet_flags_);
 }

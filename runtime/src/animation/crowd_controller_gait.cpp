@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "mmvk/animation/crowd_controller.hpp"
+#include "mmvk/animation/foot_locker.hpp"
 #include "mmvk/animation/playback.hpp"
 #include "mmvk/features/foot_contacts.hpp"
 #include "mmvk/search/search.hpp"
@@ -113,6 +114,30 @@ bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratc
   const bool stands = (database_->frame_tags()[frame] & gaits_.bits.bit[std::size_t(GaitBand::Stand)]) != 0;
   holding = !clip.loop && stands && (animation_->contacts[frame] & kBothFeet) == kBothFeet ? 1 : 0;
   return holding != 0 && settle();
+}
+
+void CrowdController::settle_feet(std::uint32_t b) {
+  // Held where it planted mid-stride, a foot would stay a stride from the
+  // standing pose (legs stretched, hips lowered) for as long as the
+  // character stands: such a foot steps onto its pose (FootLocker::step),
+  // one foot at a time and the farther first. The foot it lifts is shown
+  // off the ground. The distance is just above the 10 cm a planted toe may
+  // be off its pose, so that a foot near it stays put and the stand still.
+  constexpr float kStepDistance = 0.11f;  // metres
+  if (!locker_ || !gaits_.enabled || gaits_.state[b].phase != GaitPhase::Stand) return;
+  const auto off_pose = [&](std::size_t side) {
+    const glm::vec3& c = locker_->corrections()[std::size_t{b} * 2 + side];
+    return locker_->locked()[std::size_t{b} * 2 + side] != 0 ? std::hypot(c.x, c.z) : 0.0f;
+  };
+  if (!locker_->stepping(b, 0) && !locker_->stepping(b, 1)) {
+    const std::size_t farther = off_pose(1) > off_pose(0) ? 1 : 0;
+    if (off_pose(farther) > kStepDistance) locker_->step(b, farther);
+  }
+  for (std::size_t side = 0; side < 2; ++side) {
+    if (!locker_->stepping(b, side)) continue;
+    const int s = int(side);
+    playback_.contacts[b] &= std::uint8_t(~(contact_planted_bit(s) | contact_heel_bit(s) | contact_toe_bit(s)));
+  }
 }
 
 }  // namespace mmvk

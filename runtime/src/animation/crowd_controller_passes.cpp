@@ -339,6 +339,7 @@ void CrowdController::display(std::uint32_t b, float dt) {
   const std::span<const glm::vec3> animated(poses_.animated_world.data() + base, joints_);
   const std::span<glm::vec3> world(poses_.world.data() + base, joints_);
   if (locker_) {
+    settle_feet(b);
     locker_->update(b, dt, playback_.contacts[b], roots_.position[b], roots_.yaw[b], animated,
                     std::span(poses_.rotations).subspan(base, joints_),
                     std::span(poses_.translations).subspan(base, joints_), world);

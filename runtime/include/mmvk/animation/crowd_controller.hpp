@@ -273,9 +273,12 @@ class CrowdController {
   // Foot locking (ControllerParams::foot_ik), per character and foot
   // (left, right), [B x 2]: 1 while the foot is held where it was planted;
   // the world position it is held at (metres); 1 when the leg could not
-  // reach its target this tick and was soft-clamped. All 0 with foot IK off.
+  // reach its target this tick and was soft-clamped; how far the displayed
+  // foot is held from its animated pose (the lock's correction, world metres,
+  // y = 0). All 0 with foot IK off.
   std::span<const std::uint8_t> foot_locked() const;
   std::span<const glm::vec3> foot_anchors() const;
+  std::span<const glm::vec3> foot_corrections() const;
   std::span<const std::uint8_t> ik_reach_clamped() const;
   // The locker itself (hip drops, corrections), or null with foot IK off
   // on a skeleton without legs.
@@ -413,6 +416,9 @@ class CrowdController {
   // jumps to its rest frame and holds it. Returns whether b holds a frame
   // (plays at rate 0).
   bool choose_gait(std::size_t b, float dt, ThreadScratch& scratch);
+  // A standing b's foot locked far from where its pose puts it steps there;
+  // the contacts shown lose a stepping foot's bits.
+  void settle_feet(std::uint32_t b);
   // The one forward kinematics of b's animated pose, and the velocities of
   // the joints queries read; `fresh`: no previous tick.
   void measure(std::uint32_t b, float dt, bool fresh);

@@ -186,6 +186,9 @@ class Crowd:
     def foot_locked(self) -> npt.NDArray[np.uint8]:
         """[agents x 2] (left, right)."""
     @property
+    def foot_corrections(self) -> FloatArray:
+        """[agents x 2 x 3] how far each displayed foot is held from its animated pose, world metres (y = 0)."""
+    @property
     def play_rates(self) -> FloatArray:
         """[agents] clip seconds per second in the last step."""
     stride_scales: FloatArray  # read-only: [agents] the root motion's scale in the last step

@@ -16,7 +16,11 @@ every character's shown speed over the last 0.5 s is within 10% of the
 command (a stand: under 5 cm/s) and its heading within 10 degrees; for a
 stand, the mean distance the shown root travelled from the command
 (stop_travel_m) against the simulated root's (spring_travel_m: the spring's
-own overshoot), and where it came to rest against it (rest_offset_m).
+own overshoot), and where it came to rest against it (rest_offset_m). The
+planted feet's distance from the animated pose (foot_corrections of locked
+feet): p95 over the whole run (planted_offset_p95_m) and, per stand, over
+its held part (rest_planted_offset_p95_m); null with a module that lacks
+foot_corrections.
 
   PYTHONPATH=build/python python3 bench/tools/command_script.py DATA [--rate 30] [--speed-from-animation off]
       [--correction-half-life S]
@@ -56,6 +60,8 @@ def main():
     for i in range(AGENTS):
         crowd.place(i, 4.0 * i, 0.0, 0.0)
     has_corrections = hasattr(crowd, "root_corrections")
+    has_foot_corrections = hasattr(crowd, "foot_corrections")
+    planted_offsets = []  # per tick, the locked feet's distances from their animated pose
     toes = [j for j in db.animation.contact_joints if j >= 0]
     segments = []
     last = crowd.root_positions.copy()
@@ -71,6 +77,7 @@ def main():
         # overshoot is the latter), and where the shown root comes to rest against the simulated one.
         start_shown, start_simulated = crowd.root_positions.copy(), crowd.simulated_positions.copy()
         recent = []
+        rest_offsets = []
         following = []  # per tick: the mean shown speed within 10% (stops: under 5 cm/s) and heading within 10 degrees
         for tick in range(ticks):
             crowd.step(velocity, facing)
@@ -79,6 +86,11 @@ def main():
             toe_positions = crowd.joint_positions[:, toes]
             toe_speed = np.linalg.norm(toe_positions - last_toes, axis=2).max(axis=1) / crowd.dt
             last_toes = toe_positions.copy()
+            if has_foot_corrections:
+                offsets = np.hypot(crowd.foot_corrections[..., 0], crowd.foot_corrections[..., 2])[crowd.foot_locked == 1]
+                planted_offsets.append(offsets)
+                if speed == 0.0 and tick * crowd.dt >= SETTLE_S:
+                    rest_offsets.append(offsets)
             recent.append(step)
             window = recent[-int(round(WINDOW_S * crowd.rate)):]
             shown_speed = np.sum(window, axis=0) / (len(window) * crowd.dt)
@@ -104,7 +116,8 @@ def main():
             flat = lambda p: p[:, [0, 2]]
             stop = {"stop_travel_m": round(float(np.linalg.norm(flat(crowd.root_positions - start_shown), axis=1).mean()), 3),
                     "spring_travel_m": round(float(np.linalg.norm(flat(crowd.simulated_positions - start_simulated), axis=1).mean()), 3),
-                    "rest_offset_m": round(float(np.linalg.norm(flat(crowd.root_positions - crowd.simulated_positions), axis=1).mean()), 3)}
+                    "rest_offset_m": round(float(np.linalg.norm(flat(crowd.root_positions - crowd.simulated_positions), axis=1).mean()), 3),
+                    "rest_planted_offset_p95_m": p95(rest_offsets) if has_foot_corrections else None}
         segments.append({"speed_mps": speed, "heading_deg": heading, **stop,
                          "settle_s": None if settled is None else round(settled * crowd.dt, 2),
                          "still_share": round(still / steady, 3) if steady else None,
@@ -115,7 +128,15 @@ def main():
             "transitions_per_agent_s", "glide_cm_s", "glide_share_of_travel", "animation_share_of_travel",
             "played_speed_error", "shown_speed_error", "heading_error_deg", "standing_still_share", "chosen_frames_hash"]
     print(json.dumps({"data": args.data, "rate": args.rate, "speed_from_animation": args.speed_from_animation,
-                      "summary": {k: s.get(k) for k in keys}, "segments": segments}))
+                      "summary": {k: s.get(k) for k in keys},
+                      "planted_offset_p95_m": p95(planted_offsets) if has_foot_corrections else None,
+                      "segments": segments}))
+
+
+def p95(per_tick):
+    """The 95th percentile of the distances in a list of per-tick arrays, metres (null when none)."""
+    values = np.concatenate(per_tick) if per_tick else np.zeros(0)
+    return round(float(np.percentile(values, 95)), 3) if values.size else None
 
 
 if __name__ == "__main__":

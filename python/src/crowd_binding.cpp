@@ -475,6 +475,14 @@ void add_state_arrays(py::class_<PyCrowd>& crowd) {
           },
           "1 while a foot (left, right) is held where it was planted, uint8 [agents x 2].")
       .def_property_readonly(
+          "foot_corrections",
+          [](const PyCrowd& c) {
+            return vec3_array(c.session()->controller().foot_corrections(), {py::ssize_t(c.agents()), 2, 3});
+          },
+          "How far each displayed foot (left, right) is held from its animated pose after the last step: the "
+          "foot lock's horizontal correction, world metres, float32 [agents x 2 x 3] (y = 0; zeros with foot IK "
+          "off).")
+      .def_property_readonly(
           "joint_positions",
           [](const PyCrowd& c) { return per_joint_array(c.session()->world_positions(), c.agents()); },
           "The displayed global joint positions after the last step (foot IK included), float32 [agents x joints "

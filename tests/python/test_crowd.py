@@ -273,6 +273,12 @@ def test_told_to_stand_the_characters_stand_still_on_their_own_choice(db):
     assert np.all(crowd.gaits == [0, 0]), crowd.gaits
     assert still / ticks >= 0.9, still / ticks
     assert crowd.summary()["standing_still_share"] >= 0.9
+    # Standing, the locked feet are on (or stepped onto) the standing pose.
+    corrections = crowd.foot_corrections
+    assert corrections.shape == (4, 2, 3) and corrections.dtype == np.float32
+    assert np.all(corrections[..., 1] == 0.0)
+    off_pose = np.hypot(corrections[..., 0], corrections[..., 2])[crowd.foot_locked == 1]
+    assert off_pose.size > 0 and np.all(off_pose <= 0.11), off_pose
     for _ in range(60):
         crowd.step(walk)
     assert np.all(crowd.gaits[:, 0] == 1) and np.all(crowd.resting == 0)

@@ -22,6 +22,23 @@ constexpr std::uint32_t kNoEntry = std::numeric_limits<std::uint32_t>::max();
 
 float horizontal_speed(const glm::vec3& v) { return std::sqrt(v.x * v.x + v.z * v.z); }
 
+bool both_feet_down(const AnimationData& animation, std::uint32_t frame) {
+  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
+  return (animation.contacts[frame] & kBothFeet) == kBothFeet;
+}
+
+// Whether the standing frames of `frame`'s clip from `frame` on (tagged
+// `stand`) end, with the clip or in a frame that moves, without one that
+// has both feet down.
+bool steps_off_standing(const Database& database, TagMask stand, std::uint32_t frame) {
+  const Clip& clip = database.clips()[database.frame_clip()[frame]];
+  for (std::uint32_t f = frame; f < clip.first_frame + clip.frame_count && (database.frame_tags()[f] & stand) != 0;
+       ++f) {
+    if (both_feet_down(*database.animation(), f)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void CrowdController::start_gaits() {
@@ -97,23 +114,30 @@ bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratc
     return true;
   };
   const std::uint32_t frame = playback_.frames[b];
-  const Clip& clip = database_->clips()[database_->frame_clip()[frame]];
-  if (constraint.rest) {
-    // No idle: the rest frame of the clip it plays, blended into by the
-    // inertialization as any jump is, then held (its feet locked).
-    const std::uint32_t rest = entry.rest_frames[database_->frame_clip()[frame]];
-    if (rest == kNoFrame) return false;
-    if (rest != frame) jump(static_cast<std::uint32_t>(b), rest, scratch);
+  const std::uint32_t clip = database_->frame_clip()[frame];
+  // The rest frame of the clip it plays, blended into by the
+  // inertialization as any jump is, then held (its feet locked).
+  const auto rest = [&] {
+    const std::uint32_t to = entry.rest_frames[clip];
+    if (to == kNoFrame) return false;
+    if (to != frame) jump(static_cast<std::uint32_t>(b), to, scratch);
+    holding = 1;
+    return settle();
+  };
+  if (constraint.rest) return rest();  // no idle
+  // Standing frames of a clip that goes on (a walk's first steps, a stop's
+  // end) are held once both feet are down: played on they would shift
+  // weight and step off, and each search would cut that short. One whose
+  // standing frames step off before both feet are down (a weight shift
+  // into a start) would never be held: each search would pick another,
+  // and the character shuffle. It rests instead.
+  const TagMask stand = gaits_.bits.bit[std::size_t(GaitBand::Stand)];
+  if (database_->clips()[clip].loop || (database_->frame_tags()[frame] & stand) == 0) return false;
+  if (both_feet_down(*animation_, frame)) {
     holding = 1;
     return settle();
   }
-  // Standing frames of a clip that goes on (a walk's first steps, a stop's
-  // end) are held once both feet are down: played on they would shift
-  // weight and step off, and each search would cut that short.
-  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
-  const bool stands = (database_->frame_tags()[frame] & gaits_.bits.bit[std::size_t(GaitBand::Stand)]) != 0;
-  holding = !clip.loop && stands && (animation_->contacts[frame] & kBothFeet) == kBothFeet ? 1 : 0;
-  return holding != 0 && settle();
+  return steps_off_standing(*database_, stand, frame) && rest();
 }
 
 void CrowdController::settle_feet(std::uint32_t b) {

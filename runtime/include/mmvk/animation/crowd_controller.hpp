@@ -234,7 +234,9 @@ class CrowdController {
   std::span<const SearchKind> searched() const { return schedule_.searched; }       // this tick's search of each
   std::span<const std::uint8_t> jumped() const { return outcome_.jumped; }          // 1: jumped this tick
   std::span<const float> match_costs() const { return outcome_.match_cost; }        // last applied match (inf: none)
-  std::span<const std::uint8_t> contacts() const { return playback_.contacts; }     // FootContact bits of the nearest frame
+  // FootContact bits of the nearest frame, less those of a foot that steps
+  // (a standing character's, settle_feet), [B].
+  std::span<const std::uint8_t> contacts() const { return playback_.contacts; }
   // The gait each character was commanded into this tick and the tag
   // constraint its searches get (ControllerParams::choose_gait; empty
   // constraints where it does not apply), and 1 while, told to stand, it

@@ -140,11 +140,12 @@ class FootLocker {
   void reset(std::uint32_t b);
 
   // Character b's foot `side` (0 left, 1 right) steps onto its animated
-  // pose: its lock is released, and over the next 0.3 s its correction eases
-  // to zero with the foot lifted on an arc (a quarter of the distance, at
-  // most 6 cm), whatever the contacts say; then a planted foot locks where
-  // it landed. For a character that rests on a held frame with a foot still
-  // where it planted mid-stride. No effect while that foot steps already.
+  // pose: its lock is released, and over the next 0.25 s its correction
+  // eases to zero with the foot lifted on an arc (a quarter of the
+  // distance, at most 6 cm), whatever the contacts say; then a planted foot
+  // locks where it landed. For a standing character with a foot still
+  // locked where it planted mid-stride. No effect while that foot steps
+  // already.
   void step(std::uint32_t b, std::size_t side);
 
   std::uint32_t size() const { return characters_; }
@@ -160,7 +161,7 @@ class FootLocker {
   std::span<const std::uint8_t> reach_clamped() const { return clamped_; }  // 1: the ankle missed its target this tick
   std::span<const glm::vec3> corrections() const { return offset_; }     // c, world metres (y = 0)
   std::span<const float> yaw_corrections() const { return yaw_offset_; }  // psi, radians
-  // 1 while the foot steps (step()).
+  // True while the foot steps (step()).
   bool stepping(std::uint32_t b, std::size_t side) const { return steps_[std::size_t{b} * 2 + side].time >= 0.0f; }
   // Per character [B]: how far the hips are lowered (metres, >= 0).
   std::span<const float> hip_drops() const { return hip_drop_; }

@@ -87,7 +87,8 @@ def main():
             toe_speed = np.linalg.norm(toe_positions - last_toes, axis=2).max(axis=1) / crowd.dt
             last_toes = toe_positions.copy()
             if has_foot_corrections:
-                offsets = np.hypot(crowd.foot_corrections[..., 0], crowd.foot_corrections[..., 2])[crowd.foot_locked == 1]
+                corrections = crowd.foot_corrections
+                offsets = np.hypot(corrections[..., 0], corrections[..., 2])[crowd.foot_locked == 1]
                 planted_offsets.append(offsets)
                 if speed == 0.0 and tick * crowd.dt >= SETTLE_S:
                     rest_offsets.append(offsets)

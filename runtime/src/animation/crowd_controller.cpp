@@ -129,7 +129,7 @@ void CrowdController::size_state(std::uint32_t characters) {
   poses_.joint_velocities.assign(n * velocity_joints, glm::vec3(0.0f));
   poses_.fresh.assign(n, 1);
   no_feet_flags_.assign(2 * n, 0);
-  no_feet_anchors_.assign(2 * n, glm::vec3(0.0f));
+  no_feet_vectors_.assign(2 * n, glm::vec3(0.0f));
   for (auto* v : {&batch_.characters, &batch_.continuing, &in_flight_.characters, &in_flight_.continuing,
                   &applied_.characters}) {
     v->resize(n);
@@ -248,11 +248,11 @@ std::span<const std::uint8_t> CrowdController::foot_locked() const {
 }
 
 std::span<const glm::vec3> CrowdController::foot_anchors() const {
-  return locker_ ? locker_->anchors() : std::span<const glm::vec3>(no_feet_anchors_);
+  return locker_ ? locker_->anchors() : std::span<const glm::vec3>(no_feet_vectors_);
 }
 
 std::span<const glm::vec3> CrowdController::foot_corrections() const {
-  return locker_ ? locker_->corrections() : std::span<const glm::vec3>(no_feet_anchors_);  // zeros
+  return locker_ ? locker_->corrections() : std::span<const glm::vec3>(no_feet_vectors_);
 }
 
 std::span<const std::uint8_t> CrowdController::ik_reach_clamped() const {

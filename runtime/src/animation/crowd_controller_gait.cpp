@@ -22,11 +22,6 @@ constexpr std::uint32_t kNoEntry = std::numeric_limits<std::uint32_t>::max();
 
 float horizontal_speed(const glm::vec3& v) { return std::sqrt(v.x * v.x + v.z * v.z); }
 
-bool both_feet_down(const AnimationData& animation, std::uint32_t frame) {
-  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
-  return (animation.contacts[frame] & kBothFeet) == kBothFeet;
-}
-
 // Whether the standing frames of `frame`'s clip from `frame` on (tagged
 // `stand`) end, with the clip or in a frame that moves, without one that
 // has both feet down.
@@ -34,7 +29,7 @@ bool steps_off_standing(const Database& database, TagMask stand, std::uint32_t f
   const Clip& clip = database.clips()[database.frame_clip()[frame]];
   for (std::uint32_t f = frame; f < clip.first_frame + clip.frame_count && (database.frame_tags()[f] & stand) != 0;
        ++f) {
-    if (both_feet_down(*database.animation(), f)) return false;
+    if (both_feet_planted(database.animation()->contacts[f])) return false;
   }
   return true;
 }
@@ -133,7 +128,7 @@ bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratc
   // and the character shuffle. It rests instead.
   const TagMask stand = gaits_.bits.bit[std::size_t(GaitBand::Stand)];
   if (database_->clips()[clip].loop || (database_->frame_tags()[frame] & stand) == 0) return false;
-  if (both_feet_down(*animation_, frame)) {
+  if (both_feet_planted(animation_->contacts[frame])) {
     holding = 1;
     return settle();
   }

@@ -10,7 +10,6 @@ namespace mmvk::detail {
 std::vector<std::uint32_t> find_rest_frames(const Database& database, std::span<const float> stride_speeds,
                                             TagMask require, TagMask exclude) {
   const AnimationData& animation = *database.animation();
-  constexpr std::uint8_t kBothFeet = kContactLeft | kContactRight;
   constexpr float kNoBothFeet = 1e6f;  // ranks a frame without both feet down after every one with them
   constexpr float kUnranked = std::numeric_limits<float>::infinity();
   // What a search with these masks could jump to (no continuing frame).
@@ -25,7 +24,7 @@ std::vector<std::uint32_t> find_rest_frames(const Database& database, std::span<
     const Clip& clip = database.clips()[c];
     for (std::uint32_t f = clip.first_frame; f < clip.first_frame + clip.frame_count; ++f) {
       if (!is_candidate(database, f, allowed)) continue;
-      const bool both_feet = (animation.contacts[f] & kBothFeet) == kBothFeet;
+      const bool both_feet = both_feet_planted(animation.contacts[f]);
       const float rank = stride_speeds[f] + (both_feet ? 0.0f : kNoBothFeet);
       if (both_feet && rank < clip_ranks[c]) {
         clip_ranks[c] = rank;

@@ -83,7 +83,6 @@ GaitCoverage measure_gait_coverage(const Database& database, TagMask require_all
   const Candidates candidate{database, require_all, exclude_any};
   const AnimationData* animation = database.animation();
   coverage.has_contacts = animation != nullptr && !animation->contacts.empty();
-  const std::uint8_t both_feet = kContactLeft | kContactRight;
   for (std::uint32_t f = 0; f < database.frame_count(); ++f) {
     if (!candidate(f)) continue;
     const TagMask tags = database.frame_tags()[f];
@@ -91,7 +90,7 @@ GaitCoverage measure_gait_coverage(const Database& database, TagMask require_all
     coverage.start_frames += (tags & bits[kGaitStartTag]) != 0;
     coverage.stop_frames += (tags & bits[kGaitStopTag]) != 0;
     const bool stands = (tags & bits[std::size_t(GaitBand::Stand)]) != 0;
-    if (stands && coverage.has_contacts && (animation->contacts[f] & both_feet) == both_feet) {
+    if (stands && coverage.has_contacts && both_feet_planted(animation->contacts[f])) {
       ++coverage.stand_both_feet_frames;
     }
   }

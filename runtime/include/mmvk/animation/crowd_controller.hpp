@@ -460,7 +460,7 @@ class CrowdController {
   Applied applied_;
   std::optional<FootLocker> locker_;
   std::vector<std::uint8_t> no_feet_flags_;  // [B x 2] zeros, without a locker
-  std::vector<glm::vec3> no_feet_anchors_;   // [B x 2]
+  std::vector<glm::vec3> no_feet_vectors_;   // [B x 2] zeros: anchors and corrections without foot IK
   std::vector<ThreadScratch> scratch_;
 };
 

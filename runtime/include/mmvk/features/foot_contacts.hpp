@@ -34,6 +34,10 @@ inline constexpr std::uint8_t kContactAllBits = 0x3F;
 constexpr std::uint8_t contact_planted_bit(int side) { return side == 0 ? kContactLeft : kContactRight; }
 constexpr std::uint8_t contact_heel_bit(int side) { return side == 0 ? kContactLeftHeel : kContactRightHeel; }
 constexpr std::uint8_t contact_toe_bit(int side) { return side == 0 ? kContactLeftToe : kContactRightToe; }
+// Both feet planted (a double support, or standing).
+constexpr bool both_feet_planted(std::uint8_t bits) {
+  return (bits & (kContactLeft | kContactRight)) == (kContactLeft | kContactRight);
+}
 // The bits with left and right exchanged (a mirrored motion's contacts):
 // the planted bits sit side by side, the heel and toe pairs two apart.
 constexpr std::uint8_t mirror_contact_bits(std::uint8_t bits) {

@@ -191,7 +191,7 @@ class Crowd:
     @property
     def play_rates(self) -> FloatArray:
         """[agents] clip seconds per second in the last step."""
-    stride_scales: FloatArray  # read-only: [agents] the root motion's scale in the last step
+    stride_scales: FloatArray  # read-only: [agents] the root motion's scale in the last step (0: standing in place)
     root_corrections: FloatArray  # read-only: [agents x 3] the last step's root correction (the glide), metres
     @property
     def joint_positions(self) -> FloatArray:

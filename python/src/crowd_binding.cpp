@@ -599,7 +599,8 @@ void add_speed_arrays(py::class_<PyCrowd>& crowd) {
                     "The rate each character played its clip at in the last step (clip seconds per second), "
                     "float32 [agents].");
   add_per_character(crowd, "stride_scales", &CrowdController::stride_scales,
-                    "The scale of each character's root motion in the last step, float32 [agents].");
+                    "The scale of each character's root motion in the last step (0: a standing frame played in place "
+                    "while told to stand), float32 [agents].");
   crowd.def_property_readonly(
       "root_corrections",
       [](const PyCrowd& c) {

@@ -110,6 +110,34 @@ TEST(CrowdGaitChoice, ToldToStandTheyStandStillOnStandingFrames) {
   }
 }
 
+TEST(CrowdGaitChoice, ToldToStandAStandingLoopPlaysInPlace) {
+  // The default data's standing loop (CMU 16) creeps on about 4 cm/s: played
+  // with its root motion, a character placed and told to stand crept off its
+  // spot until the correction pulled it back, over and over (2.3 cm of root
+  // path per second; 83% of such a stand's ticks still at 60 Hz).
+  const Database db = open(shipped("cmu16") / "manifest.json");
+  const std::unique_ptr<CrowdSession> s = session(db);
+  ASSERT_TRUE(s);
+  const CrowdController& c = s->controller();
+  const TagMask stand = tag(db, "gait:stand");
+  drive(*s, 0.0f, 2.0, 0.0, [](std::uint32_t) {});
+  std::vector<glm::vec3> last(c.root_positions().begin(), c.root_positions().end());
+  std::vector<float> path(kAgents, 0.0f);
+  constexpr double kMeasured = 2.0;
+  std::size_t played = 0;
+  drive(*s, 0.0f, kMeasured, kMeasured, [&](std::uint32_t b) {
+    const glm::vec3 step = c.root_positions()[b] - last[b];
+    path[b] += std::hypot(step.x, step.z);
+    last[b] = c.root_positions()[b];
+    // A held frame (play rate 0) does not move either.
+    if ((db.frame_tags()[c.frames()[b]] & stand) == 0 || c.play_rates()[b] == 0.0f) return;
+    ++played;
+    EXPECT_EQ(c.stride_scales()[b], 0.0f) << "a standing frame told to stand plays in place";
+  });
+  EXPECT_GT(played, 0u) << "the stand plays the standing loop";
+  for (std::uint32_t b = 0; b < kAgents; ++b) EXPECT_LT(path[b] / kMeasured, 0.005) << "character " << b;
+}
+
 TEST(CrowdGaitChoice, AGaitChangeAtRuntimeFollowsTheCommand) {
   const Database db = open(shipped("cmu16") / "manifest.json");
   const std::unique_ptr<CrowdSession> s = session(db);

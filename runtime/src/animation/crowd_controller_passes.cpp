@@ -70,7 +70,8 @@ void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, floa
     const glm::vec3 v = roots_.simulated[b].velocity;
     const float target = std::sqrt(v.x * v.x + v.z * v.z);
     const float stride_speed = stride_speeds_[nearest_frame(database, before)];
-    detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target);
+    const float commanded = std::sqrt(desired.x * desired.x + desired.z * desired.z);
+    detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target, commanded);
     // A character placed since the last tick holds its frame until its
     // first search has chosen what it plays: moving on a frame it was only
     // placed on would give the jump a velocity that nothing commanded.

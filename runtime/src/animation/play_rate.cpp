@@ -31,9 +31,13 @@ std::vector<float> stride_speeds(const Database& database, float stride_window) 
   return speeds;
 }
 
-SpeedScale speed_scale(const ControllerParams& params, float stride_speed, float target_speed) {
+SpeedScale speed_scale(const ControllerParams& params, float stride_speed, float target_speed,
+                       float commanded_speed) {
   SpeedScale scale;
-  if (!(stride_speed >= kStandingSpeed)) return scale;
+  if (!(stride_speed >= kStandingSpeed)) {
+    if (!(commanded_speed >= kStandingSpeed)) scale.stride_scale = 0.0f;
+    return scale;
+  }
   const float wanted = target_speed / stride_speed;
   scale.play_rate = std::clamp(wanted, params.min_play_rate, params.max_play_rate);
   scale.stride_scale = std::clamp(wanted / scale.play_rate, params.min_stride_scale, params.max_stride_scale);

@@ -30,9 +30,14 @@ struct SpeedScale {
 
 // The play rate that brings `stride_speed` toward `target_speed` (m/s),
 // within [min_play_rate, max_play_rate], then the stride scale for what is
-// left, within [min_stride_scale, max_stride_scale]. 1 and 1 on a standing
-// frame (stride_speed < kStandingSpeed).
-SpeedScale speed_scale(const ControllerParams& params, float stride_speed, float target_speed);
+// left, within [min_stride_scale, max_stride_scale]. On a standing frame
+// (stride_speed < kStandingSpeed) the rate is 1, and so is the stride scale
+// unless the command is to stand (`commanded_speed` < kStandingSpeed): then
+// 0, the frame plays in place. A standing loop's root drifts (the default
+// data's CMU loop creeps on about 4 cm/s), and a character told to stand
+// should neither creep off the spot it stopped on nor glide back to it.
+SpeedScale speed_scale(const ControllerParams& params, float stride_speed, float target_speed,
+                       float commanded_speed);
 
 // The checks of ControllerParams' play-rate, stride and correction-ratio
 // fields: each finite, positive where it must be, each pair of bounds

@@ -118,7 +118,10 @@ struct ControllerParams {
   // made up by stride warping: the played root motion is scaled, within
   // [min_stride_scale, max_stride_scale] (planted feet are held by the foot
   // locker meanwhile). A standing frame (stride speed under 0.1 m/s) plays
-  // at rate 1, unwarped. All four 1: the data's own speeds. Each bound
+  // at rate 1, unwarped, and in place (stride scale 0) while the command
+  // is to stand: a standing loop's root drift does not move a character
+  // told to stand. All four 1: the data's own speeds (still in place when
+  // told to stand). Each bound
   // finite and > 0, each pair ordered.
   float min_play_rate = 0.75f;
   float max_play_rate = 1.3f;

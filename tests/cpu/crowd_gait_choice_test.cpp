@@ -248,6 +248,28 @@ TEST(CrowdGaitChoice, AtRestTheFeetStepOntoTheHeldPose) {
   }
 }
 
+TEST(CrowdGaitChoice, MovingAFootHeldFarOffItsPoseStepsOntoIt) {
+  // Bandai locomotion, walked at 1.3 m/s and turned 180 degrees: the jump
+  // into the turn blends the pose under a foot that has just locked, and the
+  // lock held it up to 41 cm off its pose (the leg stretched behind, across
+  // the other). A locked foot more than 10 cm off its pose steps onto it, so
+  // none is held much further (the last tick's motion before the step).
+  MMVK_REQUIRE_DATA_DIR(data);
+  const Database db = open(data / "bandai-namco-nc/locomotion-normal");
+  const std::unique_ptr<CrowdSession> s = session(db);
+  ASSERT_TRUE(s);
+  const CrowdController& c = s->controller();
+  drive(*s, 1.3f, 4.0, 0.0, [](std::uint32_t) {}, 90.0f);
+  float farthest = 0.0f;
+  drive(*s, 1.3f, 4.0, 4.0, [&](std::uint32_t b) {
+    for (std::size_t f = b * 2; f < b * 2 + 2; ++f) {
+      const glm::vec3 off = c.foot_corrections()[f];
+      if (c.foot_locked()[f]) farthest = std::max(farthest, std::hypot(off.x, off.z));
+    }
+  }, 270.0f);
+  EXPECT_LT(farthest, 0.15f);
+}
+
 TEST(CrowdGaitChoice, AHostsOwnGaitTagIsLeftAlone) {
   const Database db = open(shipped("cmu16") / "manifest.json");
   const std::unique_ptr<CrowdSession> s = session(db);

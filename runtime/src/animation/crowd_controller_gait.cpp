@@ -140,17 +140,25 @@ void CrowdController::settle_feet(std::uint32_t b) {
   // standing pose (legs stretched, hips lowered) for as long as the
   // character stands: such a foot steps onto its pose (FootLocker::step),
   // one foot at a time and the farther first. The foot it lifts is shown
-  // off the ground. The distance is just above the 10 cm a planted toe may
-  // be off its pose, so that a foot near it stays put and the stand still.
-  constexpr float kStepDistance = 0.11f;  // metres
-  if (!locker_ || !gaits_.enabled || gaits_.state[b].phase != GaitPhase::Stand) return;
+  // off the ground. Standing, the distance is just above the 10 cm a
+  // planted toe may be off its pose, so that a foot near it stays put and
+  // the stand still.
+  constexpr float kStandingStepDistance = 0.11f;  // metres
+  // Moving, a lock holds a foot off its pose when a jump's blend or the
+  // correction moves the pose under it (up to 41 cm in a 180-degree turn on
+  // Bandai: the leg stretched behind, across the other, sliding where it
+  // cannot reach); such a foot steps once it is 10 cm off.
+  constexpr float kMovingStepDistance = 0.10f;  // metres
+  if (!locker_) return;
+  const bool standing = gaits_.enabled && gaits_.state[b].phase == GaitPhase::Stand;
+  const float step_distance = standing ? kStandingStepDistance : kMovingStepDistance;
   const auto off_pose = [&](std::size_t side) {
     const glm::vec3& c = locker_->corrections()[std::size_t{b} * 2 + side];
     return locker_->locked()[std::size_t{b} * 2 + side] != 0 ? std::hypot(c.x, c.z) : 0.0f;
   };
   if (!locker_->stepping(b, 0) && !locker_->stepping(b, 1)) {
     const std::size_t farther = off_pose(1) > off_pose(0) ? 1 : 0;
-    if (off_pose(farther) > kStepDistance) locker_->step(b, farther);
+    if (off_pose(farther) > step_distance) locker_->step(b, farther);
   }
   for (std::size_t side = 0; side < 2; ++side) {
     if (!locker_->stepping(b, side)) continue;

@@ -238,7 +238,7 @@ class CrowdController {
   std::span<const std::uint8_t> jumped() const { return outcome_.jumped; }          // 1: jumped this tick
   std::span<const float> match_costs() const { return outcome_.match_cost; }        // last applied match (inf: none)
   // FootContact bits of the nearest frame, less those of a foot that steps
-  // (a standing character's, settle_feet), [B].
+  // (settle_feet), [B].
   std::span<const std::uint8_t> contacts() const { return playback_.contacts; }
   // The gait each character was commanded into this tick and the tag
   // constraint its searches get (ControllerParams::choose_gait; empty
@@ -421,8 +421,8 @@ class CrowdController {
   // jumps to its rest frame and holds it. Returns whether b holds a frame
   // (plays at rate 0).
   bool choose_gait(std::size_t b, float dt, ThreadScratch& scratch);
-  // A standing b's foot locked far from where its pose puts it steps there;
-  // the contacts shown lose a stepping foot's bits.
+  // b's foot locked far from where its pose puts it steps there (11 cm
+  // standing, 10 cm moving); the contacts shown lose a stepping foot's bits.
   void settle_feet(std::uint32_t b);
   // The one forward kinematics of b's animated pose, and the velocities of
   // the joints queries read; `fresh`: no previous tick.

@@ -1,8 +1,9 @@
 // The controller's gait from the command (ControllerParams::choose_gait), as
 // a host drives it through CrowdSession::step on the shipped data: told to
-// stand, characters stand still on standing frames; told to run, they leave
-// the walk; on data without an idle they rest on a held frame; a host's own
-// gait tag is left alone.
+// stand, characters stand still on standing frames, a standing loop played
+// in place; told to run, they leave the walk; on data without an idle they
+// rest on a held frame; a foot locked far off its pose steps onto it,
+// standing or moving; a host's own gait tag is left alone.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -121,8 +121,7 @@ struct ControllerParams {
   // at rate 1, unwarped, and in place (stride scale 0) while the command
   // is to stand: a standing loop's root drift does not move a character
   // told to stand. All four 1: the data's own speeds (still in place when
-  // told to stand). Each bound
-  // finite and > 0, each pair ordered.
+  // told to stand). Each bound finite and > 0, each pair ordered.
   float min_play_rate = 0.75f;
   float max_play_rate = 1.3f;
   float min_stride_scale = 0.85f;

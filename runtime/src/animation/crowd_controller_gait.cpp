@@ -9,6 +9,7 @@
 #include "mmvk/animation/playback.hpp"
 #include "mmvk/features/foot_contacts.hpp"
 #include "mmvk/search/search.hpp"
+#include "play_rate.hpp"
 #include "rest_frames.hpp"
 
 namespace mmvk {
@@ -19,8 +20,6 @@ namespace {
 // ever new tags) the entries start anew with only those in use.
 constexpr std::size_t kMaxGaitEntries = 256;
 constexpr std::uint32_t kNoEntry = std::numeric_limits<std::uint32_t>::max();
-
-float horizontal_speed(const glm::vec3& v) { return std::sqrt(v.x * v.x + v.z * v.z); }
 
 // Whether the standing frames of `frame`'s clip from `frame` on (tagged
 // `stand`) end, with the clip or in a frame that moves, without one that
@@ -80,8 +79,8 @@ void CrowdController::refresh_gait_options() {
 
 bool CrowdController::choose_gait(std::size_t b, float dt, ThreadScratch& scratch) {
   if (!gaits_.enabled) return false;
-  const float commanded = horizontal_speed(schedule_.desired_velocity[b]);
-  const float simulated = horizontal_speed(roots_.simulated[b].velocity);
+  const float commanded = detail::horizontal_speed(schedule_.desired_velocity[b]);
+  const float simulated = detail::horizontal_speed(roots_.simulated[b].velocity);
   GaitState& state = gaits_.state[b];
   state = gaits_.first[b] ? first_gait_state(gaits_.params, commanded)
                           : next_gait_state(gaits_.params, state, commanded, simulated, dt);

@@ -67,11 +67,10 @@ void CrowdController::simulate_and_play(std::size_t begin, std::size_t end, floa
     schedule_.was_blocked[b] = (flags[nearest_frame(database, before)] & kFrameBlockTransition) != 0 ? 1 : 0;
     // The simulated root's speed is the command as the character can follow
     // it: the animation moves at it where the bounds allow.
-    const glm::vec3 v = roots_.simulated[b].velocity;
-    const float target = std::sqrt(v.x * v.x + v.z * v.z);
+    const float target = detail::horizontal_speed(roots_.simulated[b].velocity);
     const float stride_speed = stride_speeds_[nearest_frame(database, before)];
-    const float commanded = std::sqrt(desired.x * desired.x + desired.z * desired.z);
-    detail::SpeedScale scale = detail::speed_scale(params_, stride_speed, target, commanded);
+    detail::SpeedScale scale =
+        detail::speed_scale(params_, stride_speed, target, detail::horizontal_speed(desired));
     // A character placed since the last tick holds its frame until its
     // first search has chosen what it plays: moving on a frame it was only
     // placed on would give the jump a velocity that nothing commanded.
@@ -108,7 +107,7 @@ void CrowdController::blend(std::size_t begin, std::size_t end, float dt) {
     float& yaw = roots_.yaw[b];
     roots_.start_yaw[b] = yaw;
     const glm::vec3 step = playback_.step_translation[b] + offset.velocity * dt;
-    roots_.animated_speed[b] = std::sqrt(step.x * step.x + step.z * step.z) / dt;
+    roots_.animated_speed[b] = detail::horizontal_speed(step) / dt;
     roots_.position[b] += detail::yaw_rotate(step, yaw);
     roots_.position[b].y = 0.0f;
     yaw = wrap_angle(yaw + playback_.step_yaw[b] + offset.yaw_rate * dt);

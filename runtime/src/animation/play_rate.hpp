@@ -4,9 +4,12 @@
 // the speed its simulated root moves at.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "mmvk/animation/crowd_controller.hpp"
 #include "mmvk/database/database.hpp"
@@ -14,8 +17,12 @@
 namespace mmvk::detail {
 
 // The played root speed below which a frame counts as standing (m/s): its
-// rate and stride stay 1, since no rate makes a standing frame walk.
+// rate stays 1, since no rate makes a standing frame walk, and so does its
+// stride unless the command is to stand (speed_scale).
 inline constexpr float kStandingSpeed = 0.1f;
+
+// The speed of a velocity along the ground (its y ignored), m/s.
+inline float horizontal_speed(const glm::vec3& v) { return std::sqrt(v.x * v.x + v.z * v.z); }
 
 // Each frame's stride speed, [frames] m/s: the root's horizontal path length
 // over stride_window seconds centred on the frame (clipped to its clip),
